@@ -1,0 +1,715 @@
+"""Run configuration: frozen dataclasses, safe YAML loading and validation.
+
+A config file may give only some keys; every key it leaves out takes the value of the
+embedded default (``cartpole_q/default.yaml``). Loading never constructs Python objects
+from YAML tags and never returns a half-checked config: it returns a frozen
+:class:`Config` or raises :class:`ConfigError`, whose message names the file and field.
+
+This module imports neither numba nor gymnasium, so that ``cartpole-q --help`` stays fast.
+
+>>> config = load_config()
+>>> config.env.id, config.discretization.bins
+('CartPole-v1', (1, 1, 6, 12))
+>>> load_config(overrides={"agent.alpha": "5e-4"}).agent.alpha
+Schedule(kind='constant', start=0.0005, end=0.0005, rate=1.0)
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import difflib
+import math
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import yaml
+
+from cartpole_q.errors import UserError
+
+ENGINES = ("auto", "numba", "gymnasium")
+SCHEDULE_KINDS = ("constant", "exponential", "log")
+MAX_EPISODES = 10_000_000
+MAX_SEEDS = 10_000
+_NAME_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+_NUMBER_PATTERN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+_MISSING = object()
+
+
+class ConfigError(UserError):
+    """A configuration that cannot be used.
+
+    The message is one paragraph that names the source (file or command line) and the
+    field, so the command line can print it as is and exit with code 2.
+    """
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """A value that may change once per episode (learning rate, exploration rate).
+
+    For episode index ``e`` (0 for the first episode):
+
+    - ``constant``: ``start``;
+    - ``exponential``: ``max(end, start * rate ** e)``; the blog's ``epsilon *= 0.995``
+      down to 0.01 is ``start=1.0, rate=0.995, end=0.01``;
+    - ``log``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the
+      constant ``k``; with ``start=1`` this is the classic tabular CartPole schedule.
+    """
+
+    kind: str
+    """one of ``constant``, ``exponential``, ``log``"""
+    start: float
+    """the value at the first episode (the cap of the log schedule)"""
+    end: float
+    """the floor the value never goes below (equals ``start`` for a constant)"""
+    rate: float = 1.0
+    """the decay factor per episode (exponential) or ``k`` (log); unused for a constant"""
+
+    @property
+    def code(self) -> int:
+        """The kind as the integer the compiled agent functions take."""
+        return SCHEDULE_KINDS.index(self.kind)
+
+    def to_yaml(self) -> float | dict[str, Any]:
+        """Return the YAML form: a number for a constant, else a mapping."""
+        if self.kind == "constant":
+            return self.start
+        if self.kind == "exponential":
+            return {"type": "exponential", "start": self.start, "decay": self.rate, "end": self.end}
+        return {"type": "log", "k": self.rate, "end": self.end, "start": self.start}
+
+
+@dataclass(frozen=True)
+class EnvConfig:
+    """Which Gymnasium environment to learn."""
+
+    id: str
+    """the id given to ``gymnasium.make``"""
+    kwargs: Mapping[str, Any]
+    """keyword arguments forwarded to ``gymnasium.make`` (read-only mapping)"""
+
+
+@dataclass(frozen=True)
+class DiscretizationConfig:
+    """The grid that turns a continuous observation into a Q-table row."""
+
+    bins: tuple[int, ...]
+    """bins per observation dimension; a dimension with 1 bin is ignored"""
+    low: tuple[float, ...]
+    """lower edge of the grid per dimension; values below fall in the first bin"""
+    high: tuple[float, ...]
+    """upper edge of the grid per dimension; values above fall in the last bin"""
+
+
+@dataclass(frozen=True)
+class AgentConfig:
+    """Q-learning hyperparameters."""
+
+    gamma: float
+    """discount factor in [0, 1]"""
+    alpha: Schedule
+    """learning rate, every value in (0, 1]"""
+    epsilon: Schedule
+    """exploration rate of the epsilon-greedy policy, every value in [0, 1]"""
+    q_init: float
+    """initial value of every Q-table entry"""
+    max_q_table_bytes: int
+    """refuse to allocate a Q-table larger than this many bytes"""
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """How long to train and what to record on the way."""
+
+    episodes: int
+    """number of training episodes (an upper bound when ``stop_when_solved``)"""
+    seeds: tuple[int, ...] | None
+    """train one run per seed, in parallel; ``None`` trains the single top-level seed"""
+    stop_when_solved: bool
+    """stop at the first episode whose 100-episode average return reaches the threshold"""
+    reward_threshold: float | None
+    """the solve threshold; ``None`` takes the environment's registered threshold"""
+    eval_every: int
+    """run a greedy evaluation every this many episodes; 0 disables it"""
+    eval_episodes: int
+    """episodes per periodic greedy evaluation"""
+    checkpoint_every: int
+    """write a resumable checkpoint every this many episodes; 0 disables it"""
+
+
+@dataclass(frozen=True)
+class EvalConfig:
+    """The greedy evaluation recorded in ``summary.json`` and used by ``cartpole-q eval``."""
+
+    episodes: int
+    """number of greedy episodes"""
+    seed: int
+    """seed of the evaluation environment's first reset"""
+
+
+@dataclass(frozen=True)
+class Config:
+    """A complete, validated run configuration. Never mutated after loading."""
+
+    name: str
+    """run-name prefix: letters, digits, '-', '_'"""
+    seed: int
+    """the run's seed; every random generator of the run is derived from it"""
+    engine: str
+    """``auto``, ``numba`` or ``gymnasium``"""
+    env: EnvConfig
+    discretization: DiscretizationConfig
+    agent: AgentConfig
+    train: TrainConfig
+    eval: EvalConfig
+
+    def to_dict(self) -> dict[str, Any]:
+        """Return the config as plain YAML-ready data, every key present."""
+        return {
+            "name": self.name,
+            "seed": self.seed,
+            "engine": self.engine,
+            "env": {"id": self.env.id, "kwargs": _plain(self.env.kwargs)},
+            "discretization": {
+                "bins": list(self.discretization.bins),
+                "low": list(self.discretization.low),
+                "high": list(self.discretization.high),
+            },
+            "agent": {
+                "gamma": self.agent.gamma,
+                "alpha": self.agent.alpha.to_yaml(),
+                "epsilon": self.agent.epsilon.to_yaml(),
+                "q_init": self.agent.q_init,
+                "max_q_table_bytes": self.agent.max_q_table_bytes,
+            },
+            "train": {
+                "episodes": self.train.episodes,
+                "seeds": None if self.train.seeds is None else format_seeds(self.train.seeds),
+                "stop_when_solved": self.train.stop_when_solved,
+                "reward_threshold": self.train.reward_threshold,
+                "eval_every": self.train.eval_every,
+                "eval_episodes": self.train.eval_episodes,
+                "checkpoint_every": self.train.checkpoint_every,
+            },
+            "eval": {"episodes": self.eval.episodes, "seed": self.eval.seed},
+        }
+
+    def to_yaml(self) -> str:
+        """Return the resolved config as YAML; loading it gives back an equal config."""
+        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None)
+
+    def for_seed(self, seed: int) -> Config:
+        """Return this config as the single run of ``seed`` (no ``train.seeds``)."""
+        return dataclasses.replace(
+            self, seed=seed, train=dataclasses.replace(self.train, seeds=None)
+        )
+
+
+_SECTIONS: dict[str, type] = {
+    "env": EnvConfig,
+    "discretization": DiscretizationConfig,
+    "agent": AgentConfig,
+    "train": TrainConfig,
+    "eval": EvalConfig,
+}
+_TOP_LEVEL_KEYS = ("name", "seed", "engine", *_SECTIONS)
+_SCHEDULE_REQUIRED = {
+    "constant": ("value",),
+    "exponential": ("start", "decay", "end"),
+    "log": ("k", "end"),
+}
+_SCHEDULE_KEYS = {
+    "constant": ("type", "value"),
+    "exponential": ("type", "start", "decay", "end"),
+    "log": ("type", "k", "end", "start"),
+}
+
+
+def load_config(
+    path: str | Path | None = None, overrides: Mapping[str, Any] | None = None
+) -> Config:
+    """Load, complete and validate a config.
+
+    Args:
+        path: a YAML file; ``None`` loads the embedded default alone.
+        overrides: dotted keys (``"train.episodes"``) and values that replace the
+            file's, as given on the command line.
+
+    Returns:
+        The validated, frozen config.
+
+    Raises:
+        ConfigError: the file cannot be read or parsed, or a key or value is invalid.
+    """
+    raw = default_raw()
+    source = "default config"
+    if path is not None:
+        source = str(path)
+        user = read_yaml_mapping(Path(path))
+        check_known_keys(user, source)
+        raw = _merge(raw, user)
+    overridden = set()
+    for dotted, value in (overrides or {}).items():
+        section, _, key = dotted.rpartition(".")
+        target = raw[section] if section else raw
+        target[key] = value
+        overridden.add(dotted)
+    return _Reader(raw, source, overridden).config()
+
+
+def default_yaml_text() -> str:
+    """Return the embedded default config file's text."""
+    return resources.files("cartpole_q").joinpath("default.yaml").read_text(encoding="utf-8")
+
+
+def default_raw() -> dict[str, Any]:
+    """Return the embedded default config as plain data (a fresh copy)."""
+    data = yaml.safe_load(default_yaml_text())
+    assert isinstance(data, dict)  # the packaged file is ours; tests check it loads
+    return data
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """A safe loader that refuses duplicate mapping keys instead of keeping the last."""
+
+
+def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode) -> dict[Any, Any]:
+    seen: set[Any] = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node)
+        if isinstance(key, Iterable) and not isinstance(key, str):
+            raise yaml.constructor.ConstructorError(
+                None, None, "a mapping key must be a scalar", key_node.start_mark
+            )
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r}", key_node.start_mark
+            )
+        seen.add(key)
+    return loader.construct_mapping(node)
+
+
+_UniqueKeyLoader.add_constructor(
+    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_unique_mapping
+)
+
+
+def read_yaml_mapping(path: Path) -> dict[str, Any]:
+    """Read a YAML file that must hold a mapping, with the safe loader only.
+
+    Raises:
+        ConfigError: the file is missing, unreadable, not YAML, empty, not a mapping, or
+            uses a tag that would construct a Python object.
+    """
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: config file not found.") from None
+    except IsADirectoryError:
+        raise ConfigError(f"{path}: is a directory, not a config file.") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"{path}: is not a UTF-8 text file.") from None
+    except OSError as error:
+        raise ConfigError(f"{path}: cannot be read ({error.strerror}).") from None
+    try:
+        data = yaml.load(text, Loader=_UniqueKeyLoader)
+    except yaml.constructor.ConstructorError as error:
+        where = _yaml_mark(error.problem_mark)
+        if error.problem and "could not determine a constructor" in error.problem:
+            problem = (
+                f"uses a YAML tag that is not allowed{where}; only plain YAML "
+                "(mappings, lists, numbers, strings, booleans, null) is accepted, and "
+                "nothing was executed"
+            )
+        else:
+            problem = f"{error.problem}{where}"
+        raise ConfigError(f"{path}: {problem}.") from None
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        problem = getattr(error, "problem", None) or "invalid syntax"
+        raise ConfigError(f"{path}: is not valid YAML: {problem}{_yaml_mark(mark)}.") from None
+    if data is None:
+        raise ConfigError(f"{path}: is empty; a config must be a mapping such as 'seed: 0'.")
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: must be a mapping of keys to values, not a {_type_name(data)}.")
+    return data
+
+
+def _yaml_mark(mark: Any) -> str:
+    return "" if mark is None else f" (line {mark.line + 1}, column {mark.column + 1})"
+
+
+def check_known_keys(user: Mapping[Any, Any], source: str) -> None:
+    """Refuse keys the config does not know, suggesting the closest valid one.
+
+    Raises:
+        ConfigError: naming the unknown key and, when one is close, the likely intended key.
+    """
+    _check_keys(user, _TOP_LEVEL_KEYS, "", source)
+    for section, section_type in _SECTIONS.items():
+        if section not in user or user[section] is None:
+            continue
+        value = user[section]
+        if not isinstance(value, dict):
+            raise ConfigError(
+                f"{source}: {section}: must be a mapping of keys to values, "
+                f"not a {_type_name(value)}."
+            )
+        names = [field.name for field in dataclasses.fields(section_type)]
+        _check_keys(value, names, f"{section}.", source)
+
+
+def _check_keys(data: Mapping[Any, Any], valid: Iterable[str], prefix: str, source: str) -> None:
+    valid = list(valid)
+    for key in data:
+        if key in valid:
+            continue
+        close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
+        hint = (
+            f"; did you mean '{prefix}{close[0]}'?"
+            if close
+            else f"; valid keys: {', '.join(valid)}."
+        )
+        raise ConfigError(f"{source}: unknown key '{prefix}{key}'{hint}")
+
+
+def _merge(base: dict[str, Any], user: Mapping[str, Any]) -> dict[str, Any]:
+    """Overlay the user's keys on the default; sections merge key by key, values replace."""
+    merged = copy.deepcopy(base)
+    for key, value in user.items():
+        if key in _SECTIONS and value is None:
+            continue
+        if key in _SECTIONS:
+            merged[key].update(copy.deepcopy(value))
+        else:
+            merged[key] = copy.deepcopy(value)
+    return merged
+
+
+class _Reader:
+    """Typed, range-checked access to the merged raw mapping, with precise error messages."""
+
+    def __init__(self, raw: dict[str, Any], source: str, overridden: set[str]) -> None:
+        self._raw = raw
+        self._source = source
+        self._overridden = overridden
+
+    def error(self, field: str, problem: str) -> ConfigError:
+        source = "command line" if field in self._overridden else self._source
+        return ConfigError(f"{source}: {field}: {problem}")
+
+    def _value(self, field: str) -> Any:
+        section, _, key = field.rpartition(".")
+        return (self._raw[section] if section else self._raw)[key]
+
+    # -- scalar readers ---------------------------------------------------------------
+
+    def number(
+        self,
+        field: str,
+        value: Any = _MISSING,
+        *,
+        low: float = -math.inf,
+        high: float = math.inf,
+        low_open: bool = False,
+        interval: str = "",
+    ) -> float:
+        value = self._value(field) if value is _MISSING else value
+        number = _as_number(value)
+        if number is None:
+            raise self.error(field, f"must be a number, got {_shown(value)}.")
+        if not math.isfinite(number):
+            raise self.error(field, f"must be a finite number, got {_shown(value)}.")
+        too_low = number <= low if low_open else number < low
+        if too_low or number > high:
+            raise self.error(field, f"must be in {interval}, got {_shown(value)}.")
+        return number
+
+    def integer(self, field: str, *, minimum: int, maximum: int | None = None) -> int:
+        value = self._value(field)
+        number = _as_number(value)
+        if number is None or not math.isfinite(number) or number != int(number):
+            raise self.error(field, f"must be an integer, got {_shown(value)}.")
+        integer = int(value) if isinstance(value, int) else int(number)
+        if integer < minimum:
+            raise self.error(field, f"must be at least {minimum}, got {integer}.")
+        if maximum is not None and integer > maximum:
+            raise self.error(field, f"must be at most {maximum}, got {integer}.")
+        return integer
+
+    def boolean(self, field: str) -> bool:
+        value = self._value(field)
+        if not isinstance(value, bool):
+            raise self.error(field, f"must be true or false, got {_shown(value)}.")
+        return value
+
+    def string(self, field: str) -> str:
+        value = self._value(field)
+        if not isinstance(value, str) or not value:
+            raise self.error(field, f"must be a non-empty string, got {_shown(value)}.")
+        return value
+
+    def choice(self, field: str, choices: tuple[str, ...]) -> str:
+        value = self._value(field)
+        if value not in choices:
+            raise self.error(field, f"must be one of {', '.join(choices)}; got {_shown(value)}.")
+        return str(value)
+
+    # -- composite readers ------------------------------------------------------------
+
+    def number_list(self, field: str) -> tuple[float, ...]:
+        values = self._value(field)
+        if not isinstance(values, list) or not values:
+            raise self.error(field, f"must be a non-empty list of numbers, got {_shown(values)}.")
+        return tuple(self.number(f"{field}[{i}]", v) for i, v in enumerate(values))
+
+    def bins(self, field: str) -> tuple[int, ...]:
+        values = self._value(field)
+        if not isinstance(values, list) or not values:
+            raise self.error(
+                field, f"must be a non-empty list of positive integers, got {_shown(values)}."
+            )
+        result = []
+        for i, value in enumerate(values):
+            number = _as_number(value)
+            if number is None or not math.isfinite(number) or number != int(number):
+                raise self.error(
+                    field, f"entry {i} must be a positive integer, got {_shown(value)}."
+                )
+            if number < 1:
+                raise self.error(field, f"entry {i} must be at least 1, got {_shown(value)}.")
+            result.append(int(number))
+        return tuple(result)
+
+    def schedule(self, field: str, *, low: float, low_open: bool, interval: str) -> Schedule:
+        value = self._value(field)
+        bounded = {"low": low, "high": 1.0, "low_open": low_open, "interval": interval}
+        if not isinstance(value, dict):
+            constant = self.number(field, value, **bounded)  # type: ignore[arg-type]
+            return Schedule("constant", constant, constant)
+        kind = value.get("type")
+        if kind not in SCHEDULE_KINDS:
+            raise self.error(
+                f"{field}.type",
+                f"must be one of {', '.join(SCHEDULE_KINDS)}; got {_shown(kind)}.",
+            )
+        keys = _SCHEDULE_KEYS[kind]
+        _check_keys_with(value, keys, f"{field}.", lambda problem: self.error(field, problem))
+        for key in _SCHEDULE_REQUIRED[kind]:
+            if key not in value:
+                raise self.error(field, f"a {kind} schedule needs '{key}'.")
+        if kind == "constant":
+            constant = self.number(f"{field}.value", value["value"], **bounded)  # type: ignore[arg-type]
+            return Schedule("constant", constant, constant)
+        end = self.number(f"{field}.end", value["end"], **bounded)  # type: ignore[arg-type]
+        if kind == "exponential":
+            start = self.number(f"{field}.start", value["start"], **bounded)  # type: ignore[arg-type]
+            decay = self.number(
+                f"{field}.decay",
+                value["decay"],
+                low=0.0,
+                high=1.0,
+                low_open=True,
+                interval="(0, 1]",
+            )
+            return Schedule("exponential", start, end, decay)
+        start = self.number(f"{field}.start", value.get("start", 1.0), **bounded)  # type: ignore[arg-type]
+        k = self.number(f"{field}.k", value["k"], low=0.0, low_open=True, interval="(0, inf)")
+        return Schedule("log", start, end, k)
+
+    def seeds(self, field: str) -> tuple[int, ...] | None:
+        value = self._value(field)
+        if value is None:
+            return None
+        try:
+            seeds = parse_seeds(value)
+        except ValueError as error:
+            raise self.error(field, str(error)) from None
+        return seeds
+
+    def kwargs(self, field: str) -> Mapping[str, Any]:
+        value = self._value(field)
+        if value is None:
+            return MappingProxyType({})
+        if not isinstance(value, dict) or not all(isinstance(key, str) for key in value):
+            raise self.error(
+                field, f"must be a mapping of argument names to values, got {_shown(value)}."
+            )
+        return MappingProxyType(copy.deepcopy(value))
+
+    # -- the whole config -------------------------------------------------------------
+
+    def config(self) -> Config:
+        raw = self._raw
+        for section in _SECTIONS:
+            if not isinstance(raw.get(section), dict):
+                raise self.error(section, "must be a mapping of keys to values.")
+        name = self.string("name")
+        if not _NAME_PATTERN.fullmatch(name):
+            raise self.error(
+                "name",
+                f"must be 1-64 letters, digits, '-' or '_' (it names a directory; no path "
+                f"separators or '..'), got {_shown(name)}.",
+            )
+        discretization = self._discretization()
+        return Config(
+            name=name,
+            seed=self.integer("seed", minimum=0),
+            engine=self.choice("engine", ENGINES),
+            env=EnvConfig(id=self.string("env.id"), kwargs=self.kwargs("env.kwargs")),
+            discretization=discretization,
+            agent=AgentConfig(
+                gamma=self.number("agent.gamma", low=0.0, high=1.0, interval="[0, 1]"),
+                alpha=self.schedule("agent.alpha", low=0.0, low_open=True, interval="(0, 1]"),
+                epsilon=self.schedule("agent.epsilon", low=0.0, low_open=False, interval="[0, 1]"),
+                q_init=self.number("agent.q_init"),
+                max_q_table_bytes=self.integer("agent.max_q_table_bytes", minimum=1),
+            ),
+            train=TrainConfig(
+                episodes=self.integer("train.episodes", minimum=1, maximum=MAX_EPISODES),
+                seeds=self.seeds("train.seeds"),
+                stop_when_solved=self.boolean("train.stop_when_solved"),
+                reward_threshold=(
+                    None
+                    if raw["train"]["reward_threshold"] is None
+                    else self.number("train.reward_threshold")
+                ),
+                eval_every=self.integer("train.eval_every", minimum=0),
+                eval_episodes=self.integer("train.eval_episodes", minimum=1),
+                checkpoint_every=self.integer("train.checkpoint_every", minimum=0),
+            ),
+            eval=EvalConfig(
+                episodes=self.integer("eval.episodes", minimum=1),
+                seed=self.integer("eval.seed", minimum=0),
+            ),
+        )
+
+    def _discretization(self) -> DiscretizationConfig:
+        bins = self.bins("discretization.bins")
+        low = self.number_list("discretization.low")
+        high = self.number_list("discretization.high")
+        for field, values in (("discretization.low", low), ("discretization.high", high)):
+            if len(values) != len(bins):
+                raise self.error(
+                    field,
+                    f"has {len(values)} entries but discretization.bins has {len(bins)}; "
+                    "give one per observation dimension.",
+                )
+        for d, (lo, hi) in enumerate(zip(low, high, strict=True)):
+            if not lo < hi:
+                raise self.error(
+                    "discretization.low",
+                    f"entry {d} ({lo}) must be below discretization.high entry {d} ({hi}).",
+                )
+        return DiscretizationConfig(bins=bins, low=low, high=high)
+
+
+def _check_keys_with(
+    data: Mapping[Any, Any], valid: tuple[str, ...], prefix: str, error: Any
+) -> None:
+    for key in data:
+        if key not in valid:
+            close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
+            hint = (
+                f"; did you mean '{close[0]}'?" if close else f"; valid keys: {', '.join(valid)}."
+            )
+            raise error(f"unknown key '{prefix}{key}'{hint}")
+
+
+def parse_seeds(value: Any) -> tuple[int, ...]:
+    """Parse a seed list: an integer, a list of integers, or a string like ``"0-9,20"``.
+
+    Returns:
+        The distinct seeds in ascending order.
+
+    Raises:
+        ValueError: the value is not a seed list, a seed is negative, or there are too many.
+
+    >>> parse_seeds("0-3,7")
+    (0, 1, 2, 3, 7)
+    """
+    seeds: list[int] = []
+    if isinstance(value, bool):
+        raise ValueError(f"must be seeds like '0-99' or [0, 1, 2], got {_shown(value)}.")
+    if isinstance(value, int):
+        seeds = [value]
+    elif isinstance(value, list) and value:
+        for item in value:
+            if isinstance(item, bool) or not isinstance(item, int):
+                raise ValueError(f"every seed must be an integer, got {_shown(item)}.")
+            seeds.append(item)
+    elif isinstance(value, str) and value.strip():
+        for part in value.split(","):
+            match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+            if not match:
+                raise ValueError(f"must be seeds like '0-99' or '0,5,10-19', got {_shown(value)}.")
+            first, last = int(match[1]), int(match[2] or match[1])
+            if last < first:
+                raise ValueError(f"range '{part.strip()}' runs backwards.")
+            if last - first >= MAX_SEEDS:
+                raise ValueError(f"at most {MAX_SEEDS} seeds, got range '{part.strip()}'.")
+            seeds.extend(range(first, last + 1))
+    else:
+        raise ValueError(f"must be seeds like '0-99' or [0, 1, 2], got {_shown(value)}.")
+    if any(seed < 0 for seed in seeds):
+        raise ValueError("seeds must be non-negative.")
+    unique = sorted(set(seeds))
+    if len(unique) > MAX_SEEDS:
+        raise ValueError(f"at most {MAX_SEEDS} seeds, got {len(unique)}.")
+    return tuple(unique)
+
+
+def format_seeds(seeds: Iterable[int]) -> str:
+    """Write seeds compactly: ``(0, 1, 2, 3, 7)`` becomes ``"0-3,7"``.
+
+    >>> format_seeds([0, 1, 2, 3, 7])
+    '0-3,7'
+    """
+    parts: list[str] = []
+    ordered = sorted(set(seeds))
+    start = previous = None
+    for seed in [*ordered, None]:
+        if previous is not None and (seed is None or seed != previous + 1):
+            parts.append(str(start) if start == previous else f"{start}-{previous}")
+            start = seed
+        elif start is None:
+            start = seed
+        previous = seed
+    return ",".join(parts)
+
+
+def _as_number(value: Any) -> float | None:
+    """Return ``value`` as a float if it is a number or a numeric string like ``5e-4``."""
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int | float):
+        return float(value)
+    if isinstance(value, str) and _NUMBER_PATTERN.fullmatch(value.strip()):
+        return float(value)
+    return None
+
+
+def _type_name(value: Any) -> str:
+    return {list: "list", str: "string", int: "number", float: "number", bool: "boolean"}.get(
+        type(value), type(value).__name__
+    )
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _plain(value: Any) -> Any:
+    """Turn read-only mappings back into plain dicts for YAML and JSON."""
+    if isinstance(value, Mapping):
+        return {key: _plain(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(item) for item in value]
+    return value
