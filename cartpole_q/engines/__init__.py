@@ -1,0 +1,60 @@
+"""Training engines: ``gymnasium`` (real environments) and ``numba`` (compiled twin).
+
+Both drive the same agent functions with the same random draws; choosing one changes
+speed, never results. Engine modules are imported only when an engine is made, so this
+package costs nothing to import.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from cartpole_q.config import Config, ConfigError
+from cartpole_q.engines.base import AgentParams, Engine
+from cartpole_q.environment import EnvInfo
+
+
+def resolve_engine(config: Config, env_info: EnvInfo, source: str = "config") -> str:
+    """Return the engine that will run: ``auto`` becomes numba where a twin exists.
+
+    Raises:
+        ConfigError: ``engine: numba`` was asked for an environment the twin cannot
+            reproduce (the message names the id or key).
+    """
+    from cartpole_q.engines.cartpole_twin import TwinSettings, twin_settings
+
+    if config.engine == "gymnasium":
+        return "gymnasium"
+    settings = twin_settings(config.env.id, config.env.kwargs, env_info.max_episode_steps)
+    if isinstance(settings, TwinSettings):
+        return "numba"
+    if config.engine == "numba":
+        raise ConfigError(
+            f"{source}: engine: numba cannot run this config: {settings}. Use engine: "
+            "gymnasium (or auto, which falls back to it)."
+        )
+    return "gymnasium"
+
+
+def make_engine(
+    name: str,
+    config: Config,
+    env_info: EnvInfo,
+    env_seed: int,
+    env_rng_state: dict[str, Any] | None = None,
+) -> Engine:
+    """Build the named engine for a config, seeding its environment with ``env_seed``.
+
+    ``env_rng_state`` restores a checkpointed environment generator instead.
+    """
+    params = AgentParams.from_config(config, env_info)
+    if name == "numba":
+        from cartpole_q.engines.cartpole_twin import TwinSettings, twin_settings
+        from cartpole_q.engines.numba_engine import NumbaEngine
+
+        settings = twin_settings(config.env.id, config.env.kwargs, env_info.max_episode_steps)
+        assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
+        return NumbaEngine(settings, params, env_seed, env_rng_state)
+    from cartpole_q.engines.gymnasium_engine import GymnasiumEngine
+
+    return GymnasiumEngine(config, params, env_seed, env_rng_state)

@@ -1,0 +1,329 @@
+"""Training: a config in, a :class:`TrainResult` out. No file I/O here.
+
+The driver runs the engine in chunks of episodes. Between chunks (always at an episode
+boundary) it keeps the solve-point table, runs periodic greedy evaluations, hands
+checkpoints and progress to the caller's callbacks, and honours a stop request. Chunk
+sizes never change results: an engine's state lives entirely in the Q-table, the metrics
+arrays and two random generators.
+
+Randomness: the run seed feeds a ``numpy.random.SeedSequence`` whose two children give the
+agent's Generator and the integer seed of the environment's first reset.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import Config
+from cartpole_q.engines import make_engine, resolve_engine
+from cartpole_q.engines.base import Engine, TrainingState
+from cartpole_q.environment import SOLVE_WINDOW, EnvInfo, inspect_env
+from cartpole_q.evaluation import EvalReport
+
+
+def derive_generators(seed: int) -> tuple[np.random.Generator, int]:
+    """Return the agent's Generator and the environment's first-reset seed for a run seed.
+
+    >>> rng, env_seed = derive_generators(0)
+    >>> env_seed
+    2968811710
+    """
+    agent_sequence, env_sequence = np.random.SeedSequence(seed).spawn(2)
+    env_seed = int(env_sequence.generate_state(1, dtype=np.uint32)[0])
+    return np.random.Generator(np.random.PCG64(agent_sequence)), env_seed
+
+
+@dataclass(frozen=True)
+class Progress:
+    """A progress report, given after every chunk of episodes."""
+
+    episode: int
+    """episodes finished"""
+    episodes: int
+    """episodes configured"""
+    last_return: float
+    moving_average: float
+    """mean return of the last (up to) 100 episodes"""
+    epsilon: float
+    env_steps: int
+    elapsed: float
+    """seconds since training (re)started"""
+    solved_episode: int | None
+
+
+@dataclass(frozen=True)
+class Checkpoint:
+    """Everything needed to continue a run exactly where it stopped (an episode boundary).
+
+    The arrays are the live training arrays: a callback must save them before returning.
+    """
+
+    engine: str
+    episode: int
+    env_steps: int
+    q: np.ndarray
+    visits: np.ndarray
+    returns: np.ndarray
+    lengths: np.ndarray
+    epsilons: np.ndarray
+    alphas: np.ndarray
+    agent_rng_state: dict[str, Any]
+    env_rng_state: dict[str, Any]
+    solved_episode: int | None
+    solved_q: np.ndarray | None
+    evaluations: list[dict[str, Any]]
+    train_seconds: float
+    wall_seconds: float
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """The outcome of training: the kept Q-table, per-episode metrics and figures."""
+
+    config: Config
+    engine: str
+    """the engine that ran"""
+    q_table: np.ndarray
+    """the kept table, shape ``(*bins, n_actions)``: from the solve point if the run solved"""
+    kept_episode: int
+    """the episode after which the kept table was taken"""
+    visits: np.ndarray
+    """how often each (state, action) was taken in training, same shape as ``q_table``"""
+    returns: np.ndarray
+    lengths: np.ndarray
+    epsilons: np.ndarray
+    alphas: np.ndarray
+    env_steps: int
+    solved_episode: int | None
+    """first episode whose 100-episode average return reached the threshold"""
+    reward_threshold: float | None
+    evaluations: list[dict[str, Any]]
+    """periodic greedy evaluations: episode, env_steps, mean, std, min, max"""
+    eval: EvalReport | None
+    """the final greedy evaluation of the kept table (the engine's environment)"""
+    train_seconds: float
+    """seconds spent in training episodes"""
+    wall_seconds: float
+    """seconds of the whole training loop, periodic evaluations included"""
+    interrupted: bool = False
+    checkpoint: Checkpoint | None = field(default=None, repr=False)
+
+    @property
+    def episodes(self) -> int:
+        """Episodes trained."""
+        return len(self.returns)
+
+    @property
+    def steps_per_second(self) -> float:
+        """Training env steps per second of training time."""
+        return self.env_steps / self.train_seconds if self.train_seconds > 0 else 0.0
+
+    def first_greedy_success(self) -> dict[str, int] | None:
+        """The first periodic evaluation whose mean reached the threshold, if any."""
+        if self.reward_threshold is None:
+            return None
+        for record in self.evaluations:
+            if record["mean"] >= self.reward_threshold:
+                return {"episode": record["episode"], "env_steps": record["env_steps"]}
+        return None
+
+
+def train(
+    config: Config,
+    *,
+    env_info: EnvInfo | None = None,
+    resume: Checkpoint | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    on_progress: Callable[[Progress], None] | None = None,
+    on_checkpoint: Callable[[Checkpoint], None] | None = None,
+    final_eval: bool = True,
+) -> TrainResult:
+    """Train a Q-table as the config says.
+
+    Args:
+        config: a validated config (its ``train.seeds`` is ignored: one run, ``config.seed``).
+        env_info: the checked environment, if the caller already inspected it.
+        resume: a checkpoint to continue from; the result is then byte-identical to an
+            uninterrupted run.
+        should_stop: polled between chunks; when it returns true, training ends at the
+            last finished episode and the result is marked ``interrupted``.
+        on_progress: called after every chunk.
+        on_checkpoint: called every ``train.checkpoint_every`` episodes, and on interruption.
+        final_eval: run the final greedy evaluation of the kept table.
+
+    Raises:
+        ConfigError: the config does not fit its environment.
+    """
+    env_info = env_info or inspect_env(config)
+    engine_name = resume.engine if resume is not None else resolve_engine(config, env_info)
+    agent_rng, env_seed = derive_generators(config.seed)
+    state = TrainingState.fresh(config, env_info, agent_rng)
+    if resume is not None:
+        _restore(state, resume)
+    engine = make_engine(
+        engine_name, config, env_info, env_seed, None if resume is None else resume.env_rng_state
+    )
+    try:
+        return _run(config, env_info, engine, state, resume, should_stop, on_progress,
+                    on_checkpoint, final_eval)  # fmt: skip
+    finally:
+        engine.close()
+
+
+def _run(
+    config: Config,
+    env_info: EnvInfo,
+    engine: Engine,
+    state: TrainingState,
+    resume: Checkpoint | None,
+    should_stop: Callable[[], bool] | None,
+    on_progress: Callable[[Progress], None] | None,
+    on_checkpoint: Callable[[Checkpoint], None] | None,
+    final_eval: bool,
+) -> TrainResult:
+    settings = config.train
+    total = settings.episodes
+    train_seconds = 0.0 if resume is None else resume.train_seconds
+    wall_before = 0.0 if resume is None else resume.wall_seconds
+    started = time.perf_counter()
+    interrupted = False
+
+    def snapshot() -> Checkpoint:
+        episode = state.episode
+        return Checkpoint(
+            engine=engine.name,
+            episode=episode,
+            env_steps=state.env_steps,
+            q=state.q,
+            visits=state.visits,
+            returns=state.returns[:episode],
+            lengths=state.lengths[:episode],
+            epsilons=state.epsilons[:episode],
+            alphas=state.alphas[:episode],
+            agent_rng_state=dict(state.agent_rng.bit_generator.state),
+            env_rng_state=engine.env_rng_state(),
+            solved_episode=state.solved_episode,
+            solved_q=state.solved_q,
+            evaluations=list(state.evaluations),
+            train_seconds=train_seconds,
+            wall_seconds=wall_before + time.perf_counter() - started,
+        )
+
+    finished = state.episode >= total or (
+        state.solved_episode is not None and settings.stop_when_solved
+    )
+    while not finished:
+        stop = min(
+            total,
+            state.episode + engine.chunk_episodes,
+            _next_multiple(state.episode, settings.eval_every),
+            _next_multiple(state.episode, settings.checkpoint_every),
+        )
+        chunk_started = time.perf_counter()
+        solved = engine.run(state, stop, check_solved=state.solved_episode is None)
+        train_seconds += time.perf_counter() - chunk_started
+        if solved is not None:
+            state.solved_episode = solved + 1
+            if not settings.stop_when_solved:
+                state.solved_q = state.q.copy()
+        if settings.eval_every and state.episode % settings.eval_every == 0:
+            periodic = EvalReport.from_returns(
+                engine.evaluate(state.q, settings.eval_episodes, config.eval.seed), config.eval.seed
+            )
+            state.evaluations.append(
+                {"episode": state.episode, "env_steps": state.env_steps, **periodic.to_dict()}
+            )
+        finished = state.episode >= total or (solved is not None and settings.stop_when_solved)
+        if (
+            on_checkpoint is not None
+            and settings.checkpoint_every
+            and state.episode % settings.checkpoint_every == 0
+            and not finished
+        ):
+            on_checkpoint(snapshot())
+        if on_progress is not None:
+            on_progress(_progress(state, total, time.perf_counter() - started))
+        if not finished and should_stop is not None and should_stop():
+            interrupted = True
+            break
+
+    last_checkpoint = snapshot() if interrupted else None
+    if interrupted and on_checkpoint is not None:
+        on_checkpoint(last_checkpoint)  # type: ignore[arg-type]
+    wall_seconds = wall_before + time.perf_counter() - started
+
+    if state.solved_episode is not None:
+        kept = state.q if state.solved_q is None else state.solved_q
+        kept_episode = state.solved_episode
+    else:
+        kept, kept_episode = state.q, state.episode
+    report: EvalReport | None = None
+    if final_eval:
+        report = EvalReport.from_returns(
+            engine.evaluate(kept, config.eval.episodes, config.eval.seed), config.eval.seed
+        )
+    table_shape = (*config.discretization.bins, env_info.n_actions)
+    episode = state.episode
+    return TrainResult(
+        config=config,
+        engine=engine.name,
+        q_table=kept.reshape(table_shape).copy(),
+        kept_episode=kept_episode,
+        visits=state.visits.reshape(table_shape).copy(),
+        returns=state.returns[:episode].copy(),
+        lengths=state.lengths[:episode].copy(),
+        epsilons=state.epsilons[:episode].copy(),
+        alphas=state.alphas[:episode].copy(),
+        env_steps=state.env_steps,
+        solved_episode=state.solved_episode,
+        reward_threshold=env_info.reward_threshold,
+        evaluations=list(state.evaluations),
+        eval=report,
+        train_seconds=train_seconds,
+        wall_seconds=wall_seconds,
+        interrupted=interrupted,
+        checkpoint=last_checkpoint,
+    )
+
+
+def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
+    episode = checkpoint.episode
+    state.q[...] = checkpoint.q
+    state.visits[...] = checkpoint.visits
+    state.returns[:episode] = checkpoint.returns
+    state.lengths[:episode] = checkpoint.lengths
+    state.epsilons[:episode] = checkpoint.epsilons
+    state.alphas[:episode] = checkpoint.alphas
+    state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
+    state.episode = episode
+    state.env_steps = checkpoint.env_steps
+    state.solved_episode = checkpoint.solved_episode
+    state.solved_q = None if checkpoint.solved_q is None else checkpoint.solved_q.copy()
+    state.evaluations = list(checkpoint.evaluations)
+
+
+def _next_multiple(episode: int, every: int) -> int:
+    """The next episode count after ``episode`` that is a multiple of ``every`` (0: never)."""
+    if every <= 0:
+        return np.iinfo(np.int64).max
+    return (episode // every + 1) * every
+
+
+def _progress(state: TrainingState, total: int, elapsed: float) -> Progress:
+    episode = state.episode
+    window = state.returns[max(0, episode - SOLVE_WINDOW) : episode]
+    return Progress(
+        episode=episode,
+        episodes=total,
+        last_return=float(state.returns[episode - 1]) if episode else 0.0,
+        moving_average=float(window.mean()) if episode else 0.0,
+        epsilon=float(state.epsilons[episode - 1]) if episode else 0.0,
+        env_steps=state.env_steps,
+        elapsed=elapsed,
+        solved_episode=state.solved_episode,
+    )
