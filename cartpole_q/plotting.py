@@ -1,0 +1,336 @@
+"""Figures, drawn with matplotlib's object API (no pyplot state) on the Agg canvas.
+
+The ``*_figure`` functions take arrays and return a :class:`matplotlib.figure.Figure`;
+:func:`plot_rewards` and :func:`plot_policy` are what ``cartpole-q plot`` runs: they load
+run directories, draw, and write the PNG atomically.
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from cartpole_q.environment import SOLVE_WINDOW
+
+DPI = 100
+CURVE_SIZE = (8.0, 4.5)
+"""inches; at 100 dpi a reward curve is 800 x 450 pixels"""
+POLICY_SIZE = (13.5, 4.2)
+"""inches; at 100 dpi a policy map is 1350 x 420 pixels"""
+CARTPOLE_DIMENSIONS = ("cart position", "cart velocity", "pole angle", "pole angular velocity")
+CARTPOLE_UNITS = ("m", "m/s", "rad", "rad/s")
+BOOTSTRAP_RESAMPLES = 1000
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One run's training returns, as drawn on a reward-curve figure."""
+
+    label: str
+    returns: np.ndarray
+    solved_episode: int | None = None
+
+
+@dataclass(frozen=True)
+class SeedBand:
+    """Several seeds' training returns, drawn as a mean with a confidence band."""
+
+    label: str
+    returns: list[np.ndarray]
+    solved_episodes: list[int | None]
+
+
+def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
+    """Trailing mean over the last ``window`` values (fewer at the start).
+
+    >>> moving_average(np.array([1.0, 3.0, 5.0, 7.0]), window=2).tolist()
+    [1.0, 2.0, 4.0, 6.0]
+    """
+    values = np.asarray(values, dtype=np.float64)
+    if values.size == 0:
+        return values
+    cumulative = np.concatenate([[0.0], np.cumsum(values)])
+    index = np.arange(1, values.size + 1)
+    start = np.maximum(index - window, 0)
+    return np.asarray((cumulative[index] - cumulative[start]) / (index - start))
+
+
+def bootstrap_band(
+    curves: np.ndarray, rng: np.random.Generator, resamples: int = BOOTSTRAP_RESAMPLES
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Mean over seeds per episode and its 95% percentile-bootstrap confidence band.
+
+    Args:
+        curves: ``(n_seeds, n_episodes)``; NaN where a seed has no value (it stopped).
+        rng: the generator that draws the resamples.
+        resamples: bootstrap resamples.
+
+    Returns:
+        ``(mean, low, high)``, each of length ``n_episodes``.
+    """
+    n_seeds = curves.shape[0]
+    mean = np.nanmean(curves, axis=0)
+    picks = rng.integers(0, n_seeds, size=(resamples, n_seeds))
+    resampled = np.nanmean(curves[picks], axis=1)
+    low, high = np.nanpercentile(resampled, [2.5, 97.5], axis=0)
+    return mean, low, high
+
+
+def reward_curve_figure(
+    curves: Sequence[Curve | SeedBand], threshold: float | None, title: str = "Training reward"
+) -> Figure:
+    """Training returns: per run, the returns (faint) and their 100-episode moving average.
+
+    A :class:`SeedBand` is drawn as its seeds' moving averages (faint), their mean, and a
+    95% bootstrap confidence band, with the median solve episode marked.
+    """
+    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    for item, colour in zip(curves, _colours(len(curves)), strict=True):
+        if isinstance(item, SeedBand):
+            _draw_band(axes, item, colour)
+            continue
+        episodes = np.arange(1, len(item.returns) + 1)
+        axes.plot(episodes, item.returns, color=colour, alpha=0.25, linewidth=0.8)
+        suffix = f" (solved at {item.solved_episode})" if item.solved_episode else ""
+        axes.plot(episodes, moving_average(item.returns), color=colour, linewidth=2.0,
+                  label=f"{item.label}{suffix}")  # fmt: skip
+        if item.solved_episode:
+            axes.axvline(item.solved_episode, color=colour, linestyle=":", linewidth=1.0)
+    if threshold is not None:
+        axes.axhline(threshold, color="black", linestyle="--", linewidth=1.0,
+                     label=f"reward threshold {threshold:g}")  # fmt: skip
+    axes.set_xlabel("training episode")
+    axes.set_ylabel(f"return ({SOLVE_WINDOW}-episode moving average)")
+    axes.set_title(title)
+    axes.grid(alpha=0.3)
+    axes.legend(loc="lower right", fontsize="small")
+    return figure
+
+
+def _draw_band(axes: object, band: SeedBand, colour: tuple[float, ...]) -> None:
+    length = max(len(r) for r in band.returns)
+    curves = np.full((len(band.returns), length), np.nan)
+    for i, returns in enumerate(band.returns):
+        curves[i, : len(returns)] = moving_average(returns)
+        # A run that stopped when solved keeps its last average for the rest of the plot.
+        if len(returns):
+            curves[i, len(returns) :] = curves[i, len(returns) - 1]
+    episodes = np.arange(1, length + 1)
+    for row in curves:
+        axes.plot(episodes, row, color=colour, alpha=0.12, linewidth=0.6)  # type: ignore[attr-defined]
+    mean, low, high = bootstrap_band(curves, np.random.default_rng(0))
+    solved = [s for s in band.solved_episodes if s is not None]
+    note = f", median solve {np.median(solved):g}" if solved else ""
+    axes.fill_between(episodes, low, high, color=colour, alpha=0.3, linewidth=0)  # type: ignore[attr-defined]
+    axes.plot(episodes, mean, color=colour, linewidth=2.0,  # type: ignore[attr-defined]
+              label=f"{band.label}: mean of {len(curves)} seeds, 95% CI{note}")  # fmt: skip
+    if solved:
+        axes.axvline(float(np.median(solved)), color=colour, linestyle=":", linewidth=1.2)  # type: ignore[attr-defined]
+
+
+def policy_figure(
+    q_table: np.ndarray,
+    visits: np.ndarray | None,
+    dims: tuple[int, int],
+    low: Sequence[float],
+    high: Sequence[float],
+    names: Sequence[str],
+    title: str,
+) -> Figure:
+    """Greedy action, state value ``max_a Q`` and visit counts over two binned dimensions.
+
+    The other dimensions are averaged out, weighted by how often training visited each
+    state (uniformly where it never did); with one bin there, the maps are exact.
+    States training never visited are shown blank.
+    """
+    q_map, value_map, visit_map = project_policy(q_table, visits, dims)
+    action_map = np.argmax(q_map, axis=-1).astype(float)
+    unvisited = visit_map == 0 if visits is not None else np.zeros_like(value_map, dtype=bool)
+    figure = Figure(figsize=POLICY_SIZE, dpi=DPI, layout="constrained")
+    panels = figure.subplots(1, 3)
+    d_row, d_col = dims
+    extent = (low[d_col], high[d_col], low[d_row], high[d_row])
+    n_actions = q_table.shape[-1]
+    layers = (
+        (
+            "greedy action",
+            np.ma.masked_where(unvisited, action_map),
+            "coolwarm",
+            (0, max(n_actions - 1, 1)),
+        ),
+        ("state value max_a Q", np.ma.masked_where(unvisited, value_map), "viridis", (None, None)),
+        ("training visits", visit_map, "magma", (None, None)),
+    )
+    for axes, (name, data, cmap, (vmin, vmax)) in zip(panels, layers, strict=True):
+        image = axes.imshow(data, origin="lower", aspect="auto", extent=extent, cmap=cmap,
+                            vmin=vmin, vmax=vmax, interpolation="nearest")  # fmt: skip
+        axes.set_title(name)
+        axes.set_xlabel(names[d_col])
+        axes.set_ylabel(names[d_row])
+        bar = figure.colorbar(image, ax=axes)
+        if name == "greedy action":
+            bar.set_ticks(list(range(n_actions)))
+            if n_actions == 2:
+                bar.set_ticklabels(["0: push left", "1: push right"])
+    figure.suptitle(title)
+    return figure
+
+
+def project_policy(
+    q_table: np.ndarray, visits: np.ndarray | None, dims: tuple[int, int]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Reduce a ``(*bins, n_actions)`` table to the two chosen dimensions.
+
+    Returns:
+        ``(q, value, visits)`` with shapes ``(bins[d0], bins[d1], n_actions)``,
+        ``(bins[d0], bins[d1])`` and ``(bins[d0], bins[d1])``: Q averaged over the other
+        dimensions (weighted by state visits where there are any), ``max_a`` of it, and
+        the visits summed.
+    """
+    n_dims = q_table.ndim - 1
+    order = (*dims, *[d for d in range(n_dims) if d not in dims], n_dims)
+    q = np.transpose(q_table, order).reshape(
+        q_table.shape[dims[0]], q_table.shape[dims[1]], -1, q_table.shape[-1]
+    )
+    if visits is None:
+        state_visits = np.zeros(q.shape[:3])
+    else:
+        state_visits = np.transpose(visits, order).reshape(q.shape).sum(axis=-1).astype(float)
+    weights = np.where(state_visits.sum(axis=2, keepdims=True) > 0, state_visits, 1.0)
+    weights = weights / weights.sum(axis=2, keepdims=True)
+    q_map = np.einsum("ijk,ijka->ija", weights, q)
+    return q_map, q_map.max(axis=-1), state_visits.sum(axis=2)
+
+
+def figure_png(figure: Figure) -> bytes:
+    """Render a figure to PNG bytes."""
+    canvas = FigureCanvasAgg(figure)
+    buffer = io.BytesIO()
+    canvas.print_png(buffer)
+    return buffer.getvalue()
+
+
+def _colours(count: int) -> list[tuple[float, ...]]:
+    from matplotlib import colormaps
+
+    if count <= 10:
+        palette = colormaps["tab10"]
+        return [tuple(palette(i)) for i in range(count)]
+    palette = colormaps["turbo"]
+    return [tuple(palette(x)) for x in np.linspace(0.05, 0.95, count)]
+
+
+# -- the plot command -----------------------------------------------------------------
+
+
+def plot_rewards(run_dirs: Sequence[Path], out: Path) -> Path:
+    """Draw the reward curves of single and multi-seed runs on one figure; write ``out``.
+
+    Raises:
+        RunError: a directory is not a complete run.
+    """
+    from cartpole_q import rundir
+    from cartpole_q.multiseed import load_seed_runs
+
+    items: list[Curve | SeedBand] = []
+    thresholds: set[float | None] = set()
+    for path in run_dirs:
+        if rundir.is_multi_seed(path):
+            runs = load_seed_runs(path)
+            items.append(SeedBand(
+                path.name, [run.metrics.returns for run in runs],
+                [run.summary.get("solved_episode") for run in runs],
+            ))  # fmt: skip
+            thresholds.update(run.summary.get("reward_threshold") for run in runs)
+        else:
+            run = rundir.load_run(path)
+            items.append(Curve(path.name, run.metrics.returns, run.summary.get("solved_episode")))
+            thresholds.add(run.summary.get("reward_threshold"))
+    thresholds.discard(None)
+    threshold = thresholds.pop() if len(thresholds) == 1 else None
+    title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
+    figure = reward_curve_figure(items, threshold, title)
+    _write_png(out, figure)
+    return out
+
+
+def plot_policy(run_dir: Path, out: Path, dims_text: str | None) -> Path:
+    """Draw one run's policy map over two binned dimensions; write ``out``.
+
+    Raises:
+        RunError: the directory is not a complete run.
+        UserError: ``dims_text`` does not name two distinct dimensions of the grid.
+    """
+    from cartpole_q import rundir
+
+    run = rundir.load_run(run_dir)
+    bins = run.config.discretization.bins
+    dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
+    names = _dimension_names(run.config.env.id, len(bins))
+    figure = policy_figure(
+        run.q_table, run.visits, dims, run.config.discretization.low,
+        run.config.discretization.high, names, f"Policy of {run_dir.name}",
+    )  # fmt: skip
+    _write_png(out, figure)
+    return out
+
+
+def parse_dims(text: str, bins: Sequence[int]) -> tuple[int, int]:
+    """Parse ``--dims`` such as ``2,3``.
+
+    Raises:
+        UserError: not two distinct dimension numbers of the grid.
+    """
+    from cartpole_q.errors import UserError
+
+    parts = [part.strip() for part in text.split(",")]
+    if len(parts) != 2 or not all(part.isdigit() for part in parts):
+        raise UserError(f"--dims: expected two dimension numbers like 2,3, got {text!r}.")
+    first, second = int(parts[0]), int(parts[1])
+    if first == second or max(first, second) >= len(bins):
+        raise UserError(
+            f"--dims: expected two different dimensions between 0 and {len(bins) - 1}, got {text!r}."
+        )
+    return first, second
+
+
+def default_dims(bins: Sequence[int]) -> tuple[int, int]:
+    """The two dimensions with the most bins, in order (later ones win ties).
+
+    For CartPole's usual grids this is pole angle (2) and angular velocity (3).
+
+    >>> default_dims([1, 3, 6, 12]), default_dims([10, 10, 10, 10])
+    ((2, 3), (2, 3))
+    """
+    ranked = sorted(range(len(bins)), key=lambda d: (bins[d], d), reverse=True)
+    first, second = sorted(ranked[:2])
+    return first, second
+
+
+def _dimension_names(env_id: str, n_dims: int) -> list[str]:
+    if env_id.startswith("CartPole") and n_dims == 4:
+        return [
+            f"{name} ({unit})"
+            for name, unit in zip(CARTPOLE_DIMENSIONS, CARTPOLE_UNITS, strict=True)
+        ]
+    return [f"observation {d}" for d in range(n_dims)]
+
+
+def _write_png(out: Path, figure: Figure) -> None:
+    from cartpole_q.errors import UserError
+    from cartpole_q.rundir import atomic_write_bytes
+
+    if out.is_dir():
+        raise UserError(
+            f"{out}: --out is a directory; give a file name such as {out / 'plot.png'}."
+        )
+    if not out.parent.exists():
+        raise UserError(f"{out}: the directory {out.parent} does not exist.")
+    atomic_write_bytes(out, figure_png(figure))

@@ -1,0 +1,174 @@
+"""Progress output while training: a live bar on a terminal, plain lines otherwise.
+
+Reporters are cheap to call after every chunk of episodes: the live bar redraws at most
+ten times a second from its own thread, and plain lines are printed every tenth of the run.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import IO, Any, Protocol
+
+from cartpole_q.training import Progress
+
+
+class Reporter(Protocol):
+    """Receives training progress for one or more runs."""
+
+    def start(self, key: Any, label: str, episodes: int) -> None:
+        """A run (``key``) starts; ``episodes`` is its configured length."""
+        ...
+
+    def update(self, key: Any, progress: Progress) -> None:
+        """A run advanced."""
+        ...
+
+    def finish(self, key: Any, line: str) -> None:
+        """A run ended; ``line`` says how."""
+        ...
+
+    def close(self) -> None:
+        """All runs ended."""
+        ...
+
+
+class NullReporter:
+    """Prints nothing (``--quiet``)."""
+
+    def start(self, key: Any, label: str, episodes: int) -> None:
+        """Ignore."""
+
+    def update(self, key: Any, progress: Progress) -> None:
+        """Ignore."""
+
+    def finish(self, key: Any, line: str) -> None:
+        """Ignore."""
+
+    def close(self) -> None:
+        """Ignore."""
+
+
+def progress_line(label: str, progress: Progress) -> str:
+    """One plain line describing a run's progress.
+
+    >>> p = Progress(150, 1000, 500.0, 480.25, 0.0, 60000, 1.5, None)
+    >>> progress_line("seed 0", p)
+    'seed 0: episode 150/1000  return 500  avg100 480.2  epsilon 0.000  40,000 steps/s'
+    """
+    rate = progress.env_steps / progress.elapsed if progress.elapsed > 0 else 0.0
+    solved = f"  solved at {progress.solved_episode}" if progress.solved_episode else ""
+    return (
+        f"{label}: episode {progress.episode}/{progress.episodes}  return {progress.last_return:g}  "
+        f"avg100 {progress.moving_average:.1f}  epsilon {progress.epsilon:.3f}  "
+        f"{rate:,.0f} steps/s{solved}"
+    )
+
+
+class PlainReporter:
+    """Plain lines, no control codes: for logs, pipes and CI."""
+
+    def __init__(self, stream: IO[str] | None = None, every_fraction: float = 0.1) -> None:
+        self._stream = stream or sys.stdout
+        self._every_fraction = every_fraction
+        self._labels: dict[Any, str] = {}
+        self._next_line_at: dict[Any, int] = {}
+        self._step: dict[Any, int] = {}
+        self._single = True
+
+    def start(self, key: Any, label: str, episodes: int) -> None:
+        """Remember the run; lines come every tenth of its episodes."""
+        self._labels[key] = label
+        self._step[key] = max(1, int(episodes * self._every_fraction))
+        self._next_line_at[key] = self._step[key]
+        self._single = len(self._labels) == 1
+
+    def update(self, key: Any, progress: Progress) -> None:
+        """Print a line when the run crosses the next tenth (single runs only)."""
+        if not self._single or progress.episode < self._next_line_at.get(key, 0):
+            return
+        step = self._step[key]
+        self._next_line_at[key] = (progress.episode // step + 1) * step
+        print(progress_line(self._labels[key], progress), file=self._stream, flush=True)
+
+    def finish(self, key: Any, line: str) -> None:
+        """Print how the run ended."""
+        print(line, file=self._stream, flush=True)
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
+class RichReporter:
+    """A live rich progress display: one bar per run (or per worker) on a terminal."""
+
+    def __init__(self, console: Any | None = None, min_interval: float = 0.1) -> None:
+        from rich.console import Console
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+        from rich.progress import (
+            Progress as RichProgress,
+        )
+
+        self._console = console or Console()
+        self._progress = RichProgress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TextColumn("{task.fields[stats]}"),
+            TimeElapsedColumn(),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=self._console,
+            refresh_per_second=10,
+        )
+        self._tasks: dict[Any, Any] = {}
+        self._last_update: dict[Any, float] = {}
+        self._min_interval = min_interval
+        self._progress.start()
+
+    def start(self, key: Any, label: str, episodes: int) -> None:
+        """Add a bar for the run (or reuse the bar of ``key`` for its next run)."""
+        if key in self._tasks:
+            self._progress.reset(self._tasks[key], total=episodes, description=label, stats="")
+        else:
+            self._tasks[key] = self._progress.add_task(label, total=episodes, stats="")
+        self._last_update[key] = 0.0
+
+    def update(self, key: Any, progress: Progress) -> None:
+        """Move the run's bar (throttled, so the bar never slows training)."""
+        now = time.monotonic()
+        if now - self._last_update.get(key, 0.0) < self._min_interval:
+            return
+        self._last_update[key] = now
+        rate = progress.env_steps / progress.elapsed if progress.elapsed > 0 else 0.0
+        stats = (
+            f"return {progress.last_return:>5g}  avg100 {progress.moving_average:6.1f}  "
+            f"eps {progress.epsilon:.3f}  {rate:>10,.0f} steps/s"
+        )
+        self._progress.update(self._tasks[key], completed=progress.episode, stats=stats)
+
+    def finish(self, key: Any, line: str) -> None:
+        """Complete the run's bar and show how it ended."""
+        task = self._tasks.get(key)
+        if task is not None:
+            self._progress.update(task, total=self._progress.tasks[task].completed or 1, stats=line)
+
+    def close(self) -> None:
+        """Stop the live display, leaving the final bars on screen."""
+        self._progress.stop()
+
+
+def make_reporter(quiet: bool, stream: IO[str] | None = None) -> Reporter:
+    """The reporter for the output: none when quiet, a bar on a terminal, else plain lines."""
+    stream = stream or sys.stdout
+    if quiet:
+        return NullReporter()
+    if stream.isatty():
+        return RichReporter()
+    return PlainReporter(stream)
