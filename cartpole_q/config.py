@@ -368,15 +368,17 @@ def check_known_keys(user: Mapping[Any, Any], source: str) -> None:
 def _check_keys(data: Mapping[Any, Any], valid: Iterable[str], prefix: str, source: str) -> None:
     valid = list(valid)
     for key in data:
-        if key in valid:
-            continue
-        close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
-        hint = (
-            f"; did you mean '{prefix}{close[0]}'?"
-            if close
-            else f"; valid keys: {', '.join(valid)}."
-        )
-        raise ConfigError(f"{source}: unknown key '{prefix}{key}'{hint}")
+        if key not in valid:
+            raise ConfigError(f"{source}: {_unknown_key(key, valid, prefix)}")
+
+
+def _unknown_key(key: Any, valid: list[str], prefix: str) -> str:
+    """The message for an unknown key, with the closest valid one when there is one."""
+    close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
+    hint = (
+        f"; did you mean '{prefix}{close[0]}'?" if close else f"; valid keys: {', '.join(valid)}."
+    )
+    return f"unknown key '{prefix}{key}'{hint}"
 
 
 def _merge(base: dict[str, Any], user: Mapping[str, Any]) -> dict[str, Any]:
@@ -500,7 +502,10 @@ class _Reader:
                 f"must be one of {', '.join(SCHEDULE_KINDS)}; got {_shown(kind)}.",
             )
         keys = _SCHEDULE_KEYS[kind]
-        _check_keys_with(value, keys, f"{field}.", lambda problem: self.error(field, problem))
+        for key in value:
+            if key not in keys:
+                source = "command line" if field in self._overridden else self._source
+                raise ConfigError(f"{source}: {_unknown_key(key, list(keys), f'{field}.')}")
         for key in _SCHEDULE_REQUIRED[kind]:
             if key not in value:
                 raise self.error(field, f"a {kind} schedule needs '{key}'.")
@@ -608,18 +613,6 @@ class _Reader:
                     f"entry {d} ({lo}) must be below discretization.high entry {d} ({hi}).",
                 )
         return DiscretizationConfig(bins=bins, low=low, high=high)
-
-
-def _check_keys_with(
-    data: Mapping[Any, Any], valid: tuple[str, ...], prefix: str, error: Any
-) -> None:
-    for key in data:
-        if key not in valid:
-            close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
-            hint = (
-                f"; did you mean '{close[0]}'?" if close else f"; valid keys: {', '.join(valid)}."
-            )
-            raise error(f"unknown key '{prefix}{key}'{hint}")
 
 
 def parse_seeds(value: Any) -> tuple[int, ...]:

@@ -1,0 +1,42 @@
+"""Shared fixtures: small configs and an isolated working directory."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+import yaml
+
+REPO = Path(__file__).resolve().parents[1]
+CONFIGS = REPO / "configs"
+
+# Rendering in tests never opens a window.
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+
+
+def write_yaml(path: Path, data: object) -> Path:
+    """Write ``data`` as YAML and return the path."""
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    return path
+
+
+@pytest.fixture
+def in_tmp(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Run the test inside an empty temporary directory (so runs/ lands there)."""
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.fixture
+def small_config_file(tmp_path: Path) -> Path:
+    """A quick config: 30 episodes, periodic evaluation and checkpoints on."""
+    return write_yaml(
+        tmp_path / "small.yaml",
+        {
+            "name": "small",
+            "train": {"episodes": 30, "eval_every": 10, "eval_episodes": 2, "checkpoint_every": 10},
+            "eval": {"episodes": 3},
+        },
+    )

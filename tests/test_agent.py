@@ -1,0 +1,137 @@
+"""Agent functions with hand-computed values: TD targets, schedules, epsilon-greedy draws."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from cartpole_q.agent import (
+    CONSTANT,
+    EXPONENTIAL,
+    LOG,
+    epsilon_greedy,
+    learn_step,
+    reaches_threshold,
+    schedule_value,
+    td_update,
+)
+
+
+def table() -> np.ndarray:
+    # state 0: Q = [1, 0]; state 1: Q = [2, 3]
+    return np.array([[1.0, 0.0], [2.0, 3.0]])
+
+
+def test_td_update_ordinary_step_bootstraps_from_the_best_next_action() -> None:
+    q = table()
+    td_update(q, 0, 0, 1.0, 1, False, 0.5, 0.9)
+    # target = 1 + 0.9 * max(2, 3) = 3.7; Q = 1 + 0.5 * (3.7 - 1) = 2.35
+    assert q[0, 0] == pytest.approx(2.35, abs=1e-15)
+    assert q[0, 1] == 0.0 and q[1].tolist() == [2.0, 3.0]
+
+
+def test_td_update_terminated_step_does_not_bootstrap() -> None:
+    q = table()
+    td_update(q, 0, 0, 1.0, 1, True, 0.5, 0.9)
+    # target = r = 1; Q = 1 + 0.5 * (1 - 1) = 1
+    assert q[0, 0] == 1.0
+    q = table()
+    td_update(q, 0, 1, -1.0, 1, True, 0.25, 0.9)
+    # target = -1; Q = 0 + 0.25 * (-1 - 0) = -0.25
+    assert q[0, 1] == -0.25
+
+
+def test_truncated_step_bootstraps_like_an_ordinary_one() -> None:
+    truncated, ordinary = table(), table()
+    visits = np.zeros((2, 2), dtype=np.int64)
+    rng = np.random.default_rng(0)
+    low, high, bins = np.array([0.0]), np.array([2.0]), np.array([2])
+    next_observation = np.array([1.5], dtype=np.float32)  # state 1
+    state, action = learn_step(truncated, visits, 0, 0, 1.0, next_observation, False, True,
+                               low, high, bins, 0.5, 0.9, 0.0, rng)  # fmt: skip
+    assert (state, action) == (1, -1)  # the episode ended: no next action is drawn
+    td_update(ordinary, 0, 0, 1.0, 1, False, 0.5, 0.9)
+    assert truncated[0, 0] == ordinary[0, 0] == pytest.approx(2.35, abs=1e-15)
+    assert visits.tolist() == [[1, 0], [0, 0]]
+
+
+def test_learn_step_picks_the_next_action_from_the_updated_table() -> None:
+    q = np.array([[0.0, 0.0], [0.0, 0.1]])
+    visits = np.zeros((2, 2), dtype=np.int64)
+    low, high, bins = np.array([0.0]), np.array([2.0]), np.array([2])
+    state, action = learn_step(q, visits, 1, 1, 1.0, np.array([1.5], dtype=np.float32), False, False,
+                               low, high, bins, 1.0, 0.0, 0.0, np.random.default_rng(0))  # fmt: skip
+    # Q(1, 1) becomes 1.0 before the greedy choice in state 1
+    assert (state, action) == (1, 1)
+    assert q[1, 1] == 1.0
+
+
+@pytest.mark.parametrize(
+    ("kind", "start", "end", "rate", "episode", "expected"),
+    [
+        (CONSTANT, 0.1, 0.1, 1.0, 0, 0.1),
+        (CONSTANT, 0.1, 0.1, 1.0, 999, 0.1),
+        # the blog's epsilon: 1.0 * 0.995^e, floor 0.01
+        (EXPONENTIAL, 1.0, 0.01, 0.995, 0, 1.0),
+        (EXPONENTIAL, 1.0, 0.01, 0.995, 1, 0.995),
+        (EXPONENTIAL, 1.0, 0.01, 0.995, 100, 0.995**100),  # 0.6057704364907278
+        (EXPONENTIAL, 1.0, 0.01, 0.995, 918, 0.995**918),  # 0.01004: just above the floor
+        (EXPONENTIAL, 1.0, 0.01, 0.995, 1000, 0.01),  # floor reached at e = 919
+        # log schedule with k = 25: max(end, min(1, 1 - log10((e + 1) / 25)))
+        (LOG, 1.0, 0.1, 25.0, 0, 1.0),  # 1 - log10(1/25) = 2.398 -> capped at 1
+        (LOG, 1.0, 0.1, 25.0, 24, 1.0),  # 1 - log10(1) = 1
+        (LOG, 1.0, 0.1, 25.0, 49, 1 - math.log10(2)),  # 0.69897
+        (LOG, 1.0, 0.1, 25.0, 99, 1 - math.log10(4)),  # 0.39794
+        (LOG, 1.0, 0.1, 25.0, 199, 0.1),  # 1 - log10(8) = 0.0969 -> floor 0.1
+        (LOG, 1.0, 0.0, 10.0, 999, 0.0),
+        (LOG, 0.5, 0.05, 25.0, 0, 0.5),  # a start below 1 caps the schedule
+    ],
+)
+def test_schedule_values(
+    kind: int, start: float, end: float, rate: float, episode: int, expected: float
+) -> None:
+    assert schedule_value(kind, start, end, rate, episode) == pytest.approx(expected, rel=1e-12)
+
+
+def test_exponential_floor_is_reached_exactly_where_the_product_drops_below_it() -> None:
+    values = [schedule_value(EXPONENTIAL, 1.0, 0.01, 0.995, e) for e in range(1000)]
+    first_floor = values.index(0.01)
+    assert first_floor == 919
+    assert 0.995**918 > 0.01 > 0.995**919
+
+
+def test_epsilon_greedy_draws_one_uniform_per_greedy_choice() -> None:
+    rng, mirror = np.random.default_rng(42), np.random.default_rng(42)
+    q_values = np.array([0.0, 5.0, 1.0])
+    for _ in range(200):
+        action = epsilon_greedy(q_values, 0.3, rng)
+        if mirror.random() < 0.3:
+            assert action == mirror.integers(0, 3)
+        else:
+            assert action == 1
+    assert rng.bit_generator.state == mirror.bit_generator.state
+
+
+def test_epsilon_zero_still_draws_so_the_stream_does_not_depend_on_epsilon() -> None:
+    rng = np.random.default_rng(1)
+    before = rng.bit_generator.state["state"]["state"]
+    assert epsilon_greedy(np.array([0.0, 1.0]), 0.0, rng) == 1
+    assert rng.bit_generator.state["state"]["state"] != before
+
+
+def test_ties_go_to_the_lowest_action() -> None:
+    assert epsilon_greedy(np.array([2.0, 2.0, 1.0]), 0.0, np.random.default_rng(0)) == 0
+
+
+def test_solve_needs_a_full_window_of_returns_at_the_threshold() -> None:
+    returns = np.full(150, 500.0)
+    assert not reaches_threshold(returns, 98, 475.0)  # 99 episodes: window not full
+    assert reaches_threshold(returns, 99, 475.0)
+    returns[50] = 0.0  # one failure in the window: average 495
+    assert reaches_threshold(returns, 99, 475.0)
+    returns[51:53] = 0.0  # three failures: average 485
+    assert reaches_threshold(returns, 99, 485.0)
+    assert not reaches_threshold(returns, 99, 485.01)
+    assert not reaches_threshold(returns, 149, 500.0)

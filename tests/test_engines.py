@@ -1,0 +1,183 @@
+"""The compiled twin and the numba engine against real Gymnasium, by exact equality."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils import seeding
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.engines import cartpole_twin as twin
+from cartpole_q.engines import make_engine, resolve_engine
+from cartpole_q.environment import inspect_env
+from cartpole_q.rundir import atomic_save_npy, metrics_csv
+from cartpole_q.training import derive_generators, train
+from tests.conftest import CONFIGS
+
+
+def _compare_trajectory(env_kwargs: dict, seed: int, steps: int, choose) -> int:  # type: ignore[no-untyped-def]
+    """Step Gymnasium and the twin side by side; return how many steps were compared."""
+    env = gym.make("CartPole-v1", **env_kwargs)
+    settings = twin.twin_settings("CartPole-v1", env_kwargs, 500)
+    assert isinstance(settings, twin.TwinSettings)
+    rng = seeding.np_random(seed)[0]
+    state, observation = np.empty(4), np.empty(4, dtype=np.float32)
+    gym_observation, _ = env.reset(seed=seed)
+    twin.reset(state, observation, rng)
+    length = 0
+    for step in range(steps):
+        assert np.array_equal(state, env.unwrapped.state), f"state differs at step {step}"
+        assert observation.tobytes() == gym_observation.tobytes(), (
+            f"observation differs at step {step}"
+        )
+        action = choose(step, gym_observation)
+        gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(action)
+        reward, terminated = twin.step(state, action, observation, settings.sutton_barto_reward)
+        length += 1
+        truncated = length >= settings.max_episode_steps
+        assert (reward, terminated, truncated) == (gym_reward, gym_terminated, gym_truncated), step
+        assert state.dtype == np.float64 and observation.dtype == np.float32
+        if terminated or truncated:
+            gym_observation, _ = env.reset()
+            twin.reset(state, observation, rng)
+            length = 0
+    return steps
+
+
+@pytest.mark.parametrize(
+    "env_kwargs", [{}, {"sutton_barto_reward": True}, {"max_episode_steps": 120}]
+)
+def test_twin_follows_fixed_action_sequences_exactly(env_kwargs: dict) -> None:
+    actions = np.random.default_rng(5).integers(0, 2, size=12_000)
+    sequence = np.concatenate(
+        [actions[:4000], np.tile([0, 0, 1, 1, 1, 0], 1000), np.ones(2000, int)]
+    )
+    compared = _compare_trajectory(
+        env_kwargs, 11, len(sequence), lambda step, _: int(sequence[step])
+    )
+    assert compared >= 12_000
+
+
+def test_twin_follows_closed_loop_play_exactly() -> None:
+    # A controller that reacts to the observation keeps episodes long (up to truncation).
+    def controller(step: int, observation: np.ndarray) -> int:
+        return int(observation[2] + 0.5 * observation[3] + 0.01 * observation[1] > 0)
+
+    assert _compare_trajectory({}, 3, 15_000, controller) >= 15_000
+
+
+def test_twin_refuses_what_it_cannot_reproduce() -> None:
+    assert "no compiled twin" in twin.twin_settings("MountainCar-v0", {}, 200)
+    assert "'render_mode'" in twin.twin_settings("CartPole-v1", {"render_mode": "human"}, 500)
+    assert "positive integer" in twin.twin_settings("CartPole-v1", {"max_episode_steps": 0}, 500)
+    config = load_config(overrides={"engine": "numba", "env.kwargs": {"render_mode": "rgb_array"}})
+    with pytest.raises(
+        ConfigError, match=r"engine: numba cannot run this config: env\.kwargs key 'render_mode'"
+    ):
+        resolve_engine(config, inspect_env(config))
+    auto = load_config(overrides={"env.kwargs": {"render_mode": "rgb_array"}})
+    assert resolve_engine(auto, inspect_env(auto)) == "gymnasium"
+    assert resolve_engine(load_config(), inspect_env(load_config())) == "numba"
+
+
+def _trained_bytes(
+    config_path, engine: str, seed: int, episodes: int | None = None
+) -> tuple[bytes, str]:  # type: ignore[no-untyped-def]
+    overrides = {"engine": engine, "seed": seed, "train.checkpoint_every": 0}
+    if episodes is not None:
+        overrides["train.episodes"] = episodes
+    result = train(load_config(config_path, overrides), final_eval=False)
+    assert result.engine == engine
+    return result.q_table.tobytes(), metrics_csv(result)
+
+
+@pytest.mark.parametrize(
+    ("config_name", "episodes"),
+    [("default.yaml", None), ("blog.yaml", None), ("sutton_barto.yaml", 150)],
+)
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_numba_and_gymnasium_engines_give_byte_identical_runs(
+    tmp_path, config_name: str, episodes, seed: int
+) -> None:  # type: ignore[no-untyped-def]
+    path = CONFIGS / config_name
+    overrides = {"seed": seed, "train.checkpoint_every": 0}
+    if episodes is not None:
+        overrides["train.episodes"] = episodes
+    files = {}
+    for engine in ("numba", "gymnasium"):
+        result = train(load_config(path, {**overrides, "engine": engine}), final_eval=False)
+        directory = tmp_path / engine
+        directory.mkdir()
+        atomic_save_npy(directory / "q_table.npy", result.q_table)
+        files[engine] = (
+            (directory / "q_table.npy").read_bytes(),
+            metrics_csv(result),
+            result.evaluations,
+        )
+        assert result.env_steps > 0
+    assert files["numba"][0] == files["gymnasium"][0]
+    assert files["numba"][1] == files["gymnasium"][1]
+    # periodic evaluations ran on the twin for one engine and in Gymnasium for the other
+    assert files["numba"][2] == files["gymnasium"][2]
+
+
+def test_twin_evaluation_returns_exactly_what_gymnasium_returns() -> None:
+    # A half-trained table fails in varied ways, so the returns differ between episodes.
+    config = load_config(overrides={"train.episodes": 60, "train.stop_when_solved": False})
+    result = train(config, final_eval=False)
+    info = inspect_env(config)
+    q = result.q_table.reshape(-1, info.n_actions)
+    numba_engine = make_engine("numba", config, info, env_seed=0)
+    gymnasium_engine = make_engine("gymnasium", config, info, env_seed=0)
+    for seed in (0, 1000000, 123):
+        compiled = numba_engine.evaluate(q, 40, seed)
+        played = gymnasium_engine.evaluate(q, 40, seed)
+        assert np.array_equal(compiled, played)
+        assert len(set(played.tolist())) > 3
+
+
+def test_same_seed_gives_the_same_run_and_another_seed_does_not() -> None:
+    first = _trained_bytes(None, "numba", 4)
+    assert _trained_bytes(None, "numba", 4) == first
+    assert _trained_bytes(None, "numba", 5) != first
+
+
+def test_chunking_does_not_change_results() -> None:
+    # Periodic evaluation and checkpoints split training into different chunks.
+    base = {"train.episodes": 120, "train.stop_when_solved": False}
+    plain = train(
+        load_config(overrides={**base, "train.eval_every": 0, "train.checkpoint_every": 0}),
+        final_eval=False,
+    )
+    chunked = train(load_config(overrides={**base, "train.eval_every": 7, "train.checkpoint_every": 13}),
+                    on_checkpoint=lambda _: None, final_eval=False)  # fmt: skip
+    assert plain.q_table.tobytes() == chunked.q_table.tobytes()
+    assert metrics_csv(plain) == metrics_csv(chunked)
+    assert len(chunked.evaluations) == 120 // 7
+
+
+def test_generators_are_derived_from_the_seed() -> None:
+    rng_a, env_a = derive_generators(7)
+    rng_b, env_b = derive_generators(7)
+    assert env_a == env_b and rng_a.random() == rng_b.random()
+    assert derive_generators(8)[1] != env_a
+
+
+def test_kept_table_is_the_solve_point_when_training_goes_on() -> None:
+    stopped = train(load_config(overrides={"seed": 1}), final_eval=False)
+    assert stopped.solved_episode is not None
+    assert stopped.episodes == stopped.solved_episode == stopped.kept_episode
+    longer = train(
+        load_config(
+            overrides={
+                "seed": 1,
+                "train.stop_when_solved": False,
+                "train.episodes": stopped.solved_episode + 50,
+            }
+        ),
+        final_eval=False,
+    )
+    assert longer.episodes == stopped.solved_episode + 50
+    assert longer.kept_episode == stopped.solved_episode
+    assert longer.q_table.tobytes() == stopped.q_table.tobytes()
