@@ -71,12 +71,15 @@ def run_seeds(
     seeds = config.train.seeds
     assert seeds is not None
     started = time.perf_counter()
+    if resume:
+        (parent / rundir.SUMMARY_FILE).unlink(missing_ok=True)
     jobs: list[tuple[int, Path, bool]] = []
     for seed in seeds:
         child = seed_dir(parent, seed, seeds)
         if resume and _finished(child):
             continue
-        child_resume = resume and (child / rundir.CHECKPOINT_FILE).is_file()
+        # A started seed resumes from its checkpoint (or from episode 0 if it has none).
+        child_resume = resume and (child / rundir.CONFIG_FILE).is_file()
         if not child_resume:
             child.mkdir(parents=True, exist_ok=True)
             rundir.write_config(child, config.for_seed(seed))

@@ -25,6 +25,7 @@ import os
 import platform
 import tempfile
 import time
+import zipfile
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -64,6 +65,12 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
         raise
+
+
+def remove_stale_temporaries(run_dir: Path) -> None:
+    """Delete temporary files a killed process left behind (never a finished file)."""
+    for temporary in run_dir.glob(".*.tmp"):
+        temporary.unlink(missing_ok=True)
 
 
 def atomic_write_text(path: Path, text: str) -> None:
@@ -193,7 +200,7 @@ def load_checkpoint(run_dir: Path) -> Any:
                 train_seconds=float(meta["train_seconds"]),
                 wall_seconds=float(meta["wall_seconds"]),
             )
-    except (OSError, ValueError, KeyError, TypeError, EOFError) as error:
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as error:
         raise RunError(
             f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
         ) from None

@@ -125,7 +125,8 @@ def execute_run(
     Args:
         run_dir: the run directory.
         prepared: the checked config.
-        resume: continue from ``run_dir``'s checkpoint instead of starting afresh.
+        resume: continue from ``run_dir``'s checkpoint (from episode 0 when the run was
+            stopped before its first checkpoint) instead of a new run.
         should_stop: polled between chunks of episodes.
         reporter: receives progress under ``key``.
         key: the reporter's key for this run.
@@ -135,8 +136,12 @@ def execute_run(
         RunError: ``resume`` and the checkpoint is missing or damaged.
     """
     reporter = reporter or NullReporter()
-    checkpoint = rundir.load_checkpoint(run_dir) if resume else None
+    checkpoint = None
     if resume:
+        rundir.remove_stale_temporaries(run_dir)
+        # Killed before its first checkpoint: nothing was lost but time; start over.
+        if (run_dir / rundir.CHECKPOINT_FILE).is_file():
+            checkpoint = rundir.load_checkpoint(run_dir)
         # The run is unfinished again until the new summary is written.
         (run_dir / rundir.SUMMARY_FILE).unlink(missing_ok=True)
     config = prepared.config
@@ -158,7 +163,7 @@ def prepare_resume(run_dir: Path) -> Prepared:
     """Load an unfinished run's config for ``--resume``.
 
     Raises:
-        RunError: ``run_dir`` is not a run, has no checkpoint, or already finished.
+        RunError: ``run_dir`` is not a run directory, or its run already finished.
         ConfigError: its ``config.yaml`` no longer fits its environment.
     """
     if not (run_dir / rundir.CONFIG_FILE).is_file():
@@ -166,7 +171,7 @@ def prepare_resume(run_dir: Path) -> Prepared:
     source = str(run_dir / rundir.CONFIG_FILE)
     config = load_config(run_dir / rundir.CONFIG_FILE)
     summary_path = run_dir / rundir.SUMMARY_FILE
-    if config.train.seeds is None and summary_path.is_file():
+    if summary_path.is_file():
         import json
 
         try:

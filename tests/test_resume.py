@@ -1,0 +1,211 @@
+"""Interruption and resume: nothing finished is lost, and resuming changes nothing."""
+
+from __future__ import annotations
+
+import json
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+from typer.testing import CliRunner
+
+from cartpole_q import rundir
+from cartpole_q.cli import app
+from cartpole_q.config import load_config
+from cartpole_q.runner import execute_run, prepare, start_run
+from tests.conftest import write_yaml
+
+RESULT_FILES = ("q_table.npy", "visits.npy", "metrics.csv", "evaluations.csv")
+
+
+def _reference(tmp_path: Path, overrides: dict) -> Path:
+    """An uninterrupted run of the same config."""
+    prepared = prepare(load_config(overrides=overrides), "test")
+    reference = start_run(prepared, tmp_path / "reference")
+    execute_run(reference, prepared)
+    return reference
+
+
+def _assert_same_results(run: Path, reference: Path) -> None:
+    for name in RESULT_FILES:
+        assert (run / name).read_bytes() == (reference / name).read_bytes(), name
+    summary = json.loads((run / "summary.json").read_text())
+    expected = json.loads((reference / "summary.json").read_text())
+    for key in (
+        "episodes",
+        "env_steps",
+        "solved_episode",
+        "q_table",
+        "eval",
+        "first_greedy_success",
+    ):
+        assert summary[key] == expected[key], key
+    assert summary["interrupted"] is False
+    assert not (run / rundir.CHECKPOINT_FILE).exists()
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+@pytest.mark.parametrize(
+    ("episodes", "stop_after_polls"),
+    [(120, 1), (120, 7), (230, 19)],  # the last run solves (about episode 175) before it stops
+)
+def test_interrupted_run_is_complete_and_resumes_byte_identically(
+    tmp_path: Path, engine: str, episodes: int, stop_after_polls: int
+) -> None:
+    overrides = {
+        "engine": engine, "seed": 2, "train.episodes": episodes, "train.stop_when_solved": False,
+        "train.checkpoint_every": 25, "train.eval_every": 10,
+    }  # fmt: skip
+    reference = _reference(tmp_path, overrides)
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= stop_after_polls - 1)
+
+    assert outcome.result.interrupted
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] is True and 0 < summary["episodes"] < episodes
+    loaded = rundir.load_run(run)  # the interrupted run is a complete, usable run directory
+    assert len(loaded.metrics.returns) == summary["episodes"]
+    assert (run / rundir.CHECKPOINT_FILE).is_file()
+
+    result = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert result.stdout.strip() == str(run)
+    _assert_same_results(run, reference)
+
+
+def test_resume_refuses_a_finished_run_and_other_options(tmp_path: Path) -> None:
+    reference = _reference(tmp_path, {"train.episodes": 5})
+    runner = CliRunner()
+    result = runner.invoke(app, ["train", "--resume", str(reference)])
+    assert result.exit_code == 2 and "already finished" in result.stderr
+    result = runner.invoke(app, ["train", "--resume", str(reference), "--seed", "3"])
+    assert result.exit_code == 2 and "--seed" in result.stderr
+    result = runner.invoke(app, ["train", "--resume", str(tmp_path / "nothing")])
+    assert result.exit_code == 2 and "not a run directory" in result.stderr
+
+
+def test_damaged_checkpoint_is_refused(tmp_path: Path) -> None:
+    prepared = prepare(
+        load_config(overrides={"train.episodes": 50, "train.checkpoint_every": 10}), "t"
+    )
+    run = start_run(prepared, tmp_path / "run")
+    execute_run(run, prepared, should_stop=lambda: True)
+    (run / rundir.CHECKPOINT_FILE).write_bytes(b"PK\x03\x04 truncated")
+    result = CliRunner().invoke(app, ["train", "--resume", str(run)])
+    assert result.exit_code == 2 and "checkpoint is damaged" in result.stderr
+
+
+# -- real signals, in a subprocess ---------------------------------------------------------
+
+SLOW_TRAINING = {
+    "name": "slow",
+    "engine": "gymnasium",
+    "train": {"episodes": 1500, "stop_when_solved": False, "checkpoint_every": 5, "eval_every": 0},
+    "eval": {"episodes": 5},
+}
+
+
+def _command(*args: object) -> list[str]:
+    return [sys.executable, "-m", "cartpole_q", *map(str, args)]
+
+
+def _wait_for(path: Path, timeout: float = 120.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not path.exists():
+        assert time.monotonic() < deadline, f"{path} never appeared"
+        time.sleep(0.05)
+
+
+def _check_every_file_loads(run: Path) -> int:
+    """Every file in the run directory is absent or complete; return how many were checked."""
+    checked = 0
+    for path in sorted(run.iterdir()):
+        if path.name.startswith(".") and path.name.endswith(".tmp"):
+            continue  # a temporary file a kill interrupted: never a contract file, removed on resume
+        if path.suffix == ".yaml":
+            load_config(path)
+        elif path.name == rundir.CHECKPOINT_FILE:
+            rundir.load_checkpoint(run)
+        elif path.suffix == ".npy":
+            assert np.load(path, allow_pickle=False).size > 0
+        elif path.suffix == ".csv":
+            rows = [line.split(",") for line in path.read_text().splitlines()]
+            assert rows and len({len(row) for row in rows}) == 1, path
+        elif path.suffix == ".json":
+            json.loads(path.read_text())
+        elif path.suffix == ".png":
+            with Image.open(path) as image:
+                image.verify()
+        else:
+            raise AssertionError(f"unexpected file {path}")
+        checked += 1
+    return checked
+
+
+@pytest.mark.slow
+def test_sigint_completes_the_run_directory_and_exits_130(tmp_path: Path) -> None:
+    config = write_yaml(tmp_path / "slow.yaml", SLOW_TRAINING)
+    run = tmp_path / "run"
+    process = subprocess.Popen(_command("train", "-c", config, "--out", run), stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)  # fmt: skip
+    _wait_for(run / rundir.CHECKPOINT_FILE)
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr and "SIGINT: stopping after the current episode" in stderr
+    assert stdout.strip().splitlines()[-1] == str(run)
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] is True and 5 <= summary["episodes"] < 1500
+    assert _check_every_file_loads(run) >= 7
+    assert len(rundir.load_run(run).metrics.returns) == summary["episodes"]
+
+    resumed = subprocess.run(
+        _command("train", "--resume", run, "-q"), capture_output=True, text=True, timeout=300
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    _assert_same_results(run, _reference_of(config, tmp_path))
+
+
+def _reference_of(config: Path, tmp_path: Path) -> Path:
+    prepared = prepare(load_config(config), str(config))
+    reference = start_run(prepared, tmp_path / "reference")
+    execute_run(reference, prepared)
+    return reference
+
+
+@pytest.mark.slow
+def test_sigkill_at_random_instants_never_leaves_a_broken_file(tmp_path: Path) -> None:
+    config = write_yaml(tmp_path / "slow.yaml", SLOW_TRAINING)
+    run = tmp_path / "run"
+    # Start-up takes about 0.3 s; the whole run about 6 s.
+    instants = [random.Random(seed).uniform(0.3, 2.5) for seed in range(6)]
+    resumed_from_checkpoint = 0
+    for instant in instants:
+        started = (run / rundir.CONFIG_FILE).is_file()
+        resumed_from_checkpoint += (run / rundir.CHECKPOINT_FILE).is_file()
+        args = ("train", "--resume", run) if started else ("train", "-c", config, "--out", run)
+        process = subprocess.Popen(
+            _command(*args, "-q"), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        )
+        time.sleep(instant)
+        os.kill(process.pid, signal.SIGKILL)
+        process.wait()
+        if run.exists():
+            _check_every_file_loads(run)
+        if (run / rundir.SUMMARY_FILE).is_file():
+            break  # it finished before the kill
+    assert resumed_from_checkpoint >= 2, "the kills should interrupt training, not only start-up"
+    final = subprocess.run(
+        _command("train", "--resume", run, "-q"), capture_output=True, text=True, timeout=300
+    )
+    assert final.returncode in (0, 2), final.stderr  # 2: it had already finished
+    _assert_same_results(run, _reference_of(config, tmp_path))
