@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import LogNorm, Normalize
 from matplotlib.figure import Figure
 
 from cartpole_q.environment import SOLVE_WINDOW
@@ -107,10 +108,10 @@ def reward_curve_figure(
         axes.axhline(threshold, color="black", linestyle="--", linewidth=1.0,
                      label=f"reward threshold {threshold:g}")  # fmt: skip
     axes.set_xlabel("training episode")
-    axes.set_ylabel(f"return ({SOLVE_WINDOW}-episode moving average)")
+    axes.set_ylabel(f"return (faint: each episode; bold: {SOLVE_WINDOW}-episode average)")
     axes.set_title(title)
     axes.grid(alpha=0.3)
-    axes.legend(loc="lower right", fontsize="small")
+    axes.legend(loc="best", fontsize="small")
     return figure
 
 
@@ -158,19 +159,17 @@ def policy_figure(
     d_row, d_col = dims
     extent = (low[d_col], high[d_col], low[d_row], high[d_row])
     n_actions = q_table.shape[-1]
+    # Visits span orders of magnitude (most time is spent near upright): log colour scale.
+    visit_norm = LogNorm(vmin=1, vmax=max(float(visit_map.max()), 10.0))
     layers = (
-        (
-            "greedy action",
-            np.ma.masked_where(unvisited, action_map),
-            "coolwarm",
-            (0, max(n_actions - 1, 1)),
-        ),
-        ("state value max_a Q", np.ma.masked_where(unvisited, value_map), "viridis", (None, None)),
-        ("training visits", visit_map, "magma", (None, None)),
-    )
-    for axes, (name, data, cmap, (vmin, vmax)) in zip(panels, layers, strict=True):
+        ("greedy action", np.ma.masked_where(unvisited, action_map), "coolwarm",
+         Normalize(0, max(n_actions - 1, 1))),
+        ("state value max_a Q", np.ma.masked_where(unvisited, value_map), "viridis", None),
+        ("training visits (log scale)", np.ma.masked_where(visit_map == 0, visit_map), "magma", visit_norm),
+    )  # fmt: skip
+    for axes, (name, data, cmap, norm) in zip(panels, layers, strict=True):
         image = axes.imshow(data, origin="lower", aspect="auto", extent=extent, cmap=cmap,
-                            vmin=vmin, vmax=vmax, interpolation="nearest")  # fmt: skip
+                            norm=norm, interpolation="nearest")  # fmt: skip
         axes.set_title(name)
         axes.set_xlabel(names[d_col])
         axes.set_ylabel(names[d_row])

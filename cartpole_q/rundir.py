@@ -23,7 +23,7 @@ import io
 import json
 import os
 import platform
-import tempfile
+import secrets
 import time
 import zipfile
 from dataclasses import dataclass
@@ -56,14 +56,18 @@ class RunError(UserError):
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` so that ``path`` is either absent, old, or complete."""
-    handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    """Write ``data`` to ``path`` so that ``path`` is either absent, old, or complete.
+
+    The temporary file is created with ``open(..., "xb")`` rather than ``mkstemp`` so
+    that it gets the user's usual permissions (umask), not mkstemp's owner-only 0600.
+    """
+    temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
     try:
-        with os.fdopen(handle, "wb") as stream:
+        with open(temporary, "xb") as stream:
             stream.write(data)
         os.replace(temporary, path)
     except BaseException:
-        Path(temporary).unlink(missing_ok=True)
+        temporary.unlink(missing_ok=True)
         raise
 
 

@@ -1,7 +1,7 @@
 """Animated GIFs of the greedy policy, from Gymnasium's ``rgb_array`` rendering.
 
 Frames come from ``env.render()`` (pygame, from the ``gymnasium[classic-control]``
-extra), keep the renderer's size, and carry the episode, step and return so far. Every
+extra), keep the renderer's size, and carry the episode and step. Every
 third step is kept and shown for three steps' time, so the GIF plays in real time.
 """
 
@@ -42,17 +42,10 @@ class GifRecorder:
         self._path = path
         self._episodes = episodes
         self._frames: list[Any] = []
-        self._episode_return = 0.0
-        self._last_step = 0
 
     def on_frame(self, env: Any, episode: int, step: int) -> None:
         """Record a frame after a reset (step 0) or a step of a recorded episode."""
-        if episode >= self._episodes:
-            return
-        if step == 0:
-            self._episode_return = 0.0
-        self._last_step = step
-        if step % FRAME_STRIDE:
+        if episode >= self._episodes or step % FRAME_STRIDE:
             return
         from PIL import Image, ImageDraw
 
