@@ -11,8 +11,8 @@ Q-learning, stated precisely:
 
 - target ``r + gamma * max_a' Q(s', a')`` when the step did not terminate, ``r`` when it
   terminated; truncation (a time limit) is not termination, so it bootstraps;
-- epsilon-greedy draws ``rng.random()`` on every decision, and ``rng.integers`` only when
-  it explores; ties go to the lowest action (``argmax``);
+- epsilon-greedy draws ``rng.random()`` to decide (unless epsilon is 0 or 1) and
+  ``rng.integers`` for the action when it explores; ties go to the lowest action;
 - schedules advance once per episode.
 
 >>> import numpy as np
@@ -31,14 +31,17 @@ from numba import njit
 
 from cartpole_q import discretize
 from cartpole_q.environment import SOLVE_WINDOW
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
 
 CONSTANT, EXPONENTIAL, LOG = 0, 1, 2
 
-state_index = njit(cache=True, nogil=True)(discretize.state_index)
+state_index = njit(cache=True, nogil=True, inline="always")(discretize.state_index)
 """the binning rule of :mod:`cartpole_q.discretize`, compiled (the same source)"""
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def schedule_value(kind: int, start: float, end: float, rate: float, episode: int) -> float:
     """Return a schedule's value at a 0-based episode index.
 
@@ -56,19 +59,47 @@ def schedule_value(kind: int, start: float, end: float, rate: float, episode: in
     return max(end, min(start, 1.0 - math.log10((episode + 1.0) / rate)))
 
 
-@njit(cache=True, nogil=True)
-def epsilon_greedy(q_values: np.ndarray, epsilon: float, rng: np.random.Generator) -> int:
+@njit(cache=True, nogil=True, inline="always")
+def best_action(q: np.ndarray, state: int) -> int:
+    """``argmax_a Q(state, a)``, the lowest action on ties (as ``np.argmax``)."""
+    best = 0
+    for action in range(1, q.shape[1]):
+        if q[state, action] > q[state, best]:
+            best = action
+    return best
+
+
+@njit(cache=True, nogil=True, inline="always")
+def epsilon_greedy(q: np.ndarray, state: int, epsilon: float, rng: np.random.Generator) -> int:
     """Choose an action: a uniform random one with probability ``epsilon``, else the greedy one.
 
-    ``rng.random()`` is drawn on every call, even when ``epsilon`` is 0 or 1, so the
-    generator's stream does not depend on the schedule's value.
+    The generator is drawn from only when the outcome is uncertain: at ``epsilon == 0``
+    nothing is drawn, at ``epsilon == 1`` only the random action. Otherwise
+    ``rng.random()`` decides, then ``rng.integers`` picks the action when exploring.
     """
-    if rng.random() < epsilon:
-        return int(rng.integers(0, q_values.shape[0]))
-    return int(np.argmax(q_values))
+    if epsilon <= 0.0:
+        return best_action(q, state)
+    if epsilon >= 1.0 or rng.random() < epsilon:
+        return int(rng.integers(0, q.shape[1]))
+    return best_action(q, state)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
+def best_value(q: np.ndarray, state: int) -> float:
+    """``max_a Q(state, a)``.
+
+    The compiled functions index single entries instead of taking row views: a view
+    costs two atomic reference-count updates, and numba's ``np.max`` of a two-entry row
+    costs more than a whole CartPole step.
+    """
+    best = q[state, 0]
+    for action in range(1, q.shape[1]):
+        if q[state, action] > best:
+            best = q[state, action]
+    return best
+
+
+@njit(cache=True, nogil=True, inline="always")
 def td_update(
     q: np.ndarray,
     state: int,
@@ -82,19 +113,19 @@ def td_update(
     """Move ``Q(state, action)`` toward the one-step Q-learning target, in place."""
     target = reward
     if not terminated:
-        target = reward + gamma * np.max(q[next_state])
+        target = reward + gamma * best_value(q, next_state)
     q[state, action] += alpha * (target - q[state, action])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def greedy_action(
     q: np.ndarray, observation: np.ndarray, low: np.ndarray, high: np.ndarray, bins: np.ndarray
 ) -> int:
     """Return the greedy action for an observation (lowest action on ties)."""
-    return int(np.argmax(q[state_index(observation, low, high, bins)]))
+    return best_action(q, state_index(observation, low, high, bins))
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def begin_episode(
     q: np.ndarray,
     observation: np.ndarray,
@@ -106,10 +137,10 @@ def begin_episode(
 ) -> tuple[int, int]:
     """Return the first state and action of an episode from its reset observation."""
     state = state_index(observation, low, high, bins)
-    return state, epsilon_greedy(q[state], epsilon, rng)
+    return state, epsilon_greedy(q, state, epsilon, rng)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def learn_step(
     q: np.ndarray,
     visits: np.ndarray,
@@ -131,6 +162,9 @@ def learn_step(
 
     Counts the visit of ``(state, action)``, applies the TD update, and, unless the
     episode ended, draws the next action epsilon-greedily from the updated table.
+    The numba engine's compiled loop repeats these four calls inline, in this order
+    (a call with six array arguments would double its cost per step); the cross-engine
+    tests check that both engines stay byte-identical.
 
     Returns:
         The next state and the next action (``-1`` when the episode ended).
@@ -140,10 +174,10 @@ def learn_step(
     td_update(q, state, action, reward, next_state, terminated, alpha, gamma)
     if terminated or truncated:
         return next_state, -1
-    return next_state, epsilon_greedy(q[next_state], epsilon, rng)
+    return next_state, epsilon_greedy(q, next_state, epsilon, rng)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def record_episode(
     returns: np.ndarray,
     lengths: np.ndarray,
@@ -162,7 +196,7 @@ def record_episode(
     alphas[episode] = alpha
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def reaches_threshold(returns: np.ndarray, episode: int, threshold: float) -> bool:
     """Whether the moving average of the last ``SOLVE_WINDOW`` returns reaches the threshold.
 

@@ -9,7 +9,7 @@ This module imports neither numba nor gymnasium, so that ``cartpole-q --help`` s
 
 >>> config = load_config()
 >>> config.env.id, config.discretization.bins
-('CartPole-v1', (1, 1, 6, 12))
+('CartPole-v1', (1, 1, 2, 10))
 >>> load_config(overrides={"agent.alpha": "5e-4"}).agent.alpha
 Schedule(kind='constant', start=0.0005, end=0.0005, rate=1.0)
 """

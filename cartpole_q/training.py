@@ -31,7 +31,7 @@ def derive_generators(seed: int) -> tuple[np.random.Generator, int]:
 
     >>> rng, env_seed = derive_generators(0)
     >>> env_seed
-    2968811710
+    673228719
     """
     agent_sequence, env_sequence = np.random.SeedSequence(seed).spawn(2)
     env_seed = int(env_sequence.generate_state(1, dtype=np.uint32)[0])

@@ -11,6 +11,8 @@ from cartpole_q.agent import (
     CONSTANT,
     EXPONENTIAL,
     LOG,
+    best_action,
+    best_value,
     epsilon_greedy,
     learn_step,
     reaches_threshold,
@@ -104,9 +106,9 @@ def test_exponential_floor_is_reached_exactly_where_the_product_drops_below_it()
 
 def test_epsilon_greedy_draws_one_uniform_per_greedy_choice() -> None:
     rng, mirror = np.random.default_rng(42), np.random.default_rng(42)
-    q_values = np.array([0.0, 5.0, 1.0])
+    q = np.array([[0.0, 5.0, 1.0]])
     for _ in range(200):
-        action = epsilon_greedy(q_values, 0.3, rng)
+        action = epsilon_greedy(q, 0, 0.3, rng)
         if mirror.random() < 0.3:
             assert action == mirror.integers(0, 3)
         else:
@@ -114,15 +116,24 @@ def test_epsilon_greedy_draws_one_uniform_per_greedy_choice() -> None:
     assert rng.bit_generator.state == mirror.bit_generator.state
 
 
-def test_epsilon_zero_still_draws_so_the_stream_does_not_depend_on_epsilon() -> None:
+def test_certain_choices_draw_nothing_they_do_not_need() -> None:
+    q = np.array([[0.0, 1.0, 0.5]])
     rng = np.random.default_rng(1)
-    before = rng.bit_generator.state["state"]["state"]
-    assert epsilon_greedy(np.array([0.0, 1.0]), 0.0, rng) == 1
-    assert rng.bit_generator.state["state"]["state"] != before
+    before = rng.bit_generator.state
+    assert epsilon_greedy(q, 0, 0.0, rng) == 1
+    assert rng.bit_generator.state == before  # epsilon 0: greedy, no draw
+    mirror = np.random.default_rng(1)
+    for _ in range(50):
+        assert epsilon_greedy(q, 0, 1.0, rng) == mirror.integers(0, 3)  # only the action is drawn
+    assert rng.bit_generator.state == mirror.bit_generator.state
 
 
-def test_ties_go_to_the_lowest_action() -> None:
-    assert epsilon_greedy(np.array([2.0, 2.0, 1.0]), 0.0, np.random.default_rng(0)) == 0
+def test_ties_go_to_the_lowest_action_as_with_numpy_argmax() -> None:
+    q = np.array([[2.0, 2.0, 1.0], [0.0, 3.0, 3.0], [-1.0, -1.0, -1.0], [1.0, 0.0, 4.0]])
+    for state in range(4):
+        assert best_action(q, state) == np.argmax(q[state])
+        assert best_value(q, state) == np.max(q[state])
+        assert epsilon_greedy(q, state, 0.0, np.random.default_rng(0)) == np.argmax(q[state])
 
 
 def test_solve_needs_a_full_window_of_returns_at_the_threshold() -> None:

@@ -20,6 +20,10 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
+
 TWIN_ENV_IDS = ("CartPole-v1", "CartPole-v0")
 SUPPORTED_KWARGS = ("sutton_barto_reward", "max_episode_steps")
 
@@ -73,7 +77,7 @@ def twin_settings(
     return TwinSettings(max_episode_steps=max_steps, sutton_barto_reward=sutton_barto)
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def reset(state: np.ndarray, observation: np.ndarray, rng: np.random.Generator) -> None:
     """Draw a start state into ``state`` and write its float32 ``observation``."""
     for i in range(4):
@@ -81,7 +85,7 @@ def reset(state: np.ndarray, observation: np.ndarray, rng: np.random.Generator) 
         observation[i] = np.float32(state[i])
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, inline="always")
 def step(
     state: np.ndarray, action: int, observation: np.ndarray, sutton_barto_reward: bool
 ) -> tuple[float, bool]:

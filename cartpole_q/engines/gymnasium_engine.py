@@ -19,6 +19,9 @@ from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
 from cartpole_q.environment import make_env
 from cartpole_q.evaluation import play_greedy
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
 
 
 @njit(cache=True, nogil=True)

@@ -14,15 +14,50 @@ from numba import njit
 
 from cartpole_q.agent import (
     begin_episode,
+    best_action,
+    epsilon_greedy,
     greedy_action,
-    learn_step,
     reaches_threshold,
     record_episode,
     schedule_value,
+    state_index,
+    td_update,
 )
 from cartpole_q.engines import cartpole_twin
 from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.cartpole_twin import TwinSettings
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
+
+
+@njit(cache=True, nogil=True, inline="always")
+def training_episode(
+    q, visits, low, high, bins, gamma, alpha, epsilon, agent_rng,
+    state, observation, max_episode_steps, sutton_barto_reward, may_explore,
+):  # fmt: skip
+    """Play and learn one episode on the twin (already reset); return its return and length.
+
+    ``may_explore`` is a literal at both call sites: with ``False`` (epsilon is 0 for the
+    whole episode) the compiled loop holds no generator call, which makes a step a third
+    faster; the choices are the same, since at epsilon 0 ``epsilon_greedy`` draws nothing.
+    """
+    s, a = begin_episode(q, observation, low, high, bins, epsilon, agent_rng)
+    episode_return, length = 0.0, 0
+    while True:
+        reward, terminated = cartpole_twin.step(state, a, observation, sutton_barto_reward)
+        length += 1
+        truncated = length >= max_episode_steps
+        episode_return += reward
+        # agent.learn_step, spelled out: numba keeps reference-count updates for every
+        # array argument of an inlined call, which would double the cost of a step.
+        visits[s, a] += 1
+        next_state = state_index(observation, low, high, bins)
+        td_update(q, s, a, reward, next_state, terminated, alpha, gamma)
+        if terminated or truncated:
+            return episode_return, length
+        s = next_state
+        a = epsilon_greedy(q, s, epsilon, agent_rng) if may_explore else best_action(q, s)
 
 
 @njit(cache=True, nogil=True)
@@ -47,19 +82,16 @@ def train_episodes(
         epsilon = schedule_value(epsilon_kind, epsilon_start, epsilon_end, epsilon_rate, episode)
         alpha = schedule_value(alpha_kind, alpha_start, alpha_end, alpha_rate, episode)
         cartpole_twin.reset(state, observation, env_rng)
-        s, a = begin_episode(q, observation, low, high, bins, epsilon, agent_rng)
-        episode_return, length = 0.0, 0
-        while True:
-            reward, terminated = cartpole_twin.step(state, a, observation, sutton_barto_reward)
-            length += 1
-            truncated = length >= max_episode_steps
-            episode_return += reward
-            s, a = learn_step(
-                q, visits, s, a, reward, observation, terminated, truncated,
-                low, high, bins, alpha, gamma, epsilon, agent_rng,
+        if epsilon > 0.0:
+            episode_return, length = training_episode(
+                q, visits, low, high, bins, gamma, alpha, epsilon, agent_rng,
+                state, observation, max_episode_steps, sutton_barto_reward, True,
             )  # fmt: skip
-            if terminated or truncated:
-                break
+        else:
+            episode_return, length = training_episode(
+                q, visits, low, high, bins, gamma, alpha, epsilon, agent_rng,
+                state, observation, max_episode_steps, sutton_barto_reward, False,
+            )  # fmt: skip
         record_episode(
             returns, lengths, epsilons, alphas, episode, episode_return, length, epsilon, alpha
         )
@@ -90,7 +122,7 @@ class NumbaEngine:
     """Trains on the compiled CartPole twin (CartPole-v0/v1 only)."""
 
     name = "numba"
-    chunk_episodes = 100
+    chunk_episodes = 1000
 
     def __init__(
         self,

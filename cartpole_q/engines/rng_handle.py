@@ -17,6 +17,10 @@ import numpy as np
 from numba import njit, types
 from numba.experimental import structref
 
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
+
 
 @structref.register
 class GeneratorHandleType(types.StructRef):

@@ -1,0 +1,169 @@
+"""Training throughput, measured side by side in one run (env steps per second).
+
+    python benchmarks/throughput.py [--repeats 3] [--quick]
+
+Rows:
+  blog loop         the tutorial's per-step loop (Python lists for binning,
+                    env.action_space.sample(), NumPy Q updates) on gymnasium.make: the baseline
+  gymnasium engine  cartpole-q's Python loop on gymnasium.make, same grid
+  numba engine      the compiled twin and agent, same grid (one thread, compile excluded)
+  + progress bar    the gymnasium engine with the live rich progress bar drawing
+
+Every figure is the best of --repeats runs; ratios are against the blog loop measured in
+this same run, so they hold across machines even when absolute rates do not.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import math
+import time
+
+import gymnasium as gym
+import numpy as np
+from rich.console import Console
+
+from cartpole_q.config import load_config
+from cartpole_q.environment import inspect_env
+from cartpole_q.progress import RichReporter
+from cartpole_q.training import train
+
+BLOG_BINS = (10, 10, 10, 10)
+BLOG_LOW = (-4.8, -1.0, -0.418, -1.0)
+BLOG_HIGH = (4.8, 1.0, 0.418, 1.0)
+
+
+def blog_loop(episodes: int, seed: int) -> tuple[int, float]:
+    """The tutorial's Q-learning loop, with its two bugs fixed (clamp index, truncation)."""
+    env = gym.make("CartPole-v1")
+    env.action_space.seed(seed)
+    np.random.seed(seed)  # noqa: NPY002 - the tutorial's own global generator
+    q_table = np.zeros((*BLOG_BINS, env.action_space.n))
+    alpha, gamma, epsilon = 0.1, 0.99, 1.0
+
+    def discretize(observation: np.ndarray) -> tuple[int, ...]:
+        ratios = [
+            (observation[i] + abs(BLOG_LOW[i])) / (BLOG_HIGH[i] - BLOG_LOW[i])
+            for i in range(len(observation))
+        ]
+        new_obs = [round((BLOG_BINS[i] - 1) * ratios[i]) for i in range(len(observation))]
+        new_obs = [min(BLOG_BINS[i] - 1, max(0, new_obs[i])) for i in range(len(observation))]
+        return tuple(new_obs)
+
+    steps = 0
+    started = time.perf_counter()
+    for episode in range(episodes):
+        observation, _ = env.reset(seed=seed if episode == 0 else None)
+        state = discretize(observation)
+        done = False
+        while not done:
+            if np.random.random() < epsilon:  # noqa: NPY002 - as the tutorial writes it
+                action = env.action_space.sample()
+            else:
+                action = int(np.argmax(q_table[state]))
+            observation, reward, terminated, truncated, _ = env.step(action)
+            new_state = discretize(observation)
+            q_table[state][action] += alpha * (
+                reward + gamma * np.max(q_table[new_state]) - q_table[state][action]
+            )
+            state = new_state
+            done = terminated or truncated
+            steps += 1
+        epsilon = max(0.01, epsilon * 0.995)
+    return steps, time.perf_counter() - started
+
+
+def engine_rate(
+    config_path: str | None, engine: str, episodes: int, seed: int, progress: bool = False
+) -> tuple[int, float]:
+    """Training env steps and seconds of ``train`` (periodic evaluation off, compile excluded)."""
+    overrides = {
+        "engine": engine, "seed": seed, "train.episodes": episodes, "train.stop_when_solved": False,
+        "train.eval_every": 0, "train.checkpoint_every": 0,
+    }  # fmt: skip
+    config = load_config(config_path, overrides)
+    info = inspect_env(config)
+    callback = None
+    reporter = None
+    if progress:
+        reporter = RichReporter(Console(file=io.StringIO(), force_terminal=True, width=150))
+        reporter.start("run", "benchmark", episodes)
+        callback = lambda update: reporter.update("run", update)  # noqa: E731
+    try:
+        result = train(config, env_info=info, on_progress=callback, final_eval=False)
+    finally:
+        if reporter is not None:
+            reporter.close()
+    return result.env_steps, result.train_seconds
+
+
+def best_rate(measure, repeats: int) -> float:  # type: ignore[no-untyped-def]
+    rates = []
+    for _ in range(repeats):
+        steps, seconds = measure()
+        rates.append(steps / seconds)
+    return max(rates)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="fewer episodes (a rough check)")
+    args = parser.parse_args()
+    scale = 0.2 if args.quick else 1.0
+    python_episodes = max(20, int(400 * scale))
+    numba_episodes = max(1000, int(100_000 * scale))
+    blog = "configs/blog.yaml"
+
+    # warm up numba (compile or load the cache) so that no row pays for it
+    engine_rate(blog, "numba", 5, 0)
+    engine_rate(blog, "gymnasium", 2, 0)
+    engine_rate(None, "numba", 5, 0)
+
+    rows = [
+        ("blog loop (baseline)", best_rate(lambda: blog_loop(python_episodes, 0), args.repeats)),
+        (
+            "gymnasium engine, blog grid",
+            best_rate(lambda: engine_rate(blog, "gymnasium", python_episodes, 0), args.repeats),
+        ),
+        (
+            "numba engine, blog grid",
+            best_rate(lambda: engine_rate(blog, "numba", numba_episodes, 0), args.repeats),
+        ),
+        (
+            "gymnasium engine, default config",
+            best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), args.repeats),
+        ),
+        (
+            "numba engine, default config",
+            best_rate(lambda: engine_rate(None, "numba", numba_episodes // 10, 0), args.repeats),
+        ),
+    ]
+    baseline = rows[0][1]
+    print(f"{'training loop':40s} {'env steps/s':>14s} {'vs blog loop':>13s}")
+    for name, rate in rows:
+        print(f"{name:40s} {rate:14,.0f} {rate / baseline:12.1f}x")
+    gym_default = rows[3][1]
+    print(f"numba / gymnasium engine, default config: {rows[4][1] / gym_default:,.0f}x")
+    print(f"numba / gymnasium engine, blog grid:      {rows[2][1] / rows[1][1]:,.0f}x")
+
+    # The progress bar's cost, measured as interleaved pairs so machine drift cancels out.
+    plain, with_bar = [], []
+    for _ in range(max(3, args.repeats)):
+        plain.append(best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), 1))
+        with_bar.append(
+            best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0, progress=True), 1)
+        )
+    cost = 1.0 - max(with_bar) / max(plain)
+    print(
+        f"progress bar on the gymnasium engine: {max(with_bar):,.0f} vs {max(plain):,.0f} env steps/s "
+        f"without, a cost of {100 * cost:.1f}% (best of {len(plain)} interleaved runs each)"
+    )
+    assert math.isfinite(cost)
+
+
+if __name__ == "__main__":
+    main()
