@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import tempfile
 from functools import cache
 from pathlib import Path
 
@@ -43,4 +44,9 @@ def configure() -> None:
 
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    numba.config.CACHE_DIR = str(cache_dir())  # type: ignore[attr-defined]
+    directory = cache_dir()
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except OSError:  # no writable home (some CI and container set-ups): a temporary one
+        directory = Path(tempfile.gettempdir()) / "cartpole-q" / directory.name
+    numba.config.CACHE_DIR = str(directory)  # type: ignore[attr-defined]
