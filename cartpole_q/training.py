@@ -169,6 +169,7 @@ def train(
         engine_name, config, env_info, env_seed, None if resume is None else resume.env_rng_state
     )
     try:
+        engine.warm_up(state)
         return _run(config, env_info, engine, state, resume, should_stop, on_progress,
                     on_checkpoint, final_eval)  # fmt: skip
     finally:

@@ -201,3 +201,20 @@ def test_numba_cache_is_keyed_by_every_source_file(tmp_path, monkeypatch) -> Non
     monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
     assert numba_cache.cache_dir().parent == tmp_path / "xdg" / "cartpole-q"
     numba_cache.source_digest.cache_clear()
+
+
+@pytest.mark.parametrize("name", ["numba", "gymnasium"])
+def test_warm_up_touches_no_state_and_draws_nothing(name: str) -> None:
+    from cartpole_q.engines.base import TrainingState
+
+    config = load_config()
+    info = inspect_env(config)
+    rng = np.random.default_rng(5)
+    generator_state = rng.bit_generator.state
+    state = TrainingState.fresh(config, info, rng)
+    engine = make_engine(name, config, info, env_seed=1)
+    env_state = engine.env_rng_state()
+    engine.warm_up(state)
+    assert rng.bit_generator.state == generator_state
+    assert engine.env_rng_state() == env_state
+    assert (state.q == config.agent.q_init).all() and not state.visits.any() and state.episode == 0

@@ -116,6 +116,13 @@ class Engine(Protocol):
         """Return the greedy policy's returns over ``episodes`` episodes from ``seed``."""
         ...
 
+    def warm_up(self, state: TrainingState) -> None:
+        """Compile (or load from the cache) the compiled code, so that timing excludes it.
+
+        Touches neither the state's arrays nor its generator's stream.
+        """
+        ...
+
     def env_rng_state(self) -> dict[str, Any]:
         """Return the training environment's random generator state (for checkpoints)."""
         ...

@@ -107,6 +107,22 @@ class GymnasiumEngine:
                 return episode
         return None
 
+    def warm_up(self, state: TrainingState) -> None:
+        """Compile the per-step functions on a one-row scratch table.
+
+        The observation sits on every lower grid edge, so it maps to row 0; epsilon 0 and a
+        terminated step draw nothing from the agent's generator.
+        """
+        p = self._params
+        space = self._env.observation_space
+        observation = p.low.astype(space.dtype)
+        q = np.zeros((1, state.q.shape[1]))
+        visits = np.zeros((1, state.q.shape[1]), dtype=np.int64)
+        handle = self._rng_handle(state.agent_rng)
+        _begin(handle, q, observation, p.low, p.high, p.bins, 0.0)
+        _learn(handle, q, visits, 0, 0, 0.0, observation, True, False,
+               p.low, p.high, p.bins, 0.0, p.gamma, 0.0)  # fmt: skip
+
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
         env = make_env(self._config.env)

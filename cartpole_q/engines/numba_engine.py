@@ -152,6 +152,11 @@ class NumbaEngine:
         state.env_steps += env_steps
         return None if solved < 0 else solved
 
+    def warm_up(self, state: TrainingState) -> None:
+        """Compile the kernels with an empty range of episodes (nothing runs, nothing drawn)."""
+        self.run(state, state.episode, check_solved=False)
+        self.evaluate(state.q, 0, 0)
+
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
         p, s = self._params, self._settings
