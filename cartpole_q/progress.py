@@ -99,8 +99,25 @@ class PlainReporter:
         """Nothing to close."""
 
 
+def compact_rate(steps_per_second: float) -> str:
+    """A rate in few characters.
+
+    >>> compact_rate(950.0), compact_rate(148_781.0), compact_rate(28_233_949.0)
+    ('950/s', '149k/s', '28.2M/s')
+    """
+    if steps_per_second >= 1e6:
+        return f"{steps_per_second / 1e6:.1f}M/s"
+    if steps_per_second >= 1e3:
+        return f"{steps_per_second / 1e3:.0f}k/s"
+    return f"{steps_per_second:.0f}/s"
+
+
 class RichReporter:
-    """A live rich progress display: one bar per run (or per worker) on a terminal."""
+    """A live rich progress display: one bar per run (or per worker), fitting 80 columns.
+
+    Each bar shows the episode, the last return, the 100-episode average, epsilon, env
+    steps per second and the time left; each finished run's outcome is printed above.
+    """
 
     def __init__(self, console: Any | None = None, min_interval: float = 0.1) -> None:
         from rich.console import Console
@@ -108,7 +125,6 @@ class RichReporter:
             BarColumn,
             MofNCompleteColumn,
             TextColumn,
-            TimeElapsedColumn,
             TimeRemainingColumn,
         )
         from rich.progress import (
@@ -118,14 +134,14 @@ class RichReporter:
         self._console = console or Console()
         self._progress = RichProgress(
             TextColumn("[bold]{task.description}"),
-            BarColumn(),
+            BarColumn(bar_width=None),
             MofNCompleteColumn(),
             TextColumn("{task.fields[stats]}"),
-            TimeElapsedColumn(),
             TextColumn("eta"),
             TimeRemainingColumn(),
             console=self._console,
             refresh_per_second=10,
+            expand=True,
         )
         self._tasks: dict[Any, Any] = {}
         self._last_update: dict[Any, float] = {}
@@ -148,16 +164,18 @@ class RichReporter:
         self._last_update[key] = now
         rate = progress.env_steps / progress.elapsed if progress.elapsed > 0 else 0.0
         stats = (
-            f"return {progress.last_return:>5g}  avg100 {progress.moving_average:6.1f}  "
-            f"eps {progress.epsilon:.3f}  {rate:>10,.0f} steps/s"
+            f"ret {progress.last_return:>4g} avg100 {progress.moving_average:5.1f} "
+            f"eps {progress.epsilon:.2f} {compact_rate(rate):>7}"
         )
         self._progress.update(self._tasks[key], completed=progress.episode, stats=stats)
 
     def finish(self, key: Any, line: str) -> None:
-        """Complete the run's bar and show how it ended."""
+        """Print how the run ended above the bars, and complete its bar."""
+        self._progress.console.print(line, highlight=False)
         task = self._tasks.get(key)
         if task is not None:
-            self._progress.update(task, total=self._progress.tasks[task].completed or 1, stats=line)
+            completed = self._progress.tasks[task].completed or 1
+            self._progress.update(task, total=completed, stats="done")
 
     def close(self) -> None:
         """Stop the live display, leaving the final bars on screen."""

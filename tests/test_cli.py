@@ -196,6 +196,11 @@ def test_training_another_environment_uses_the_gymnasium_engine(tmp_path: Path) 
         ("discretization:\n  bins: [1, 1, 0, 12]\n", "discretization.bins"),
         ("seed: -3", "seed"),
         ("discretization:\n  high: [2.4, 3.0, .nan, 3.5]\n", "discretization.high[2]"),
+        (
+            "discretization:\n  low: [-2.4, -.inf, -0.2, -3.5]\n",
+            ("discretization.low[1]", "finite"),
+        ),
+        ("discretization:\n  low: [-1, -1]\n", ("discretization.low", "has 2 entries")),
         ("discretization:\n  low: [-2.4, -3.0, 0.3, -3.5]\n", "discretization.low"),
         (
             "discretization:\n  bins: [2, 10]\n  low: [-1, -1]\n  high: [1, 1]\n",

@@ -177,8 +177,8 @@ def test_rich_reporter_draws_a_bar_on_a_terminal() -> None:
     reporter.finish("run", "demo: solved")
     reporter.close()
     output = stream.getvalue()
-    # the final frame: the bar ends at the 50 episodes the update reported, with the outcome
-    assert "\x1b" in output and "50/50" in output and "demo: solved" in output
+    # the outcome is printed above the bar, which ends at the 50 episodes the update reported
+    assert "\x1b" in output and "50/50" in output and "demo: solved" in output and "done" in output
 
 
 def test_null_reporter_prints_nothing(capsys: pytest.CaptureFixture[str]) -> None:

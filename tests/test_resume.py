@@ -152,16 +152,20 @@ def _check_every_file_loads(run: Path) -> int:
 
 
 @pytest.mark.slow
-def test_sigint_completes_the_run_directory_and_exits_130(tmp_path: Path) -> None:
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_sigint_or_sigterm_completes_the_run_directory_and_exits_130(
+    tmp_path: Path, signum: int
+) -> None:
     config = write_yaml(tmp_path / "slow.yaml", SLOW_TRAINING)
     run = tmp_path / "run"
     process = subprocess.Popen(_command("train", "-c", config, "--out", run), stdout=subprocess.PIPE,
                                stderr=subprocess.PIPE, text=True)  # fmt: skip
     _wait_for(run / rundir.CHECKPOINT_FILE)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(signum)
     stdout, stderr = process.communicate(timeout=120)
     assert process.returncode == 130, stderr
-    assert "Traceback" not in stderr and "SIGINT: stopping after the current episode" in stderr
+    name = signal.Signals(signum).name
+    assert "Traceback" not in stderr and f"{name}: stopping after the current episode" in stderr
     assert stdout.strip().splitlines()[-1] == str(run)
     summary = json.loads((run / "summary.json").read_text())
     assert summary["interrupted"] is True and 5 <= summary["episodes"] < 1500
