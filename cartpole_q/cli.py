@@ -53,10 +53,6 @@ def _exit_codes() -> Iterator[None]:
         raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
-def _bad_usage(message: str) -> UserError:
-    return UserError(message)
-
-
 @app.command()
 def train(
     config: Annotated[
@@ -114,7 +110,7 @@ def train(
             }  # fmt: skip
             clashing = [name for name, value in given.items() if value is not None]
             if clashing:
-                raise _bad_usage(
+                raise UserError(
                     f"--resume continues a run exactly as it was configured, so it cannot be "
                     f"combined with {', '.join(clashing)}."
                 )
@@ -122,7 +118,7 @@ def train(
             run_dir = resume
         else:
             if seed is not None and seeds is not None:
-                raise _bad_usage("give either --seed (one run) or --seeds (several), not both.")
+                raise UserError("give either --seed (one run) or --seeds (several), not both.")
             overrides: dict[str, Any] = {}
             if seed is not None:
                 overrides.update({"seed": seed, "train.seeds": None})
@@ -216,7 +212,7 @@ def eval_command(
 
         if rundir.is_multi_seed(run_dir):
             if video is not None or render:
-                raise _bad_usage(
+                raise UserError(
                     f"{run_dir}: is a multi-seed run; --video and --render take one seed's "
                     "run directory (one of its seed-* subdirectories)."
                 )
@@ -224,12 +220,12 @@ def eval_command(
             return
         run = rundir.load_run(run_dir)
         if render and video is not None:
-            raise _bad_usage("--render and --video cannot be combined: choose one.")
+            raise UserError("--render and --video cannot be combined: choose one.")
         if render:
             from cartpole_q.environment import has_display
 
             if not has_display():
-                raise _bad_usage(
+                raise UserError(
                     "--render needs a display, but neither DISPLAY nor WAYLAND_DISPLAY is set; "
                     "record the episodes with --video FILE.gif instead."
                 )
@@ -311,11 +307,11 @@ def plot(
 
         if policy:
             if len(run_dirs) != 1:
-                raise _bad_usage("--policy draws one run: give exactly one run directory.")
+                raise UserError("--policy draws one run: give exactly one run directory.")
             path = plot_policy(run_dirs[0], out or Path("policy_map.png"), dims)
         else:
             if dims is not None:
-                raise _bad_usage("--dims only applies to --policy.")
+                raise UserError("--dims only applies to --policy.")
             path = plot_rewards(run_dirs, out or Path("reward_curves.png"))
         typer.echo(str(path))
 

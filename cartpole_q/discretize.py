@@ -26,20 +26,6 @@ from collections.abc import Sequence
 from typing import Any
 
 
-def bin_index(x: float, low: float, high: float, n_bins: int) -> int:
-    """The bin of one coordinate under the contract's rule.
-
-    The comparisons are made on the scaled float before it becomes an integer, so NaN
-    and infinities never reach ``int``; for a non-negative float ``int`` is ``floor``.
-    """
-    scaled = (x - low) / (high - low) * n_bins
-    if not scaled >= 0.0:  # also NaN
-        return 0
-    if scaled >= n_bins:
-        return n_bins - 1
-    return int(scaled)
-
-
 def state_index(observation: Any, low: Any, high: Any, bins: Any) -> int:
     """The flat (C-order) Q-table row of an observation.
 
@@ -70,6 +56,6 @@ def bin_indices(
 ) -> tuple[int, ...]:
     """The per-dimension bin indices: the Q-table index without the action axis."""
     return tuple(
-        bin_index(float(x), float(lo), float(hi), int(n))
+        state_index([x], [lo], [hi], [n]) if n > 1 else 0
         for x, lo, hi, n in zip(observation, low, high, bins, strict=True)
     )

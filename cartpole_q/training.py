@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -111,7 +111,6 @@ class TrainResult:
     wall_seconds: float
     """seconds of the whole training loop, periodic evaluations included"""
     interrupted: bool = False
-    checkpoint: Checkpoint | None = field(default=None, repr=False)
 
     @property
     def episodes(self) -> int:
@@ -253,9 +252,8 @@ def _run(
             interrupted = True
             break
 
-    last_checkpoint = snapshot() if interrupted else None
     if interrupted and on_checkpoint is not None:
-        on_checkpoint(last_checkpoint)  # type: ignore[arg-type]
+        on_checkpoint(snapshot())
     wall_seconds = wall_before + time.perf_counter() - started
 
     if state.solved_episode is not None:
@@ -288,7 +286,6 @@ def _run(
         train_seconds=train_seconds,
         wall_seconds=wall_seconds,
         interrupted=interrupted,
-        checkpoint=last_checkpoint,
     )
 
 

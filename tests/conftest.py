@@ -7,6 +7,9 @@ from pathlib import Path
 
 import pytest
 import yaml
+from typer.testing import CliRunner, Result
+
+from cartpole_q.cli import app
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIGS = REPO / "configs"
@@ -40,3 +43,8 @@ def small_config_file(tmp_path: Path) -> Path:
             "eval": {"episodes": 3},
         },
     )
+
+
+def invoke(*args: object) -> Result:
+    """Run the command line in-process (unexpected exceptions propagate to the test)."""
+    return CliRunner().invoke(app, [str(a) for a in args], catch_exceptions=False)

@@ -12,17 +12,9 @@ import numpy as np
 import pytest
 import yaml
 from PIL import Image
-from typer.testing import CliRunner
 
-from cartpole_q.cli import app
 from cartpole_q.config import load_config
-from tests.conftest import CONFIGS, write_yaml
-
-runner = CliRunner()
-
-
-def invoke(*args: str):  # type: ignore[no-untyped-def]
-    return runner.invoke(app, [str(a) for a in args], catch_exceptions=False)
+from tests.conftest import CONFIGS, invoke, write_yaml
 
 
 def assert_refused(result, *named: str) -> None:  # type: ignore[no-untyped-def]

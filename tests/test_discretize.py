@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from cartpole_q import agent
-from cartpole_q.discretize import bin_index, bin_indices, state_index
+from cartpole_q.discretize import bin_indices, state_index
 
 # One dimension over [-1, 1] with 4 bins has edges at -0.5, 0 and 0.5.
 LOW, HIGH, BINS = -1.0, 1.0, 4
@@ -34,7 +34,7 @@ LOW, HIGH, BINS = -1.0, 1.0, 4
     ],
 )
 def test_bin_edges_and_clipping(x: float, expected: int) -> None:
-    assert bin_index(x, LOW, HIGH, BINS) == expected
+    assert state_index([x], [LOW], [HIGH], [BINS]) == expected
     assert (
         agent.state_index(np.array([x]), np.array([LOW]), np.array([HIGH]), np.array([BINS]))
         == expected

@@ -7,18 +7,11 @@ from pathlib import Path
 
 import pytest
 from PIL import Image
-from typer.testing import CliRunner
 
-from cartpole_q.cli import app
 from cartpole_q.config import load_config
 from cartpole_q.multiseed import run_seeds, seed_dir
 from cartpole_q.runner import prepare, start_run
-
-runner = CliRunner()
-
-
-def invoke(*args: object):  # type: ignore[no-untyped-def]
-    return runner.invoke(app, [str(a) for a in args], catch_exceptions=False)
+from tests.conftest import invoke
 
 
 @pytest.fixture(scope="module")

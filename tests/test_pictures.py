@@ -10,9 +10,7 @@ import numpy as np
 import pytest
 from PIL import Image
 from rich.console import Console
-from typer.testing import CliRunner
 
-from cartpole_q.cli import app
 from cartpole_q.plotting import (
     Curve,
     SeedBand,
@@ -25,12 +23,7 @@ from cartpole_q.plotting import (
 )
 from cartpole_q.progress import NullReporter, PlainReporter, RichReporter
 from cartpole_q.training import Progress
-
-runner = CliRunner()
-
-
-def invoke(*args: object):  # type: ignore[no-untyped-def]
-    return runner.invoke(app, [str(a) for a in args], catch_exceptions=False)
+from tests.conftest import invoke
 
 
 @pytest.fixture(scope="module")
