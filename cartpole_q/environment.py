@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+import sys
 import warnings
 from dataclasses import dataclass
 from typing import Any
@@ -127,7 +128,12 @@ def q_table_bytes(bins: tuple[int, ...], n_actions: int) -> int:
 
 
 def has_display() -> bool:
-    """Whether a window can be opened (an X11 or Wayland display is set)."""
+    """Whether a window can be opened: on Linux and BSD, an X11 or Wayland display is set.
+
+    macOS and Windows open windows without these variables.
+    """
+    if sys.platform == "darwin" or sys.platform.startswith("win"):
+        return True
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 

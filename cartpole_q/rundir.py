@@ -103,19 +103,23 @@ def create_run_dir(name: str, out: Path | None, runs_root: Path = Path("runs")) 
     Raises:
         RunError: ``out`` is a file or a non-empty directory.
     """
-    if out is not None:
-        check_output_dir(out)
-        out.mkdir(parents=True, exist_ok=True)
-        return out
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    runs_root.mkdir(parents=True, exist_ok=True)
-    for attempt in range(1000):
-        path = runs_root / (f"{name}-{stamp}" if attempt == 0 else f"{name}-{stamp}-{attempt}")
-        try:
-            path.mkdir()
-        except FileExistsError:
-            continue
-        return path
+    try:
+        if out is not None:
+            check_output_dir(out)
+            out.mkdir(parents=True, exist_ok=True)
+            return out
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        runs_root.mkdir(parents=True, exist_ok=True)
+        for attempt in range(1000):
+            path = runs_root / (f"{name}-{stamp}" if attempt == 0 else f"{name}-{stamp}-{attempt}")
+            try:
+                path.mkdir()
+            except FileExistsError:
+                continue
+            return path
+    except OSError as error:
+        where = out if out is not None else runs_root
+        raise RunError(f"{where}: cannot create the run directory ({error.strerror}).") from None
     raise RunError(f"{runs_root}: could not find a free run directory name for {name!r}.")
 
 

@@ -272,6 +272,7 @@ def test_out_must_be_new_or_empty(tmp_path: Path) -> None:
     a_file.write_text("x")
     assert_refused(invoke("train", "--out", a_file), str(a_file), "this is a file")
     assert a_file.read_text() == "x"
+    assert_refused(invoke("train", "--out", a_file / "run"), "cannot create the run directory")
     empty = tmp_path / "empty"
     empty.mkdir()
     assert invoke("train", "--out", empty, "--episodes", "3", "-q").exit_code == 0
