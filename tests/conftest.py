@@ -7,12 +7,18 @@ from pathlib import Path
 
 import pytest
 import yaml
+from hypothesis import settings
 from typer.testing import CliRunner, Result
 
 from cartpole_q.cli import app
 
 REPO = Path(__file__).resolve().parents[1]
 CONFIGS = REPO / "configs"
+
+# No test may depend on machine speed or a warm numba cache: the first call of a compiled
+# function loads (or compiles) it, which can take longer than Hypothesis' 200 ms deadline.
+settings.register_profile("cartpole-q", deadline=None)
+settings.load_profile("cartpole-q")
 
 # Rendering in tests never opens a window.
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")

@@ -96,3 +96,11 @@ def test_both_implementations_follow_the_contract(
     assert state_index(observation, low, high, bins) == flat
     assert state_index(observation, low.tolist(), high.tolist(), bins.tolist()) == flat
     assert agent.state_index(observation, low, high, bins) == flat
+
+
+def test_property_tests_have_no_deadline() -> None:
+    # A cold numba cache makes the first example slow (issue: DeadlineExceeded on a fresh
+    # clone); the suite's Hypothesis profile must not time examples.
+    from hypothesis import settings
+
+    assert settings().deadline is None
