@@ -1,52 +1,131 @@
-"""Where numba keeps compiled code: a cache directory keyed by this package's source.
+"""Where numba keeps compiled code: a private cache directory keyed by the compiled source.
 
 numba invalidates a cached function only when the function's own file changes, not when
 a function it inlines from another file does (the engines inline ``agent.py``). A stale
 cache would silently run old code, and the two engines would no longer agree. So every
-version of the package's source gets its own directory,
-``$XDG_CACHE_HOME/cartpole-q/numba-<hash of the source files>`` (``~/.cache`` by default),
-unless the user chose one with ``NUMBA_CACHE_DIR``.
+version of the compiled modules gets its own directory,
+``$XDG_CACHE_HOME/cartpole-q/numba-<hash of the compiled modules>`` (``~/.cache`` by
+default), unless the user chose one with ``NUMBA_CACHE_DIR``. Only the modules numba
+compiles are hashed (:data:`COMPILED_MODULES`): editing the command line costs no
+recompilation. Directories of older sources are removed.
+
+numba's cache files are pickles, which numba loads and runs. A cache directory must
+therefore belong to the current user and be writable by nobody else: when the home cache
+cannot be used, a per-user directory in the temporary directory (mode 0700, owner
+checked) is used, and failing that a fresh temporary directory.
 
 Every module that defines ``cache=True`` functions calls :func:`configure` before them.
 """
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import os
+import shutil
+import stat
 import tempfile
 from functools import cache
 from pathlib import Path
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
+COMPILED_MODULES = (
+    "agent.py",
+    "discretize.py",
+    "environment.py",
+    "engines/cartpole_twin.py",
+    "engines/gymnasium_engine.py",
+    "engines/numba_engine.py",
+    "engines/rng_handle.py",
+)
+"""the modules whose functions numba compiles, or whose constants and functions they inline
+(a test checks that every module defining compiled functions is listed)"""
+
+_PREFIX = "numba-"
+
 
 @cache
 def source_digest() -> str:
-    """A short hash of every Python file of the package."""
+    """A short hash of the modules numba compiles."""
     digest = hashlib.sha256()
-    for path in sorted(PACKAGE_DIR.rglob("*.py")):
-        digest.update(path.relative_to(PACKAGE_DIR).as_posix().encode())
-        digest.update(path.read_bytes())
+    for name in COMPILED_MODULES:
+        digest.update(name.encode())
+        digest.update((PACKAGE_DIR / name).read_bytes())
     return digest.hexdigest()[:16]
+
+
+def cache_root() -> Path:
+    """The directory that holds this package's numba caches (one per source version)."""
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "cartpole-q"
 
 
 def cache_dir() -> Path:
     """The numba cache directory for this source."""
-    root = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
-    return root / "cartpole-q" / f"numba-{source_digest()}"
+    return cache_root() / f"{_PREFIX}{source_digest()}"
+
+
+def is_private_directory(path: Path) -> bool:
+    """Whether ``path`` is a real directory owned by this user that nobody else may write.
+
+    Symbolic links are refused: another user could point one at their own directory.
+    """
+    try:
+        info = path.lstat()
+    except OSError:
+        return False
+    return (
+        stat.S_ISDIR(info.st_mode)
+        and info.st_uid == os.getuid()
+        and not info.st_mode & (stat.S_IWGRP | stat.S_IWOTH)
+    )
+
+
+def _private_directory(path: Path) -> Path | None:
+    """Create ``path`` (mode 0700) if needed; return it if it is private, else ``None``."""
+    try:
+        path.mkdir(mode=0o700, parents=True, exist_ok=True)
+    except OSError:
+        return None
+    return path if is_private_directory(path) and os.access(path, os.W_OK) else None
+
+
+def _fresh_temporary_directory() -> Path:
+    """A new private directory, removed when the process exits."""
+    path = Path(tempfile.mkdtemp(prefix="cartpole-q-numba-"))
+    atexit.register(shutil.rmtree, path, ignore_errors=True)
+    return path
+
+
+def remove_stale_caches(root: Path, keep: Path) -> None:
+    """Delete the cache directories of other source versions under ``root``."""
+    try:
+        entries = list(root.iterdir())
+    except OSError:
+        return
+    for entry in entries:
+        if entry.name.startswith(_PREFIX) and entry != keep and is_private_directory(entry):
+            shutil.rmtree(entry, ignore_errors=True)
+
+
+def choose_cache_dir() -> Path:
+    """The private directory numba should cache into (see the module docstring)."""
+    directory = cache_dir()
+    if _private_directory(directory.parent) and _private_directory(directory):
+        remove_stale_caches(directory.parent, directory)
+        return directory
+    fallback = Path(tempfile.gettempdir()) / f"cartpole-q-{os.getuid()}" / directory.name
+    if _private_directory(fallback.parent) and _private_directory(fallback):
+        remove_stale_caches(fallback.parent, fallback)
+        return fallback
+    return _fresh_temporary_directory()
 
 
 @cache
 def configure() -> None:
-    """Point numba's cache at :func:`cache_dir` (unless ``NUMBA_CACHE_DIR`` is set)."""
+    """Point numba's cache at :func:`choose_cache_dir` (unless ``NUMBA_CACHE_DIR`` is set)."""
     import numba
 
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
-    directory = cache_dir()
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-    except OSError:  # no writable home (some CI and container set-ups): a temporary one
-        directory = Path(tempfile.gettempdir()) / "cartpole-q" / directory.name
-    numba.config.CACHE_DIR = str(directory)  # type: ignore[attr-defined]
+    numba.config.CACHE_DIR = str(choose_cache_dir())  # type: ignore[attr-defined]

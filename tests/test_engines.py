@@ -183,26 +183,6 @@ def test_kept_table_is_the_solve_point_when_training_goes_on() -> None:
     assert longer.q_table.tobytes() == stopped.q_table.tobytes()
 
 
-def test_numba_cache_is_keyed_by_every_source_file(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
-    import shutil
-
-    from cartpole_q import numba_cache
-
-    copy = tmp_path / "cartpole_q"
-    shutil.copytree(numba_cache.PACKAGE_DIR, copy, ignore=shutil.ignore_patterns("__pycache__"))
-    monkeypatch.setattr(numba_cache, "PACKAGE_DIR", copy)
-    numba_cache.source_digest.cache_clear()
-    before = numba_cache.source_digest()
-    agent_source = copy / "agent.py"
-    agent_source.write_text(agent_source.read_text() + "\n# changed\n")
-    numba_cache.source_digest.cache_clear()
-    assert numba_cache.source_digest() != before  # an inlined dependency changed: new cache
-    numba_cache.source_digest.cache_clear()
-    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
-    assert numba_cache.cache_dir().parent == tmp_path / "xdg" / "cartpole-q"
-    numba_cache.source_digest.cache_clear()
-
-
 @pytest.mark.parametrize("name", ["numba", "gymnasium"])
 def test_warm_up_touches_no_state_and_draws_nothing(name: str) -> None:
     from cartpole_q.engines.base import TrainingState
