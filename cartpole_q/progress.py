@@ -52,16 +52,19 @@ class NullReporter:
 def progress_line(label: str, progress: Progress) -> str:
     """One plain line describing a run's progress.
 
-    >>> p = Progress(150, 1000, 500.0, 480.25, 0.0, 60000, 1.5, None)
+    The rate is training env steps per second of training time (periodic evaluations
+    excluded), the same figure as ``summary.json``'s ``steps_per_second``.
+
+    >>> p = Progress(150, 1000, 500.0, 480.25, 0.0, 60000, 2.0, None, train_seconds=1.5)
     >>> progress_line("seed 0", p)
-    'seed 0: episode 150/1000  return 500  avg100 480.2  epsilon 0.000  40,000 steps/s'
+    'seed 0: episode 150/1000  return 500  avg100 480.2  epsilon 0.000  40,000 train steps/s'
     """
-    rate = progress.env_steps / progress.elapsed if progress.elapsed > 0 else 0.0
+    rate = progress.train_steps_per_second
     solved = f"  solved at {progress.solved_episode}" if progress.solved_episode else ""
     return (
         f"{label}: episode {progress.episode}/{progress.episodes}  return {progress.last_return:g}  "
         f"avg100 {progress.moving_average:.1f}  epsilon {progress.epsilon:.3f}  "
-        f"{rate:,.0f} steps/s{solved}"
+        f"{rate:,.0f} train steps/s{solved}"
     )
 
 
@@ -145,6 +148,7 @@ class RichReporter:
         )
         self._tasks: dict[Any, Any] = {}
         self._last_update: dict[Any, float] = {}
+        self._latest: dict[Any, Progress] = {}
         self._min_interval = min_interval
         self._progress.start()
 
@@ -155,27 +159,39 @@ class RichReporter:
         else:
             self._tasks[key] = self._progress.add_task(label, total=episodes, stats="")
         self._last_update[key] = 0.0
+        self._latest.pop(key, None)
 
     def update(self, key: Any, progress: Progress) -> None:
         """Move the run's bar (throttled, so the bar never slows training)."""
+        self._latest[key] = progress
         now = time.monotonic()
         if now - self._last_update.get(key, 0.0) < self._min_interval:
             return
         self._last_update[key] = now
-        rate = progress.env_steps / progress.elapsed if progress.elapsed > 0 else 0.0
+        self._draw(key, progress)
+
+    def _draw(self, key: Any, progress: Progress) -> None:
         stats = (
             f"ret {progress.last_return:>4g} avg100 {progress.moving_average:5.1f} "
-            f"eps {progress.epsilon:.2f} {compact_rate(rate):>7}"
+            f"eps {progress.epsilon:.2f} {compact_rate(progress.train_steps_per_second):>7}"
         )
         self._progress.update(self._tasks[key], completed=progress.episode, stats=stats)
 
     def finish(self, key: Any, line: str) -> None:
-        """Print how the run ended above the bars, and complete its bar."""
+        """Print how the run ended above the bars, and complete its bar at the real count.
+
+        The last update may have been throttled away: the bar is drawn once more from the
+        latest progress, so it ends on the episode the run really ended on.
+        """
         self._progress.console.print(line, highlight=False)
         task = self._tasks.get(key)
-        if task is not None:
-            completed = self._progress.tasks[task].completed or 1
-            self._progress.update(task, total=completed, stats="done")
+        if task is None:
+            return
+        latest = self._latest.pop(key, None)
+        if latest is not None:
+            self._draw(key, latest)
+        completed = self._progress.tasks[task].completed or 1
+        self._progress.update(task, total=completed, stats="done")
 
     def close(self) -> None:
         """Stop the live display, leaving the final bars on screen."""

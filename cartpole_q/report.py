@@ -36,7 +36,7 @@ def _rows_single(run_dir: Path, summary: dict[str, Any]) -> list[tuple[str, str]
     rows.append((
         "time",
         f"{summary.get('wall_seconds', 0):.2f} s, {summary.get('env_steps', 0):,} env steps "
-        f"({summary.get('steps_per_second', 0):,.0f} steps/s)",
+        f"({summary.get('steps_per_second', 0):,.0f} train steps/s, evaluations excluded)",
     ))  # fmt: skip
     if summary.get("interrupted"):
         rows.append(("status", f"interrupted after episode {summary.get('episodes')}"))

@@ -54,6 +54,13 @@ class Progress:
     elapsed: float
     """seconds since training (re)started"""
     solved_episode: int | None
+    train_seconds: float = 0.0
+    """seconds spent in training episodes, periodic evaluations excluded, resumed runs' included"""
+
+    @property
+    def train_steps_per_second(self) -> float:
+        """Env steps per second of training time, as ``summary.json``'s ``steps_per_second``."""
+        return self.env_steps / self.train_seconds if self.train_seconds > 0 else 0.0
 
 
 @dataclass(frozen=True)
@@ -247,7 +254,7 @@ def _run(
         ):
             on_checkpoint(snapshot())
         if on_progress is not None:
-            on_progress(_progress(state, total, time.perf_counter() - started))
+            on_progress(_progress(state, total, time.perf_counter() - started, train_seconds))
         if not finished and should_stop is not None and should_stop():
             interrupted = True
             break
@@ -312,7 +319,7 @@ def _next_multiple(episode: int, every: int) -> int:
     return (episode // every + 1) * every
 
 
-def _progress(state: TrainingState, total: int, elapsed: float) -> Progress:
+def _progress(state: TrainingState, total: int, elapsed: float, train_seconds: float) -> Progress:
     episode = state.episode
     window = state.returns[max(0, episode - SOLVE_WINDOW) : episode]
     return Progress(
@@ -324,4 +331,5 @@ def _progress(state: TrainingState, total: int, elapsed: float) -> Progress:
         env_steps=state.env_steps,
         elapsed=elapsed,
         solved_episode=state.solved_episode,
+        train_seconds=train_seconds,
     )
