@@ -2,8 +2,10 @@
 
 The Python API, for notebooks and scripts (imported lazily, so the command line starts fast):
 
-- :func:`load_config` -- read and validate a YAML config (``None``: the embedded default);
-- :func:`train` -- train a config, returning a :class:`~cartpole_q.training.TrainResult`;
+- :func:`load_config` -- read and validate a config: a YAML file, a shipped config's name
+  (``"blog"``), or a mapping (``{"agent": {"gamma": 0.9}}``); ``None``: the embedded default;
+- :func:`train` -- train a config (a :class:`~cartpole_q.config.Config`, or anything
+  :func:`load_config` takes), returning a :class:`~cartpole_q.training.TrainResult`;
 - :func:`evaluate` -- play a Q-table's greedy policy in ``gymnasium.make``;
 - :func:`write_run` / :func:`load_run` -- save a result as a run directory, read one back.
 """
@@ -18,17 +20,41 @@ __all__ = ["__version__", "evaluate", "load_config", "load_run", "train", "write
 
 _LAZY = {
     "load_config": "cartpole_q.config",
-    "train": "cartpole_q.training",
     "evaluate": "cartpole_q.evaluation",
     "load_run": "cartpole_q.rundir",
     "write_run": "cartpole_q.rundir",
 }
 
 if TYPE_CHECKING:
-    from cartpole_q.config import load_config
+    from collections.abc import Mapping
+    from os import PathLike
+
+    from cartpole_q.config import Config, load_config
     from cartpole_q.evaluation import evaluate
     from cartpole_q.rundir import load_run, write_run
-    from cartpole_q.training import train
+    from cartpole_q.training import TrainResult
+
+
+def train(
+    config: Config | str | PathLike[str] | Mapping[str, Any] | None = None, **options: Any
+) -> TrainResult:
+    """Train a config; see :func:`cartpole_q.training.train` for ``options``.
+
+    Args:
+        config: a loaded config, or what :func:`load_config` takes: a YAML file
+            (``"configs/blog.yaml"``), a shipped config's name, a mapping merged onto the
+            default (``{"seed": 3}``), or ``None`` for the embedded default.
+        **options: passed on (``on_progress``, ``should_stop``, ...).
+
+    Raises:
+        ConfigError: the config is invalid or does not fit its environment.
+    """
+    from cartpole_q.config import Config, load_config
+    from cartpole_q.training import train as train_config
+
+    if not isinstance(config, Config):
+        config = load_config(config)
+    return train_config(config, **options)
 
 
 def __getattr__(name: str) -> Any:

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from typer.core import TyperCommand
 
 from cartpole_q.errors import UserError
 
@@ -26,10 +27,52 @@ EXIT_INTERRUPTED = 130
 app = typer.Typer(
     name="cartpole-q",
     help="Tabular Q-learning on Gymnasium's CartPole-v1: train, evaluate, plot.",
-    add_completion=False,
     no_args_is_help=True,
     pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
 )
+
+
+class _Command(TyperCommand):
+    """A command whose usage line reads like the README: ``eval [OPTIONS] RUN_DIR``.
+
+    Typer writes required arguments as ``{run_dir}``; this writes each argument's metavar
+    as given (``[RUN_DIR]`` when optional, ``RUN_DIR...`` when repeatable).
+    """
+
+    def collect_usage_pieces(self, ctx: Any) -> list[str]:
+        """The usage line after the command's name."""
+        pieces = [self.options_metavar] if self.options_metavar else []
+        for param in self.get_params(ctx):
+            if param.param_type_name != "argument":
+                continue
+            name = param.metavar or (param.name or "").upper()
+            name = f"{name}..." if param.nargs != 1 else name
+            pieces.append(name if param.required else f"[{name}]")
+        return pieces
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from cartpole_q import __version__
+
+        typer.echo(f"cartpole-q {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            callback=_print_version,
+            is_eager=True,
+            help="Print the version and exit.",
+        ),
+    ] = False,
+) -> None:
+    """Tabular Q-learning on Gymnasium's CartPole-v1: train, evaluate, plot."""
 
 
 class EngineChoice(StrEnum):
@@ -42,26 +85,59 @@ class EngineChoice(StrEnum):
 
 @contextmanager
 def _exit_codes() -> Iterator[None]:
-    """Turn bad input into exit code 2 and an interruption into 130, without tracebacks."""
+    """Turn bad input into exit code 2 and an interruption into 130, without tracebacks.
+
+    SIGTERM interrupts like Ctrl-C (a command may handle both itself inside, as ``train``
+    does to stop cleanly); once interrupted, further signals are ignored while it exits.
+    """
+    import signal
+    import threading
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    main = threading.current_thread() is threading.main_thread()
+    previous = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    if main:
+        signal.signal(signal.SIGTERM, interrupt)
     try:
         yield
     except UserError as error:
         typer.echo(f"error: {error}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except KeyboardInterrupt:
+        if main:
+            for signum in previous:
+                signal.signal(signum, signal.SIG_IGN)
         typer.echo("interrupted", err=True)
         raise typer.Exit(EXIT_INTERRUPTED) from None
+    finally:
+        if main:
+            for signum, handler in previous.items():
+                if handler is not None:  # None: installed outside Python, cannot be restored
+                    signal.signal(signum, handler)
 
 
-@app.command()
+@app.command(cls=_Command)
 def train(
     config: Annotated[
         Path | None,
         typer.Option(
             "--config",
             "-c",
-            help="YAML config. Keys it leaves out take the embedded default's values.",
+            metavar="PATH|NAME",
+            help="YAML config file, or a shipped config's name (see `cartpole-q configs`). "
+            "Keys it leaves out take the embedded default's values.",
             show_default="the embedded default",
+        ),
+    ] = None,
+    set_values: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--set",
+            metavar="KEY=VALUE",
+            help="Set any config key by its dotted path, the value read as YAML, e.g. "
+            "--set agent.alpha=5e-4 --set discretization.bins=[1,1,6,12]. Repeatable.",
         ),
     ] = None,
     seed: Annotated[int | None, typer.Option(min=0, help="Run seed (overrides `seed`).")] = None,
@@ -72,7 +148,12 @@ def train(
         ),
     ] = None,
     episodes: Annotated[
-        int | None, typer.Option(min=1, help="Training episodes (overrides `train.episodes`).")
+        int | None,
+        typer.Option(
+            min=1,
+            help="Training episodes (overrides `train.episodes`); with --resume, extend the "
+            "run to N episodes in all.",
+        ),
     ] = None,
     engine: Annotated[
         EngineChoice | None, typer.Option(help="Training engine (overrides `engine`).")
@@ -86,7 +167,10 @@ def train(
     ] = None,
     resume: Annotated[
         Path | None,
-        typer.Option(help="Continue an interrupted run directory to its configured episodes."),
+        typer.Option(
+            help="Continue an interrupted run directory to its configured episodes, or "
+            "extend a run that reached them (with --episodes N, or a raised train.episodes)."
+        ),
     ] = None,
     workers: Annotated[
         int | None,
@@ -101,25 +185,25 @@ def train(
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with _exit_codes():
         from cartpole_q import runner
-        from cartpole_q.config import load_config
+        from cartpole_q.config import load_config, parse_assignment, resolve_config_path
 
         if resume is not None:
             given = {
-                "--config": config, "--seed": seed, "--seeds": seeds,
-                "--episodes": episodes, "--engine": engine, "--out": out,
+                "--config": config, "--set": set_values, "--seed": seed, "--seeds": seeds,
+                "--engine": engine, "--out": out,
             }  # fmt: skip
             clashing = [name for name, value in given.items() if value is not None]
             if clashing:
                 raise UserError(
                     f"--resume continues a run exactly as it was configured, so it cannot be "
-                    f"combined with {', '.join(clashing)}."
+                    f"combined with {', '.join(clashing)} (only --episodes, to extend it)."
                 )
-            prepared = runner.prepare_resume(resume)
+            prepared = runner.prepare_resume(resume, episodes)
             run_dir = resume
         else:
             if seed is not None and seeds is not None:
                 raise UserError("give either --seed (one run) or --seeds (several), not both.")
-            overrides: dict[str, Any] = {}
+            overrides: dict[str, Any] = dict(map(parse_assignment, set_values or []))
             if seed is not None:
                 overrides.update({"seed": seed, "train.seeds": None})
             if seeds is not None:
@@ -129,7 +213,8 @@ def train(
             if engine is not None:
                 overrides["engine"] = engine.value
             loaded = load_config(config, overrides)
-            prepared = runner.prepare(loaded, str(config) if config else "default config")
+            source = str(resolve_config_path(config)) if config else "default config"
+            prepared = runner.prepare(loaded, source)
             run_dir = runner.start_run(prepared, out)
         _train_into(run_dir, prepared, resume is not None, workers, quiet)
 
@@ -143,6 +228,8 @@ def _train_into(
 
     seeds = prepared.config.train.seeds
     reporter = make_reporter(quiet)
+    resume_hint = f"resume with `cartpole-q train --resume {run_dir}`"
+    stopped_at_once = False
     with runner.StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
         try:
             if seeds is None:
@@ -157,8 +244,13 @@ def _train_into(
                     prepared, run_dir, workers=workers or default_workers(len(seeds)),
                     reporter=reporter, should_stop=stop.is_set, resume=resume,
                 )  # fmt: skip
+        except KeyboardInterrupt:
+            stopped_at_once = True  # a second signal: workers killed, checkpoints kept
         finally:
             reporter.close()
+    if stopped_at_once:
+        typer.echo(f"interrupted at once: {resume_hint}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED)
     if not quiet:
         if seeds is None:
             print_single_summary(run_dir, summary)
@@ -166,11 +258,22 @@ def _train_into(
             print_multi_summary(run_dir, summary)
     typer.echo(str(run_dir))
     if summary.get("interrupted"):
-        typer.echo(f"interrupted: resume with `cartpole-q train --resume {run_dir}`", err=True)
+        typer.echo(f"interrupted: {resume_hint}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
 
 
-@app.command("eval")
+@app.command("configs", cls=_Command)
+def configs_command() -> None:
+    """List the shipped example configs: `train -c NAME` takes one by its name."""
+    from cartpole_q.config import shipped_configs
+
+    shipped = shipped_configs()
+    width = max(map(len, shipped))
+    for name, description in shipped.items():
+        typer.echo(f"{name:<{width}}  {description}")
+
+
+@app.command("eval", cls=_Command)
 def eval_command(
     run_dir: Annotated[
         Path, typer.Argument(help="A run directory, or the parent of a multi-seed run.")
@@ -189,11 +292,18 @@ def eval_command(
     ] = False,
     video: Annotated[
         Path | None,
-        typer.Option(help="Record the first episodes as an animated GIF (see --video-episodes)."),
+        typer.Option(
+            metavar="FILE",
+            help="Record the first episodes (see --video-episodes) as FILE.gif, or FILE.mp4 "
+            "with imageio-ffmpeg installed; checked before any episode is played.",
+        ),
     ] = None,
     video_episodes: Annotated[
         int, typer.Option(min=1, help="How many of the episodes --video records.")
     ] = 1,
+    force: Annotated[
+        bool, typer.Option("--force", help="Let --video replace an existing file.")
+    ] = False,
     render: Annotated[
         bool,
         typer.Option("--render", help="Show the episodes in Gymnasium's window (needs a display)."),
@@ -222,14 +332,15 @@ def eval_command(
         if render and video is not None:
             raise UserError("--render and --video cannot be combined: choose one.")
         if render:
-            from cartpole_q.environment import has_display
+            from cartpole_q.environment import display_problem
 
-            if not has_display():
+            problem = display_problem()
+            if problem is not None:
                 raise UserError(
-                    "--render needs a display, but neither DISPLAY nor WAYLAND_DISPLAY is set; "
+                    f"--render needs a display, but {problem}; "
                     "record the episodes with --video FILE.gif instead."
                 )
-        report = _evaluate_run(run, episodes, seed, video, video_episodes, render)
+        report = _evaluate_run(run, episodes, seed, video, video_episodes, render, force)
         if json_output:
             typer.echo(json.dumps(report.to_dict()))
         else:
@@ -245,6 +356,7 @@ def _evaluate_run(
     video: Path | None,
     video_episodes: int,
     render: bool,
+    force: bool = False,
 ) -> Any:
     from cartpole_q.evaluation import evaluate
 
@@ -253,14 +365,16 @@ def _evaluate_run(
             run.q_table, run.config, episodes=episodes, seed=seed,
             render_mode="human" if render else None,
         )  # fmt: skip
-    from cartpole_q.video import GifRecorder
+    from cartpole_q.video import VideoRecorder, offscreen_rendering
 
-    recorder = GifRecorder(video, episodes=video_episodes)
-    report = evaluate(
-        run.q_table, run.config, episodes=episodes, seed=seed,
-        render_mode="rgb_array", on_frame=recorder.on_frame,
-    )  # fmt: skip
-    recorder.save()
+    # The recorder checks the file (extension, directory, an existing file) before playing.
+    with VideoRecorder(video, episodes=video_episodes, force=force) as recorder:
+        with offscreen_rendering():
+            report = evaluate(
+                run.q_table, run.config, episodes=episodes, seed=seed,
+                render_mode="rgb_array", on_frame=recorder.on_frame,
+            )  # fmt: skip
+        recorder.save()
     return report
 
 
@@ -271,10 +385,15 @@ def _eval_seeds(
     from cartpole_q.report import eval_seeds_text
 
     result = evaluate_seeds(parent, episodes=episodes, seed=seed, workers=workers)
-    typer.echo(json.dumps(result) if json_output else eval_seeds_text(parent, result))
+    if json_output:
+        typer.echo(json.dumps(result))
+        if result["note"]:
+            typer.echo(f"warning: {result['note']}", err=True)
+    else:
+        typer.echo(eval_seeds_text(parent, result))
 
 
-@app.command()
+@app.command(cls=_Command)
 def plot(
     run_dirs: Annotated[
         list[Path], typer.Argument(help="Run directories (single or multi-seed) to draw together.")
@@ -282,10 +401,13 @@ def plot(
     out: Annotated[
         Path | None,
         typer.Option(
-            help="PNG file to write.",
-            show_default="reward_curves.png, or policy_map.png with --policy",
+            metavar="FILE",
+            help="The figure to write: .png, .svg or .pdf, as its extension says.",
+            show_default="RUN_DIR/reward_curves.png, or RUN_DIR/policy_map.png with --policy; "
+            "with several run directories, reward_curves.png in the current directory",
         ),
     ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace the file if it exists.")] = False,
     policy: Annotated[
         bool,
         typer.Option(
@@ -301,18 +423,21 @@ def plot(
         ),
     ] = None,
 ) -> None:
-    """Draw reward curves (or, with --policy, a policy map) as a PNG; print its path."""
+    """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with _exit_codes():
         from cartpole_q.plotting import plot_policy, plot_rewards
 
         if policy:
             if len(run_dirs) != 1:
                 raise UserError("--policy draws one run: give exactly one run directory.")
-            path = plot_policy(run_dirs[0], out or Path("policy_map.png"), dims)
+            path = plot_policy(run_dirs[0], out or run_dirs[0] / "policy_map.png", dims, force)
         else:
             if dims is not None:
                 raise UserError("--dims only applies to --policy.")
-            path = plot_rewards(run_dirs, out or Path("reward_curves.png"))
+            default = Path("reward_curves.png")
+            if len(run_dirs) == 1:
+                default = run_dirs[0] / default
+            path = plot_rewards(run_dirs, out or default, force)
         typer.echo(str(path))
 
 

@@ -20,6 +20,7 @@ import copy
 import dataclasses
 import difflib
 import math
+import os
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -231,15 +232,32 @@ _SCHEDULE_KEYS = {
 }
 
 
+ConfigSource = str | os.PathLike[str] | Mapping[str, Any]
+"""What :func:`load_config` reads: a YAML file, a shipped config's name, or a mapping."""
+
+
 def load_config(
-    path: str | Path | None = None, overrides: Mapping[str, Any] | None = None
+    path: ConfigSource | None = None, overrides: Mapping[str, Any] | None = None
 ) -> Config:
     """Load, complete and validate a config.
 
+    Overrides merge exactly as a config file does: a section or schedule mapping merges
+    key by key (``{"agent": {"gamma": 0.9}}`` keeps ``agent.alpha``; ``agent.epsilon.k``
+    keeps the schedule's other fields), anything else replaces, and unknown keys are
+    refused with the closest valid key suggested.
+
+    >>> load_config("blog").name
+    'blog'
+    >>> load_config({"agent": {"gamma": 0.9}}, {"agent.epsilon.k": 25}).agent.epsilon
+    Schedule(kind='log', start=1.0, end=0.0, rate=25.0)
+
     Args:
-        path: a YAML file; ``None`` loads the embedded default alone.
-        overrides: dotted keys (``"train.episodes"``) and values that replace the
-            file's, as given on the command line.
+        path: a YAML file, the name of a shipped config (``"blog"``, see
+            :func:`shipped_configs`), or a mapping laid out like a config file; ``None``
+            loads the embedded default alone.
+        overrides: dotted keys (``"train.episodes"``, ``"env.kwargs.max_episode_steps"``)
+            or section names with mappings, and the values that replace the file's, as
+            given on the command line; applied in order.
 
     Returns:
         The validated, frozen config.
@@ -249,22 +267,130 @@ def load_config(
     """
     raw = default_raw()
     source = "default config"
-    if path is not None:
-        source = str(path)
-        user = read_yaml_mapping(Path(path))
-        check_known_keys(user, source)
-        raw = _merge(raw, user)
-    overridden = set()
+    if isinstance(path, Mapping):
+        source = "config mapping"
+        user: Mapping[Any, Any] = path
+    elif path is not None:
+        file = resolve_config_path(path)
+        source = str(path) if file == Path(path) else str(file)
+        user = read_yaml_mapping(file)
+    else:
+        user = {}
+    check_known_keys(user, source)
+    raw = _merge(raw, user)
+    overridden: list[str] = []
     for dotted, value in (overrides or {}).items():
-        section, _, key = dotted.rpartition(".")
-        target = raw[section] if section else raw
-        target[key] = value
-        overridden.add(dotted)
+        nested = _nest(dotted, value)
+        check_known_keys(nested, OVERRIDE_SOURCE)
+        raw = _merge(raw, nested)
+        overridden.extend(_leaf_paths(nested))
     return _Reader(raw, source, overridden).config()
 
 
+OVERRIDE_SOURCE = "command line"
+"""how errors name the source of an override (``--set``, ``--seed`` and the like)"""
+
+
+def _nest(dotted: Any, value: Any) -> dict[str, Any]:
+    """Turn ``("agent.epsilon.k", 5)`` into ``{"agent": {"epsilon": {"k": 5}}}``."""
+    parts = dotted.split(".") if isinstance(dotted, str) else []
+    if not parts or not all(parts):
+        raise ConfigError(
+            f"{OVERRIDE_SOURCE}: {_shown(dotted)} is not a config key; give a dotted path "
+            "such as 'agent.alpha' or 'env.kwargs.max_episode_steps'."
+        )
+    nested: dict[str, Any] = {parts[-1]: copy.deepcopy(value)}
+    for part in reversed(parts[:-1]):
+        nested = {part: nested}
+    return nested
+
+
+def _leaf_paths(data: Mapping[Any, Any], prefix: str = "") -> list[str]:
+    paths: list[str] = []
+    for key, value in data.items():
+        path = f"{prefix}{key}"
+        if isinstance(value, Mapping) and value:
+            paths.extend(_leaf_paths(value, f"{path}."))
+        else:
+            paths.append(path)
+    return paths
+
+
+def parse_assignment(text: str) -> tuple[str, Any]:
+    """Parse one ``--set KEY=VALUE``: the value is read as YAML (``5e-4``, ``[1, 2]``, ``true``).
+
+    >>> parse_assignment("discretization.bins=[1, 1, 6, 12]")
+    ('discretization.bins', [1, 1, 6, 12])
+
+    Raises:
+        ConfigError: there is no ``=``, the key is empty, or the value is not plain YAML.
+    """
+    key, equals, value = text.partition("=")
+    key = key.strip()
+    if not equals or not key:
+        raise ConfigError(
+            f"--set {text!r}: expected KEY=VALUE with a dotted config key, e.g. "
+            "--set agent.alpha=5e-4 or --set discretization.bins=[1,1,6,12]."
+        )
+    try:
+        parsed = yaml.load(value, Loader=_UniqueKeyLoader) if value.strip() else None
+    except yaml.YAMLError as error:
+        problem = getattr(error, "problem", None) or "invalid syntax"
+        raise ConfigError(
+            f"--set {text!r}: the value is not plain YAML ({problem}); quote strings that "
+            "contain ':', '#', '[' or '{'."
+        ) from None
+    return key, parsed
+
+
+def shipped_configs() -> dict[str, str]:
+    """The example configs shipped with the package: name -> one-line description.
+
+    >>> sorted(shipped_configs())
+    ['blog', 'default', 'sutton_barto']
+    """
+    found: dict[str, str] = {}
+    for entry in sorted(_configs_dir().iterdir(), key=lambda item: item.name):
+        if entry.name.endswith(".yaml"):
+            text = entry.read_text(encoding="utf-8")
+            found[entry.name.removesuffix(".yaml")] = _description(text)
+    return found
+
+
+def _configs_dir() -> Any:
+    return resources.files("cartpole_q").joinpath("configs")
+
+
+def _description(text: str) -> str:
+    """The first comment line of a config file, without its ``#``."""
+    for line in text.splitlines():
+        stripped = line.strip()
+        if stripped.startswith("#"):
+            return stripped.lstrip("#").strip()
+        if stripped:
+            break
+    return ""
+
+
+def resolve_config_path(value: str | os.PathLike[str]) -> Path:
+    """The file ``--config VALUE`` means: an existing file, else a shipped config's name.
+
+    A value that names neither is returned as given, so that reading it reports
+    "config file not found" with the shipped names.
+    """
+    path = Path(value)
+    text = os.fspath(value)
+    if path.is_file() or "/" in text or os.sep in text or path.suffix:
+        return path
+    shipped = _configs_dir().joinpath(f"{text}.yaml")
+    return Path(str(shipped)) if shipped.is_file() else path
+
+
 def default_yaml_text() -> str:
-    """Return the embedded default config file's text."""
+    """Return the embedded default config file's text (``cartpole_q/default.yaml``).
+
+    ``configs/default.yaml`` (among the shipped configs) is a link to the same file.
+    """
     return resources.files("cartpole_q").joinpath("default.yaml").read_text(encoding="utf-8")
 
 
@@ -303,14 +429,20 @@ _UniqueKeyLoader.add_constructor(
 def read_yaml_mapping(path: Path) -> dict[str, Any]:
     """Read a YAML file that must hold a mapping, with the safe loader only.
 
+    An empty file (or one with only comments) is the empty mapping.
+
     Raises:
-        ConfigError: the file is missing, unreadable, not YAML, empty, not a mapping, or
-            uses a tag that would construct a Python object.
+        ConfigError: the file is missing, unreadable, not YAML, not a mapping, or uses a
+            tag that would construct a Python object.
     """
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
-        raise ConfigError(f"{path}: config file not found.") from None
+        names = ", ".join(shipped_configs())
+        raise ConfigError(
+            f"{path}: config file not found; give a YAML file or the name of a shipped "
+            f"config ({names}; see `cartpole-q configs`)."
+        ) from None
     except IsADirectoryError:
         raise ConfigError(f"{path}: is a directory, not a config file.") from None
     except UnicodeDecodeError:
@@ -335,7 +467,7 @@ def read_yaml_mapping(path: Path) -> dict[str, Any]:
         problem = getattr(error, "problem", None) or "invalid syntax"
         raise ConfigError(f"{path}: is not valid YAML: {problem}{_yaml_mark(mark)}.") from None
     if data is None:
-        raise ConfigError(f"{path}: is empty; a config must be a mapping such as 'seed: 0'.")
+        return {}  # an empty file (or only comments) changes nothing: all defaults
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: must be a mapping of keys to values, not a {_type_name(data)}.")
     return data
@@ -356,7 +488,7 @@ def check_known_keys(user: Mapping[Any, Any], source: str) -> None:
         if section not in user or user[section] is None:
             continue
         value = user[section]
-        if not isinstance(value, dict):
+        if not isinstance(value, Mapping):
             raise ConfigError(
                 f"{source}: {section}: must be a mapping of keys to values, "
                 f"not a {_type_name(value)}."
@@ -381,30 +513,58 @@ def _unknown_key(key: Any, valid: list[str], prefix: str) -> str:
     return f"unknown key '{prefix}{key}'{hint}"
 
 
-def _merge(base: dict[str, Any], user: Mapping[str, Any]) -> dict[str, Any]:
-    """Overlay the user's keys on the default; sections merge key by key, values replace."""
-    merged = copy.deepcopy(base)
+_SCHEDULE_PATHS = (("agent", "alpha"), ("agent", "epsilon"))
+
+
+def _merge(
+    base: Mapping[Any, Any], user: Mapping[Any, Any], path: tuple[Any, ...] = ()
+) -> dict[Any, Any]:
+    """Overlay ``user`` on ``base``: mappings merge key by key, other values replace.
+
+    A section left empty (``agent:``) changes nothing. A schedule mapping merges into
+    the base schedule when it keeps its ``type`` (or gives none), and replaces it when
+    it names another type; a number replaces a schedule and vice versa.
+    """
+    merged = copy.deepcopy(dict(base))
     for key, value in user.items():
-        if key in _SECTIONS and value is None:
+        here = (*path, key)
+        old = merged.get(key)
+        if not path and key in _SECTIONS and value is None:
             continue
-        if key in _SECTIONS:
-            merged[key].update(copy.deepcopy(value))
+        if isinstance(value, Mapping) and isinstance(old, Mapping) and _merges(here, old, value):
+            merged[key] = _merge(old, value, here)
         else:
             merged[key] = copy.deepcopy(value)
     return merged
 
 
+def _merges(path: tuple[Any, ...], old: Mapping[Any, Any], new: Mapping[Any, Any]) -> bool:
+    if path in _SCHEDULE_PATHS:
+        return "type" not in new or new["type"] == old.get("type")
+    return True
+
+
 class _Reader:
     """Typed, range-checked access to the merged raw mapping, with precise error messages."""
 
-    def __init__(self, raw: dict[str, Any], source: str, overridden: set[str]) -> None:
+    def __init__(self, raw: dict[str, Any], source: str, overridden: list[str]) -> None:
         self._raw = raw
         self._source = source
         self._overridden = overridden
 
+    def source_of(self, field: str) -> str:
+        """The command line if an override set ``field`` (or a part of it), else the file."""
+        for path in self._overridden:
+            if (
+                path == field
+                or field.startswith((f"{path}.", f"{path}["))
+                or path.startswith(f"{field}.")
+            ):
+                return OVERRIDE_SOURCE
+        return self._source
+
     def error(self, field: str, problem: str) -> ConfigError:
-        source = "command line" if field in self._overridden else self._source
-        return ConfigError(f"{source}: {field}: {problem}")
+        return ConfigError(f"{self.source_of(field)}: {field}: {problem}")
 
     def _value(self, field: str) -> Any:
         section, _, key = field.rpartition(".")
@@ -496,6 +656,12 @@ class _Reader:
             constant = self.number(field, value, **bounded)  # type: ignore[arg-type]
             return Schedule("constant", constant, constant)
         kind = value.get("type")
+        if kind is None:
+            raise self.error(
+                field,
+                f"a schedule mapping needs 'type' ({', '.join(SCHEDULE_KINDS)}), got "
+                f"{_shown(value)}; a number is a constant.",
+            )
         if kind not in SCHEDULE_KINDS:
             raise self.error(
                 f"{field}.type",
@@ -504,8 +670,9 @@ class _Reader:
         keys = _SCHEDULE_KEYS[kind]
         for key in value:
             if key not in keys:
-                source = "command line" if field in self._overridden else self._source
-                raise ConfigError(f"{source}: {_unknown_key(key, list(keys), f'{field}.')}")
+                raise ConfigError(
+                    f"{self.source_of(field)}: {_unknown_key(key, list(keys), f'{field}.')}"
+                )
         for key in _SCHEDULE_REQUIRED[kind]:
             if key not in value:
                 raise self.error(field, f"a {kind} schedule needs '{key}'.")
@@ -613,6 +780,35 @@ class _Reader:
                     f"entry {d} ({lo}) must be below discretization.high entry {d} ({hi}).",
                 )
         return DiscretizationConfig(bins=bins, low=low, high=high)
+
+
+def config_differences(old: Config, new: Config) -> list[tuple[str, Any, Any]]:
+    """The dotted keys whose values differ between two configs, in file order.
+
+    A key present in only one of them (inside ``env.kwargs``) has the value
+    :data:`NOT_SET` in the other.
+
+    >>> config_differences(load_config(), load_config(overrides={"agent.gamma": 0.9}))
+    [('agent.gamma', 0.995, 0.9)]
+    """
+    return _differences(old.to_dict(), new.to_dict(), "")
+
+
+NOT_SET = "(not set)"
+"""stands for a key that one of two compared configs does not have"""
+
+
+def _differences(old: Any, new: Any, prefix: str) -> list[tuple[str, Any, Any]]:
+    if isinstance(old, dict) and isinstance(new, dict):
+        found: list[tuple[str, Any, Any]] = []
+        for key in dict.fromkeys([*old, *new]):
+            found.extend(
+                _differences(old.get(key, NOT_SET), new.get(key, NOT_SET), f"{prefix}{key}.")
+            )
+        return found
+    if old == new and type(old) is type(new):
+        return []
+    return [(prefix.removesuffix("."), old, new)]
 
 
 def parse_seeds(value: Any) -> tuple[int, ...]:

@@ -36,17 +36,30 @@ class EnvInfo:
     """the time limit after which an episode is truncated"""
 
 
-def make_env(env: EnvConfig, render_mode: str | None = None) -> Any:
-    """Return ``gymnasium.make(env.id, **env.kwargs)``, optionally with a render mode."""
+def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "config") -> Any:
+    """Return ``gymnasium.make(env.id, **env.kwargs)``, optionally with a render mode.
+
+    Raises:
+        ConfigError: ``env.id`` is ``"module:Env-v0"`` and the module (or something it
+            imports) cannot be imported.
+    """
     import gymnasium
 
     kwargs = dict(env.kwargs)
     if render_mode is not None:
         kwargs["render_mode"] = render_mode
-    with warnings.catch_warnings():
-        # Gymnasium warns about out-of-date versions such as CartPole-v0; the user chose it.
-        warnings.simplefilter("ignore", category=DeprecationWarning)
-        return gymnasium.make(env.id, **kwargs)
+    try:
+        with warnings.catch_warnings():
+            # Gymnasium warns about out-of-date versions such as CartPole-v0; the user chose it.
+            warnings.simplefilter("ignore", category=DeprecationWarning)
+            return gymnasium.make(env.id, **kwargs)
+    except ImportError as error:
+        module = env.id.partition(":")[0] if ":" in env.id else (error.name or "a module")
+        detail = str(error).split(". ")[0]
+        raise ConfigError(
+            f"{source}: env.id: cannot make {env.id!r}: the module {module!r} cannot be "
+            f"imported ({detail}); install it, or check the part of env.id before ':'."
+        ) from None
 
 
 def inspect_env(config: Config, source: str = "config") -> EnvInfo:
@@ -64,10 +77,11 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
     """
     import gymnasium
     from gymnasium import spaces
+    from gymnasium.envs.classic_control import CartPoleEnv
 
     env_id = config.env.id
     try:
-        env = make_env(config.env)
+        env = make_env(config.env, source=source)
     except gymnasium.error.DependencyNotInstalled as error:
         raise ConfigError(
             f"{source}: env.id: {env_id!r} needs a package that is not installed ({error})."
@@ -80,6 +94,7 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
         ) from None
     try:
         observation_space, action_space, spec = env.observation_space, env.action_space, env.spec
+        is_cartpole = isinstance(env.unwrapped, CartPoleEnv)
     finally:
         env.close()
     if not isinstance(action_space, spaces.Discrete) or int(action_space.start) != 0:
@@ -109,10 +124,10 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
             f"states x {n_actions} actions = {_size(table_bytes)}, above the limit of "
             f"{_size(limit)} (agent.max_q_table_bytes); use fewer bins or raise the limit."
         )
+    max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
     threshold = config.train.reward_threshold
     if threshold is None and spec is not None and spec.reward_threshold is not None:
-        threshold = float(spec.reward_threshold)
-    max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
+        threshold = _default_threshold(env_id, float(spec.reward_threshold), max_steps, is_cartpole)
     return EnvInfo(
         id=env_id,
         observation_dim=observation_dim,
@@ -122,19 +137,117 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
     )
 
 
+def _default_threshold(
+    env_id: str, registered_threshold: float, max_steps: Any, is_cartpole: bool
+) -> float:
+    """The solve threshold when the config gives none: the environment's registered one.
+
+    CartPole's scales with a changed time limit: ``threshold * max_episode_steps /
+    registered max_episode_steps`` (475 of 500 steps becomes 950 of 1000).
+    """
+    import gymnasium
+
+    if not is_cartpole or not isinstance(max_steps, int) or isinstance(max_steps, bool):
+        return registered_threshold
+    registered_steps = gymnasium.spec(env_id).max_episode_steps
+    if not registered_steps or max_steps <= 0 or max_steps == registered_steps:
+        return registered_threshold
+    return registered_threshold * max_steps / registered_steps
+
+
 def q_table_bytes(bins: tuple[int, ...], n_actions: int) -> int:
     """Bytes of a float64 Q-table of shape ``(*bins, n_actions)``."""
     return math.prod(bins) * n_actions * 8
 
 
 def has_display() -> bool:
-    """Whether a window can be opened: on Linux and BSD, an X11 or Wayland display is set.
+    """Whether a window can be opened here (see :func:`display_problem`)."""
+    return display_problem() is None
 
-    macOS and Windows open windows without these variables.
+
+def display_problem(timeout: float = 2.0) -> str | None:
+    """Why Gymnasium's window cannot be shown here, or ``None`` when it can.
+
+    On Linux and BSD, an X11 or Wayland display must be set *and* answer: its socket is
+    connected to (``/tmp/.X11-unix/X<n>`` for ``DISPLAY=:n``, TCP port ``6000+n`` on a
+    host, ``$XDG_RUNTIME_DIR/$WAYLAND_DISPLAY``), because pygame otherwise falls back to
+    its offscreen driver and shows nothing. ``SDL_VIDEODRIVER=dummy`` (or ``offscreen``)
+    draws nowhere either. macOS and Windows open windows without these variables.
     """
     if sys.platform == "darwin" or sys.platform.startswith("win"):
-        return True
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+        return None
+    x11, wayland = os.environ.get("DISPLAY"), os.environ.get("WAYLAND_DISPLAY")
+    if not x11 and not wayland:
+        return "neither DISPLAY nor WAYLAND_DISPLAY is set"
+    problems = []
+    if wayland:
+        problem = _wayland_problem(wayland)
+        if problem is None:
+            return _driver_problem()
+        problems.append(problem)
+    if x11:
+        problem = _x11_problem(x11, timeout)
+        if problem is None:
+            return _driver_problem()
+        problems.append(problem)
+    return "; ".join(problems)
+
+
+def _driver_problem() -> str | None:
+    drivers = {d.strip().lower() for d in os.environ.get("SDL_VIDEODRIVER", "").split(",")}
+    if drivers and drivers <= {"dummy", "offscreen"}:
+        return (
+            f"SDL_VIDEODRIVER={os.environ['SDL_VIDEODRIVER']} is set, which makes pygame draw "
+            "the window nowhere; unset it"
+        )
+    return None
+
+
+def _x11_problem(display: str, timeout: float) -> str | None:
+    """Connect to the X server of ``display`` (``[host]:number[.screen]``)."""
+    import socket
+
+    host, _, rest = display.rpartition(":")
+    number = rest.split(".")[0]
+    if not number.isdigit():
+        return f"DISPLAY={display} is not an X display name such as :0"
+    if host in ("", "unix") or host.startswith("/"):
+        path = host if host.startswith("/") else f"/tmp/.X11-unix/X{number}"
+        candidates = [path]
+        if sys.platform.startswith("linux"):
+            candidates.append("\0" + path)  # the abstract socket Xorg also listens on
+        for candidate in candidates:
+            with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
+                connection.settimeout(timeout)
+                try:
+                    connection.connect(candidate)
+                except OSError:
+                    continue
+                return None
+        return f"DISPLAY={display} cannot be reached (no X server listens on {path})"
+    port = 6000 + int(number)
+    try:
+        socket.create_connection((host.strip("[]"), port), timeout=timeout).close()
+    except OSError as error:
+        reason = error.strerror or str(error) or type(error).__name__
+        return f"DISPLAY={display} cannot be reached (no X server at {host}, port {port}: {reason})"
+    return None
+
+
+def _wayland_problem(name: str) -> str | None:
+    """Connect to the Wayland compositor's socket."""
+    import socket
+
+    runtime = os.environ.get("XDG_RUNTIME_DIR")
+    if not os.path.isabs(name) and not runtime:
+        return f"WAYLAND_DISPLAY={name} is set but XDG_RUNTIME_DIR, where its socket is, is not"
+    path = name if os.path.isabs(name) else os.path.join(runtime or "", name)
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
+        try:
+            connection.connect(path)
+        except OSError:
+            return f"WAYLAND_DISPLAY={name} cannot be reached (nothing listens on {path})"
+    return None
 
 
 def _size(n_bytes: int) -> str:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import Config
+from cartpole_q.config import MAX_EPISODES, Config, ConfigError
 from cartpole_q.discretize import state_index
 from cartpole_q.engines.base import AgentParams
 
@@ -123,15 +123,20 @@ def evaluate(
         on_frame: called after every reset and step.
 
     Raises:
+        ConfigError: ``episodes`` is not between 1 and ``MAX_EPISODES``.
         cartpole_q.rundir.RunError: the table does not fit the config and environment.
     """
     from cartpole_q.environment import inspect_env, make_env
     from cartpole_q.rundir import check_q_table
 
+    episodes = config.eval.episodes if episodes is None else episodes
+    if not 1 <= episodes <= MAX_EPISODES:
+        raise ConfigError(
+            f"--episodes: must be between 1 and {MAX_EPISODES:,} greedy episodes, got {episodes:,}."
+        )
     env_info = inspect_env(config)
     check_q_table(q_table, config.discretization.bins, env_info.n_actions, "the Q-table")
     params = AgentParams.from_config(config, env_info)
-    episodes = config.eval.episodes if episodes is None else episodes
     seed = config.eval.seed if seed is None else seed
     env = make_env(config.env, render_mode=render_mode)
     try:

@@ -12,11 +12,17 @@ import dataclasses
 import json
 import multiprocessing
 import os
-import queue as queue_module
+import pickle
 import signal
+import sys
+import threading
 import time
-from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+import traceback
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager, suppress
+from multiprocessing.connection import Connection
+from multiprocessing.connection import wait as wait_connections
+from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import Any
 
@@ -24,12 +30,10 @@ import numpy as np
 
 from cartpole_q import rundir
 from cartpole_q.config import format_seeds, load_config
+from cartpole_q.errors import UserError
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.runner import Prepared, execute_run, prepare
 from cartpole_q.training import Progress
-
-_worker_stop: Any = None
-_worker_queue: Any = None
 
 
 def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
@@ -98,109 +102,328 @@ def run_seeds(
             )  # fmt: skip
             interrupted = interrupted or outcome.result.interrupted
     else:
-        interrupted = _run_pool(jobs, workers, reporter, should_stop)
+        results = run_in_workers(
+            _train_seed, [(str(child), seed, child_resume) for seed, child, child_resume in jobs],
+            workers, reporter=reporter, should_stop=should_stop,
+        )  # fmt: skip
+        interrupted = any(result is not False for result in results)
 
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
     rundir.write_json(parent / rundir.SUMMARY_FILE, summary)
     return summary
 
 
-def _run_pool(
-    jobs: list[tuple[int, Path, bool]],
+# -- worker processes: one helper for training and evaluating seeds ---------------------
+#
+# Workers ignore SIGINT and SIGTERM from their first instruction on (the parent blocks both
+# while it spawns them, the child inherits the mask, sets them to SIG_IGN and only then
+# unblocks them), so a signal to the whole process group reaches the parent alone, and the
+# parent decides. Each worker talks to the parent through its own pipe: no queue, no feeder
+# thread, no lock, nothing an exit handler could wait on. A worker whose parent dies is
+# killed by the kernel on Linux (PR_SET_PDEATHSIG); elsewhere it stops when its pipe closes.
+
+NOT_STARTED: Any = object()
+"""The result of a job that never started because a stop was requested first."""
+
+_STOP = "stop"
+_JOIN_SECONDS = 5.0
+_worker_conn: Connection | None = None
+_worker_stopped = False
+
+
+class WorkerError(RuntimeError):
+    """A worker process failed in a way that cannot be passed on as its own exception."""
+
+
+def run_in_workers(
+    function: Callable[..., Any],
+    jobs: Sequence[tuple[Any, ...]],
     workers: int,
+    *,
+    reporter: Reporter | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> list[Any]:
+    """Call ``function(*job)`` for every job in spawned worker processes.
+
+    Args:
+        function: a module-level function; it may poll :func:`worker_should_stop` and
+            report progress through :func:`worker_reporter`.
+        jobs: the argument tuples, started in this order.
+        workers: at most this many processes (never more than there are jobs).
+        reporter: receives the workers' progress.
+        should_stop: polled about ten times a second; once true, no job starts any more
+            and the running ones are asked to stop (their results are still awaited).
+
+    Returns:
+        The results in job order; :data:`NOT_STARTED` for the jobs a stop left out.
+
+    Raises:
+        KeyboardInterrupt: raised here (by a signal handler) while waiting: every worker
+            is killed at once, then it propagates. A worker's exception propagates the
+            same way after the other workers are killed.
+    """
+    reporter = reporter or NullReporter()
+    results: list[Any] = [NOT_STARTED] * len(jobs)
+    if not jobs:
+        return results
+    context = multiprocessing.get_context("spawn")
+    if os.name == "posix":
+        # Started lazily by the first worker, multiprocessing's resource tracker unblocks
+        # SIGINT and SIGTERM once it runs; start it first so the block below holds.
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+    processes: list[BaseProcess] = []
+    conns: list[Connection] = []
+    try:
+        with _signals_blocked():
+            for number in range(min(workers, len(jobs))):
+                parent_end, child_end = context.Pipe()
+                process = context.Process(
+                    target=_worker_main, args=(child_end, os.getpid()),
+                    name=f"cartpole-q worker {number}", daemon=True,
+                )  # fmt: skip
+                processes.append(process)
+                conns.append(parent_end)
+                process.start()
+                child_end.close()
+        _dispatch(function, jobs, conns, processes, results, reporter, should_stop)
+    except BaseException:
+        _end_workers(processes, conns, kill=True)
+        raise
+    _end_workers(processes, conns, kill=False)
+    return results
+
+
+def _dispatch(
+    function: Callable[..., Any],
+    jobs: Sequence[tuple[Any, ...]],
+    conns: list[Connection],
+    processes: list[BaseProcess],
+    results: list[Any],
     reporter: Reporter,
     should_stop: Callable[[], bool] | None,
-) -> bool:
-    """Run the jobs in spawned worker processes; return whether training was interrupted."""
-    context = multiprocessing.get_context("spawn")
-    stop_event = context.Event()
-    messages = context.Queue()
-    interrupted = False
-    with ProcessPoolExecutor(
-        max_workers=workers, mp_context=context, initializer=_init_worker,
-        initargs=(stop_event, messages),
-    ) as pool:  # fmt: skip
-        pending: set[Future[Any]] = {
-            pool.submit(_train_seed, str(child), seed, child_resume)
-            for seed, child, child_resume in jobs
-        }
+) -> None:
+    """Hand out the jobs to idle workers and collect their messages until none is busy."""
+    idle = list(range(len(conns)))
+    busy: dict[int, int] = {}  # worker -> job
+    next_job = 0
+    stopping = False
+    while True:
+        if not stopping and should_stop is not None and should_stop():
+            stopping = True
+            for worker in busy:
+                _send(conns[worker], _STOP)
+        while idle and not stopping and next_job < len(jobs):
+            worker = idle.pop(0)
+            conns[worker].send(("job", function, jobs[next_job]))
+            busy[worker] = next_job
+            next_job += 1
+        if not busy:
+            return
+        wait_connections([conns[worker] for worker in busy], timeout=0.1)
+        for worker in list(busy):
+            conn = conns[worker]
+            while worker in busy and conn.poll():
+                try:
+                    kind, *payload = conn.recv()
+                except (EOFError, OSError):
+                    processes[worker].join(_JOIN_SECONDS)
+                    raise WorkerError(
+                        f"a worker process ended unexpectedly (exit code "
+                        f"{processes[worker].exitcode}) while it ran {jobs[busy[worker]]!r}."
+                    ) from None
+                if kind == "result":
+                    results[busy.pop(worker)] = payload[0]
+                    idle.append(worker)
+                elif kind == "error":
+                    raise _worker_exception(*payload)
+                elif kind == "start":
+                    reporter.start(*payload)
+                elif kind == "update":
+                    key, *fields = payload
+                    reporter.update(key, Progress(*fields))
+                else:
+                    reporter.finish(*payload)
+
+
+def _send(conn: Connection, message: Any) -> None:
+    with suppress(OSError):  # the other end is gone; reading the pipe says so
+        conn.send(message)
+
+
+def _worker_exception(pickled: bytes | None, text: str) -> BaseException:
+    """The worker's exception as the worker raised it (else a ``WorkerError`` with its text)."""
+    if pickled is not None:
         try:
-            while pending:
-                done, pending = wait(pending, timeout=0.1, return_when=FIRST_COMPLETED)
-                _relay(messages, reporter)
-                for future in done:
-                    interrupted = interrupted or bool(future.result())
-                if should_stop is not None and should_stop() and not stop_event.is_set():
-                    stop_event.set()
-                    for future in pending:
-                        future.cancel()
-                    interrupted = True
-        finally:
-            stop_event.set()
-            for future in pending:
-                future.cancel()
-        _relay(messages, reporter)
-    _relay(messages, reporter)
-    return interrupted
+            error = pickle.loads(pickled)
+        except Exception:  # any failure to rebuild it: fall back to the text
+            error = None
+        if isinstance(error, BaseException):
+            if not isinstance(error, UserError):
+                error.__cause__ = WorkerError(f"in a worker process:\n{text}")
+            return error
+    return WorkerError(f"in a worker process:\n{text}")
 
 
-def _relay(messages: Any, reporter: Reporter) -> None:
-    """Pass the workers' queued progress messages on to the reporter."""
+def _end_workers(processes: list[BaseProcess], conns: list[Connection], *, kill: bool) -> None:
+    """End every worker: politely after a normal end, at once (SIGKILL) otherwise.
+
+    Further SIGINT and SIGTERM are ignored meanwhile (this takes milliseconds), so a third
+    Ctrl-C cannot break the clean-up half-way and leave processes behind.
+    """
+    with _signals_ignored():
+        for process, conn in zip(processes, conns, strict=False):
+            if kill:
+                if process.pid is not None and process.exitcode is None:
+                    process.kill()
+            else:
+                _send(conn, None)
+        deadline = time.monotonic() + _JOIN_SECONDS
+        for process in processes:
+            if process.pid is None:
+                continue  # never started
+            process.join(max(0.0, deadline - time.monotonic()))
+            if process.exitcode is None:
+                process.kill()
+                process.join(_JOIN_SECONDS)
+        for conn in conns:
+            conn.close()
+
+
+@contextmanager
+def _signals_blocked() -> Iterator[None]:
+    """Hold SIGINT and SIGTERM back in this thread; the processes it spawns inherit the mask."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+@contextmanager
+def _signals_ignored() -> Iterator[None]:
+    """Ignore SIGINT and SIGTERM (main thread only; elsewhere handlers cannot change)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {signum: signal.signal(signum, signal.SIG_IGN) for signum in _SIGNALS}
+    try:
+        yield
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
+
+
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+def _worker_main(conn: Connection, parent_pid: int) -> None:
+    """A worker's life: ignore signals, die with the parent, run jobs until told to end."""
+    global _worker_conn, _worker_stopped
+    for signum in _SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)  # also discards one that arrived while blocked
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(_SIGNALS))
+    _die_with_parent(parent_pid)
+    _worker_conn = conn
     while True:
         try:
-            kind, key, *payload = messages.get_nowait()
-        except queue_module.Empty:
+            message = conn.recv()
+        except (EOFError, OSError):
+            return  # the parent is gone
+        if message is None:
             return
-        if kind == "start":
-            reporter.start(key, *payload)
-        elif kind == "update":
-            reporter.update(key, Progress(*payload))
+        if message == _STOP:
+            continue  # the job it was meant for has already ended
+        _, function, args = message
+        _worker_stopped = False
+        try:
+            value = function(*args)
+        except BaseException as error:  # every failure goes to the parent
+            text = traceback.format_exc()
+            try:
+                pickled: bytes | None = pickle.dumps(error)
+            except Exception:  # it cannot travel as itself
+                pickled = None
+            reply: tuple[Any, ...] = ("error", pickled, text)
         else:
-            reporter.finish(key, *payload)
+            reply = ("result", value)
+        try:
+            conn.send(reply)
+        except OSError:
+            return
 
 
-def _init_worker(stop_event: Any, messages: Any) -> None:
-    """Worker set-up: the parent decides when to stop, so Ctrl-C is ignored here."""
-    global _worker_stop, _worker_queue
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _worker_stop, _worker_queue = stop_event, messages
+def _die_with_parent(parent_pid: int) -> None:
+    """On Linux, ask the kernel to SIGKILL this process when its parent dies."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        return
+    if os.getppid() != parent_pid:
+        os._exit(1)  # the parent died before the request took effect
 
 
-class _QueueReporter:
+def worker_should_stop() -> bool:
+    """In a job run by :func:`run_in_workers`: whether the parent asked it to stop."""
+    global _worker_stopped
+    conn = _worker_conn
+    if not _worker_stopped and conn is not None:
+        try:
+            while conn.poll():
+                if conn.recv() in (_STOP, None):
+                    _worker_stopped = True
+        except (EOFError, OSError):
+            _worker_stopped = True  # the parent is gone
+    return _worker_stopped
+
+
+class _PipeReporter:
     """Forwards a worker's progress to the parent process (throttled)."""
 
-    def __init__(self, messages: Any, min_interval: float = 0.2) -> None:
-        self._messages = messages
+    def __init__(self, conn: Connection, min_interval: float = 0.2) -> None:
+        self._conn = conn
         self._min_interval = min_interval
         self._last = 0.0
 
     def start(self, key: Any, label: str, episodes: int) -> None:
-        self._messages.put(("start", key, label, episodes))
+        _send(self._conn, ("start", key, label, episodes))
 
     def update(self, key: Any, progress: Progress) -> None:
         now = time.monotonic()
         if now - self._last >= self._min_interval:
             self._last = now
-            self._messages.put(("update", key, *dataclasses.astuple(progress)))
+            _send(self._conn, ("update", key, *dataclasses.astuple(progress)))
 
     def finish(self, key: Any, line: str) -> None:
-        self._messages.put(("finish", key, line))
+        _send(self._conn, ("finish", key, line))
 
     def close(self) -> None:
         """Nothing to close."""
 
 
+def worker_reporter() -> Reporter | None:
+    """In a job run by :func:`run_in_workers`: a reporter that reaches the parent's."""
+    return None if _worker_conn is None else _PipeReporter(_worker_conn)
+
+
 def _train_seed(child: str, seed: int, resume: bool) -> bool:
-    """Worker task: train one seed into its directory; return whether it was interrupted."""
-    if _worker_stop is not None and _worker_stop.is_set():
+    """Worker job: train one seed into its directory; return whether it was interrupted."""
+    if worker_should_stop():
         return True
     path = Path(child)
     prepared = prepare(load_config(path / rundir.CONFIG_FILE), str(path / rundir.CONFIG_FILE))
     outcome = execute_run(
-        path, prepared, resume=resume,
-        should_stop=None if _worker_stop is None else _worker_stop.is_set,
-        reporter=_QueueReporter(_worker_queue) if _worker_queue is not None else None,
-        key=f"worker {os.getpid()}", label=f"seed {seed}",
+        path, prepared, resume=resume, should_stop=worker_should_stop,
+        reporter=worker_reporter(), key=f"worker {os.getpid()}", label=f"seed {seed}",
     )  # fmt: skip
     return outcome.result.interrupted
 
@@ -228,7 +451,13 @@ def _spread(values: list[float]) -> dict[str, float] | None:
 def aggregate(
     parent: Path, seeds: tuple[int, ...], wall_seconds: float, interrupted: bool
 ) -> dict[str, Any]:
-    """Summarise the seeds' runs: success rate, solve episodes and env steps, eval means."""
+    """Summarise the seeds' runs: success rate, solve episodes and env steps, eval means.
+
+    Every statistic (``success_rate`` included) is over the finished seeds (``finished`` of
+    ``runs``); the others are counted in ``unfinished`` and named in ``interrupted_seeds``
+    (stopped early, listed in ``per_seed`` too) and ``no_result_seeds`` (not started, or
+    killed before writing a result), both in ``--seeds`` syntax.
+    """
     per_seed: dict[str, dict[str, Any]] = {}
     threshold = None
     engine = None
@@ -256,15 +485,20 @@ def aggregate(
     greedy = [
         run["first_greedy_success"]["env_steps"] for run in finished if run["first_greedy_success"]
     ]
+    interrupted_seeds = [seed for seed in seeds if per_seed.get(str(seed), {}).get("interrupted")]
+    no_result = [seed for seed in seeds if str(seed) not in per_seed]
     return {
         "seeds": format_seeds(seeds),
         "runs": len(seeds),
         "finished": len(finished),
+        "unfinished": len(seeds) - len(finished),
+        "interrupted_seeds": format_seeds(interrupted_seeds),
+        "no_result_seeds": format_seeds(no_result),
         "interrupted": interrupted or len(finished) < len(seeds),
         "engine": engine,
         "reward_threshold": threshold,
         "successes": successes,
-        "success_rate": successes / len(seeds),
+        "success_rate": successes / len(finished) if finished else None,
         "solved_runs": len(solved),
         "solved_episode": _spread(solved),
         "env_steps_to_solve": _spread(steps),
@@ -285,7 +519,7 @@ def aggregate(
 
 
 def load_seed_runs(parent: Path) -> list[rundir.Run]:
-    """Load every finished seed run of a multi-seed parent directory.
+    """Load every seed run of a multi-seed parent directory that has a result.
 
     Raises:
         RunError: no seed run of ``parent`` is complete.
@@ -301,6 +535,56 @@ def load_seed_runs(parent: Path) -> list[rundir.Run]:
     if not runs:
         raise rundir.RunError(f"{parent}: none of its seed runs has finished.")
     return runs
+
+
+@dataclasses.dataclass(frozen=True)
+class SeedStatus:
+    """Which seeds of a multi-seed run have finished, and why the others have not."""
+
+    finished: list[tuple[int, Path]]
+    missing: list[tuple[int, Path]]  # no directory
+    unfinished: list[tuple[int, Path]]  # not started, interrupted or killed
+
+    def note(self, parent: Path) -> str | None:
+        """One line naming the seeds left out, or None when every seed finished."""
+        if not self.missing and not self.unfinished:
+            return None
+        total = len(self.finished) + len(self.missing) + len(self.unfinished)
+        parts = []
+        if self.missing:
+            parts.append(
+                f"{_names(self.missing)} {'is' if len(self.missing) == 1 else 'are'} missing"
+            )
+        if self.unfinished:
+            verb = "has" if len(self.unfinished) == 1 else "have"
+            parts.append(f"{_names(self.unfinished)} {verb} not finished")
+        return (
+            f"{parent}: {len(self.missing) + len(self.unfinished)} of {total} seeds not evaluated: "
+            f"{'; '.join(parts)} (finish them with `cartpole-q train --resume {parent}`)"
+        )
+
+
+def _names(items: list[tuple[int, Path]], limit: int = 8) -> str:
+    names = [path.name for _, path in items]
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
+
+
+def seed_status(parent: Path) -> SeedStatus:
+    """Sort the seeds of a multi-seed run into finished, missing and unfinished."""
+    config = load_config(parent / rundir.CONFIG_FILE)
+    seeds = config.train.seeds
+    assert seeds is not None
+    status = SeedStatus([], [], [])
+    for seed in seeds:
+        child = seed_dir(parent, seed, seeds)
+        if not child.is_dir():
+            status.missing.append((seed, child))
+        elif _finished(child):
+            status.finished.append((seed, child))
+        else:
+            status.unfinished.append((seed, child))
+    return status
 
 
 def _evaluate_one(path: str, episodes: int | None, seed: int | None) -> dict[str, Any]:
@@ -321,23 +605,30 @@ def evaluate_seeds(
     """Evaluate every finished seed of a multi-seed run in ``gymnasium.make``, in parallel.
 
     Returns:
-        ``runs`` (one ``eval --json`` object per seed, with ``run_seed`` and ``path``),
-        ``successes`` (means at or above the threshold), ``reward_threshold``,
-        ``episodes``, and the ``mean`` and ``min`` of the seeds' means.
+        ``runs`` (one ``eval --json`` object per finished seed, with ``run_seed`` and
+        ``path``), ``successes`` (means at or above the threshold), ``reward_threshold``,
+        ``episodes``, the ``mean`` and ``min`` of the seeds' means, ``seeds`` (how many
+        the run has), the seed directories left out (``missing``: absent, ``unfinished``:
+        interrupted or not started) and ``note``, a line naming them (None if none).
 
     Raises:
-        RunError: a seed directory is damaged, or none has finished.
+        RunError: a finished seed's directory is damaged, or no seed has finished.
     """
-    paths = [str(run.path) for run in load_seed_runs(parent)]
+    status = seed_status(parent)
+    if not status.finished:
+        raise rundir.RunError(
+            f"{parent}: none of its seed runs has finished; {status.note(parent)}"
+        )
+    paths = [str(path) for _, path in status.finished]
+    # Loading every seed first refuses a damaged one before any work starts.
+    for path in paths:
+        rundir.load_run(path)
     workers = workers or default_workers(len(paths))
+    jobs = [(path, episodes, seed) for path in paths]
     if workers <= 1:
-        results = [_evaluate_one(path, episodes, seed) for path in paths]
+        results = [_evaluate_one(*job) for job in jobs]
     else:
-        context = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-            results = list(
-                pool.map(_evaluate_one, paths, [episodes] * len(paths), [seed] * len(paths))
-            )
+        results = run_in_workers(_evaluate_one, jobs, workers)
     threshold = _read_json(Path(paths[0]) / rundir.SUMMARY_FILE) or {}
     reward_threshold = threshold.get("reward_threshold")
     means = [result["mean"] for result in results]
@@ -350,4 +641,8 @@ def evaluate_seeds(
         "episodes": results[0]["episodes"],
         "mean": float(np.mean(means)),
         "min": float(np.min(means)),
+        "seeds": len(status.finished) + len(status.missing) + len(status.unfinished),
+        "missing": [path.name for _, path in status.missing],
+        "unfinished": [path.name for _, path in status.unfinished],
+        "note": status.note(parent),
     }

@@ -2,7 +2,7 @@
 
 The ``*_figure`` functions take arrays and return a :class:`matplotlib.figure.Figure`;
 :func:`plot_rewards` and :func:`plot_policy` are what ``cartpole-q plot`` runs: they load
-run directories, draw, and write the PNG atomically.
+run directories, draw, and write the figure (PNG, SVG or PDF) atomically.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.colors import LogNorm, Normalize
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
 from cartpole_q.environment import SOLVE_WINDOW
@@ -24,9 +24,33 @@ CURVE_SIZE = (8.0, 4.5)
 """inches; at 100 dpi a reward curve is 800 x 450 pixels"""
 POLICY_SIZE = (13.5, 4.2)
 """inches; at 100 dpi a policy map is 1350 x 420 pixels"""
-CARTPOLE_DIMENSIONS = ("cart position", "cart velocity", "pole angle", "pole angular velocity")
-CARTPOLE_UNITS = ("m", "m/s", "rad", "rad/s")
 BOOTSTRAP_RESAMPLES = 1000
+FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
+"""the extensions ``plot --out`` writes, and matplotlib's format for each"""
+DIMENSION_NAMES = {
+    "CartPole": (
+        "cart position (m)",
+        "cart velocity (m/s)",
+        "pole angle (rad)",
+        "pole angular velocity (rad/s)",
+    ),
+    "MountainCar": ("position", "velocity"),
+    "Acrobot": (
+        "cos θ1",
+        "sin θ1",
+        "cos θ2",
+        "sin θ2",
+        "θ1 velocity (rad/s)",
+        "θ2 velocity (rad/s)",
+    ),
+}
+"""observation names of the known environments, by the id's name before ``-v``"""
+ACTION_NAMES = {
+    "CartPole": ("push left", "push right"),
+    "MountainCar": ("accelerate left", "don't accelerate", "accelerate right"),
+    "Acrobot": ("torque -1", "torque 0", "torque +1"),
+}
+"""what each action does in the known environments"""
 
 
 @dataclass(frozen=True)
@@ -36,6 +60,10 @@ class Curve:
     label: str
     returns: np.ndarray
     solved_episode: int | None = None
+    threshold: float | None = None
+    """its reward threshold (``None``: the figure's)"""
+    interrupted: bool = False
+    """training was stopped before its configured episodes"""
 
 
 @dataclass(frozen=True)
@@ -45,6 +73,10 @@ class SeedBand:
     label: str
     returns: list[np.ndarray]
     solved_episodes: list[int | None]
+    threshold: float | None = None
+    """the seeds' reward threshold (``None``: the figure's)"""
+    interrupted: int = 0
+    """how many of the seeds were stopped before their configured episodes"""
 
 
 def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
@@ -89,30 +121,54 @@ def reward_curve_figure(
     """Training returns: per run, the returns (faint) and their 100-episode moving average.
 
     A :class:`SeedBand` is drawn as its seeds' moving averages (faint), their mean, and a
-    95% bootstrap confidence band, with the median solve episode marked.
+    95% bootstrap confidence band, with the median solve episode marked. One dashed
+    threshold line when the runs share their threshold (``threshold`` stands for a run
+    without its own); otherwise each run's in its colour. An interrupted run says so in
+    its legend entry.
     """
     figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
-    for item, colour in zip(curves, _colours(len(curves)), strict=True):
+    colours = _colours(len(curves))
+    for item, colour in zip(curves, colours, strict=True):
         if isinstance(item, SeedBand):
             _draw_band(axes, item, colour)
             continue
         episodes = np.arange(1, len(item.returns) + 1)
         axes.plot(episodes, item.returns, color=colour, alpha=0.25, linewidth=0.8)
         suffix = f" (solved at {item.solved_episode})" if item.solved_episode else ""
+        if item.interrupted:
+            suffix += f" (interrupted at episode {len(item.returns)})"
         axes.plot(episodes, moving_average(item.returns), color=colour, linewidth=2.0,
                   label=f"{item.label}{suffix}")  # fmt: skip
         if item.solved_episode:
             axes.axvline(item.solved_episode, color=colour, linestyle=":", linewidth=1.0)
-    if threshold is not None:
-        axes.axhline(threshold, color="black", linestyle="--", linewidth=1.0,
-                     label=f"reward threshold {threshold:g}")  # fmt: skip
+    thresholds = [threshold if item.threshold is None else item.threshold for item in curves]
+    if len(set(thresholds)) == 1:
+        shared = thresholds[0]
+        if shared is not None:
+            axes.axhline(shared, color="black", linestyle="--", linewidth=1.0,
+                         label=f"reward threshold {shared:g}")  # fmt: skip
+    else:
+        for item, colour, own in zip(curves, colours, thresholds, strict=True):
+            if own is not None:
+                axes.axhline(own, color=colour, linestyle="--", linewidth=1.0,
+                             label=f"{item.label}: reward threshold {own:g}")  # fmt: skip
     axes.set_xlabel("training episode")
-    axes.set_ylabel(f"return (faint: each episode; bold: {SOLVE_WINDOW}-episode average)")
+    axes.set_ylabel(_return_label(curves))
     axes.set_title(title)
     axes.grid(alpha=0.3)
     axes.legend(loc="best", fontsize="small")
     return figure
+
+
+def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
+    bands = sum(isinstance(item, SeedBand) for item in curves)
+    average = f"{SOLVE_WINDOW}-episode average"
+    if bands == 0:
+        return f"return (faint: each episode; bold: {average})"
+    if bands == len(curves):
+        return f"return, {average} (faint: each seed; bold: mean of seeds)"
+    return f"return (bold: {average}, of a run or mean of seeds; faint: episodes or seeds)"
 
 
 def _draw_band(axes: object, band: SeedBand, colour: tuple[float, ...]) -> None:
@@ -129,6 +185,8 @@ def _draw_band(axes: object, band: SeedBand, colour: tuple[float, ...]) -> None:
     mean, low, high = bootstrap_band(curves, np.random.default_rng(0))
     solved = [s for s in band.solved_episodes if s is not None]
     note = f", median solve {np.median(solved):g}" if solved else ""
+    if band.interrupted:
+        note += f", {band.interrupted} interrupted"
     axes.fill_between(episodes, low, high, color=colour, alpha=0.3, linewidth=0)  # type: ignore[attr-defined]
     axes.plot(episodes, mean, color=colour, linewidth=2.0,  # type: ignore[attr-defined]
               label=f"{band.label}: mean of {len(curves)} seeds, 95% CI{note}")  # fmt: skip
@@ -144,12 +202,14 @@ def policy_figure(
     high: Sequence[float],
     names: Sequence[str],
     title: str,
+    action_names: Sequence[str] | None = None,
 ) -> Figure:
     """Greedy action, state value ``max_a Q`` and visit counts over two binned dimensions.
 
     The other dimensions are averaged out, weighted by how often training visited each
     state (uniformly where it never did); with one bin there, the maps are exact.
-    States training never visited are shown blank.
+    States training never visited are shown blank. The greedy action has one colour per
+    action, labelled ``"0: push left"`` and so on when ``action_names`` are given.
     """
     q_map, value_map, visit_map = project_policy(q_table, visits, dims)
     action_map = np.argmax(q_map, axis=-1).astype(float)
@@ -159,11 +219,12 @@ def policy_figure(
     d_row, d_col = dims
     extent = (low[d_col], high[d_col], low[d_row], high[d_row])
     n_actions = q_table.shape[-1]
+    action_colours = ListedColormap(_action_colours(n_actions))
+    action_norm = BoundaryNorm(np.arange(n_actions + 1) - 0.5, n_actions)
     # Visits span orders of magnitude (most time is spent near upright): log colour scale.
     visit_norm = LogNorm(vmin=1, vmax=max(float(visit_map.max()), 10.0))
     layers = (
-        ("greedy action", np.ma.masked_where(unvisited, action_map), "coolwarm",
-         Normalize(0, max(n_actions - 1, 1))),
+        ("greedy action", np.ma.masked_where(unvisited, action_map), action_colours, action_norm),
         ("state value max_a Q", np.ma.masked_where(unvisited, value_map), "viridis", None),
         ("training visits (log scale)", np.ma.masked_where(visit_map == 0, visit_map), "magma", visit_norm),
     )  # fmt: skip
@@ -176,10 +237,21 @@ def policy_figure(
         bar = figure.colorbar(image, ax=axes)
         if name == "greedy action":
             bar.set_ticks(list(range(n_actions)))
-            if n_actions == 2:
-                bar.set_ticklabels(["0: push left", "1: push right"])
+            if action_names is not None and len(action_names) == n_actions:
+                bar.set_ticklabels([f"{a}: {text}" for a, text in enumerate(action_names)])
+            bar.minorticks_off()
     figure.suptitle(title)
     return figure
+
+
+def _action_colours(count: int) -> list[tuple[float, ...]]:
+    """Two actions: blue and red (left and right); more: evenly spread over coolwarm."""
+    from matplotlib import colormaps
+
+    palette = colormaps["coolwarm"]
+    return (
+        [tuple(palette(x)) for x in np.linspace(0.1, 0.9, count)] if count > 1 else [palette(0.1)]
+    )
 
 
 def project_policy(
@@ -216,6 +288,17 @@ def figure_png(figure: Figure) -> bytes:
     return buffer.getvalue()
 
 
+def figure_bytes(figure: Figure, file_format: str) -> bytes:
+    """Render a figure as ``png``, ``svg`` or ``pdf`` bytes."""
+    if file_format == "png":
+        return figure_png(figure)
+    buffer = io.BytesIO()
+    # The date would make every SVG or PDF of the same run differ.
+    metadata = {"Date": None}
+    figure.savefig(buffer, format=file_format, dpi=DPI, metadata=metadata)
+    return buffer.getvalue()
+
+
 def _colours(count: int) -> list[tuple[float, ...]]:
     from matplotlib import colormaps
 
@@ -229,55 +312,72 @@ def _colours(count: int) -> list[tuple[float, ...]]:
 # -- the plot command -----------------------------------------------------------------
 
 
-def plot_rewards(run_dirs: Sequence[Path], out: Path) -> Path:
+def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Path:
     """Draw the reward curves of single and multi-seed runs on one figure; write ``out``.
+
+    Args:
+        run_dirs: run directories, single or multi-seed.
+        out: a ``.png``, ``.svg`` or ``.pdf`` file.
+        force: replace ``out`` if it exists.
 
     Raises:
         RunError: a directory is not a complete run.
+        WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     from cartpole_q import rundir
     from cartpole_q.multiseed import load_seed_runs
 
     items: list[Curve | SeedBand] = []
-    thresholds: set[float | None] = set()
     for path in run_dirs:
         if rundir.is_multi_seed(path):
             runs = load_seed_runs(path)
+            thresholds = {run.summary.get("reward_threshold") for run in runs}
             items.append(SeedBand(
                 path.name, [run.metrics.returns for run in runs],
                 [run.summary.get("solved_episode") for run in runs],
+                threshold=thresholds.pop() if len(thresholds) == 1 else None,
+                interrupted=sum(bool(run.summary.get("interrupted")) for run in runs),
             ))  # fmt: skip
-            thresholds.update(run.summary.get("reward_threshold") for run in runs)
         else:
             run = rundir.load_run(path)
-            items.append(Curve(path.name, run.metrics.returns, run.summary.get("solved_episode")))
-            thresholds.add(run.summary.get("reward_threshold"))
-    thresholds.discard(None)
-    threshold = thresholds.pop() if len(thresholds) == 1 else None
+            items.append(Curve(
+                path.name, run.metrics.returns, run.summary.get("solved_episode"),
+                threshold=run.summary.get("reward_threshold"),
+                interrupted=bool(run.summary.get("interrupted")),
+            ))  # fmt: skip
+    suffix = rundir.check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
-    figure = reward_curve_figure(items, threshold, title)
-    _write_png(out, figure)
+    if len(items) == 1 and isinstance(items[0], Curve) and items[0].interrupted:
+        title += " (interrupted)"
+    figure = reward_curve_figure(items, None, title)
+    rundir.atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 
 
-def plot_policy(run_dir: Path, out: Path, dims_text: str | None) -> Path:
+def plot_policy(run_dir: Path, out: Path, dims_text: str | None, force: bool = False) -> Path:
     """Draw one run's policy map over two binned dimensions; write ``out``.
 
     Raises:
         RunError: the directory is not a complete run.
         UserError: ``dims_text`` does not name two distinct dimensions of the grid.
+        WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     from cartpole_q import rundir
 
     run = rundir.load_run(run_dir)
     bins = run.config.discretization.bins
     dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
-    names = _dimension_names(run.config.env.id, len(bins))
+    suffix = rundir.check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    env_id = run.config.env.id
+    title = f"Policy of {run_dir.name}"
+    if run.summary.get("interrupted"):
+        title += f" (training interrupted at episode {run.summary.get('episodes')})"
     figure = policy_figure(
         run.q_table, run.visits, dims, run.config.discretization.low,
-        run.config.discretization.high, names, f"Policy of {run_dir.name}",
+        run.config.discretization.high, dimension_names(env_id, len(bins)), title,
+        action_names=action_names(env_id, run.q_table.shape[-1]),
     )  # fmt: skip
-    _write_png(out, figure)
+    rundir.atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 
 
@@ -313,23 +413,28 @@ def default_dims(bins: Sequence[int]) -> tuple[int, int]:
     return first, second
 
 
-def _dimension_names(env_id: str, n_dims: int) -> list[str]:
-    if env_id.startswith("CartPole") and n_dims == 4:
-        return [
-            f"{name} ({unit})"
-            for name, unit in zip(CARTPOLE_DIMENSIONS, CARTPOLE_UNITS, strict=True)
-        ]
+def _known_environment(env_id: str) -> str:
+    """The name of a Gymnasium id without namespace and version: ``CartPole-v1`` → ``CartPole``."""
+    return env_id.rsplit("/", 1)[-1].split("-v")[0]
+
+
+def dimension_names(env_id: str, n_dims: int) -> list[str]:
+    """Axis names of the observation dimensions; ``observation N`` for unknown ones.
+
+    >>> dimension_names("CartPole-v1", 4)[2], dimension_names("Other-v0", 2)
+    ('pole angle (rad)', ['observation 0', 'observation 1'])
+    """
+    names = DIMENSION_NAMES.get(_known_environment(env_id))
+    if names is not None and len(names) == n_dims:
+        return list(names)
     return [f"observation {d}" for d in range(n_dims)]
 
 
-def _write_png(out: Path, figure: Figure) -> None:
-    from cartpole_q.errors import UserError
-    from cartpole_q.rundir import atomic_write_bytes
+def action_names(env_id: str, n_actions: int) -> list[str] | None:
+    """What each action does, for the known environments.
 
-    if out.is_dir():
-        raise UserError(
-            f"{out}: --out is a directory; give a file name such as {out / 'plot.png'}."
-        )
-    if not out.parent.exists():
-        raise UserError(f"{out}: the directory {out.parent} does not exist.")
-    atomic_write_bytes(out, figure_png(figure))
+    >>> action_names("MountainCar-v0", 3)[1], action_names("Other-v0", 2)
+    ("don't accelerate", None)
+    """
+    names = ACTION_NAMES.get(_known_environment(env_id))
+    return list(names) if names is not None and len(names) == n_actions else None

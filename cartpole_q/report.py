@@ -50,27 +50,62 @@ def _rows_multi(run_dir: Path, summary: dict[str, Any]) -> list[tuple[str, str]]
             return "-"
         return f"median {value['median']:,.0f} (IQR {value['q25']:,.0f}-{value['q75']:,.0f})"
 
-    eval_mean = summary.get("eval_mean") or {}
+    finished, runs = summary["finished"], summary["runs"]
+    threshold = summary.get("reward_threshold")
+    eval_mean = summary.get("eval_mean")
+    over = "" if finished == runs else f" (over the {finished} finished seeds)"
     rows = [
         ("run", str(run_dir)),
-        ("seeds", f"{summary['seeds']} ({summary['runs']} runs, {summary['finished']} finished)"),
+        ("seeds", f"{summary['seeds']} ({runs} runs, {finished} finished)"),
         ("engine", str(summary.get("engine"))),
         (
             "success",
-            f"{summary['successes']}/{summary['runs']} greedy eval mean >= {summary.get('reward_threshold')}",
+            f"{summary['successes']}/{finished} greedy eval mean >= {threshold}{over}"
+            if finished
+            else "- (no seed has finished)",
         ),
         ("solved episode", f"{spread('solved_episode')}, {summary['solved_runs']} solved"),
         ("env steps to solve", spread("env_steps_to_solve")),
         ("greedy first >= threshold", spread("first_greedy_success_env_steps") + " env steps"),
         (
             "eval mean",
-            f"mean {eval_mean.get('mean', float('nan')):.1f}, min {eval_mean.get('min', float('nan')):.1f}",
+            f"mean {eval_mean['mean']:.1f}, min {eval_mean['min']:.1f}" if eval_mean else "-",
         ),
-        ("time", f"{summary['wall_seconds']:.1f} s"),
     ]
+    if finished < runs:
+        rows.append(("unfinished", _unfinished(summary)))
+    rows.append(("time", f"{summary['wall_seconds']:.1f} s"))
     if summary.get("interrupted"):
         rows.append(("status", "interrupted"))
     return rows
+
+
+def _unfinished(summary: dict[str, Any]) -> str:
+    """Which seeds have not finished, and how far the interrupted ones got.
+
+    >>> _unfinished({"runs": 4, "finished": 0, "interrupted_seeds": "0-1",
+    ...     "no_result_seeds": "2-3", "per_seed": {
+    ...         "0": {"interrupted": True, "eval_mean": 500.0},
+    ...         "1": {"interrupted": True, "eval_mean": 480.0}}})
+    '4 of 4: seeds 0-1 interrupted (greedy eval mean so far 490.0), seeds 2-3 without a result'
+    """
+    parts = []
+    if summary.get("interrupted_seeds"):
+        means = [
+            run["eval_mean"]
+            for run in summary.get("per_seed", {}).values()
+            if run.get("interrupted") and run.get("eval_mean") is not None
+        ]
+        so_far = f" (greedy eval mean so far {sum(means) / len(means):.1f})" if means else ""
+        parts.append(f"{_seeds(summary['interrupted_seeds'])} interrupted{so_far}")
+    if summary.get("no_result_seeds"):
+        parts.append(f"{_seeds(summary['no_result_seeds'])} without a result")
+    return f"{summary['runs'] - summary['finished']} of {summary['runs']}: " + ", ".join(parts)
+
+
+def _seeds(seeds: str) -> str:
+    """``seed 3`` or ``seeds 0-2,5``, from seeds in ``--seeds`` syntax."""
+    return f"seed {seeds}" if seeds.isdigit() else f"seeds {seeds}"
 
 
 def _print_rows(title: str, rows: list[tuple[str, str]]) -> None:
@@ -119,14 +154,21 @@ def eval_line(run_dir: Path, report: dict[str, Any], threshold: float | None) ->
 
 
 def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
-    """Lines reporting the greedy evaluation of every seed of a multi-seed run."""
+    """Lines reporting the greedy evaluation of every seed of a multi-seed run.
+
+    The last line, when some seeds were left out, names them (``result["note"]``).
+    """
     lines = [
         f"seed {run['run_seed']}: mean {run['mean']:.2f} +/- {run['std']:.2f} (min {run['min']:g}, max {run['max']:g})"
         for run in result["runs"]
     ]
+    note = result.get("note")
     lines.append(
-        f"{parent}: {result['successes']}/{len(result['runs'])} seeds with greedy mean >= "
+        f"{parent}: {result['successes']}/{len(result['runs'])} {'finished ' if note else ''}"
+        "seeds with greedy mean >= "
         f"{result['reward_threshold']:g} over {result['episodes']} episodes each in gymnasium.make; "
         f"mean of means {result['mean']:.2f}, lowest {result['min']:.2f}"
     )
+    if note:
+        lines.append(note)
     return "\n".join(lines)

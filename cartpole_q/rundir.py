@@ -9,7 +9,7 @@
 | ``evaluations.csv`` | periodic greedy evaluations: ``episode,env_steps,mean,std,min,max`` |
 | ``reward_curve.png`` | returns, their 100-episode moving average, the threshold |
 | ``summary.json`` | figures of the run; written last, so its presence means complete |
-| ``checkpoint.npz`` | only while a run is unfinished or interrupted: what ``--resume`` needs |
+| ``checkpoint.npz`` | what ``--resume`` needs, with the config it was trained with: kept while a run is unfinished or interrupted, and after a run that reached ``train.episodes`` (to extend it) |
 
 Every file is written to a temporary file in the same directory and moved into place with
 ``os.replace``, so a reader (or a process killed at any instant) never sees half a file.
@@ -18,7 +18,9 @@ Arrays are read with ``allow_pickle=False`` only.
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import errno
 import io
 import json
 import os
@@ -32,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.errors import UserError
@@ -46,6 +49,8 @@ SUMMARY_FILE = "summary.json"
 CHECKPOINT_FILE = "checkpoint.npz"
 METRICS_HEADER = ("episode", "return", "length", "epsilon", "alpha")
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
+NPY_MAGIC = b"\x93NUMPY"
+"""the first bytes of every ``.npy`` file"""
 
 
 class RunError(UserError):
@@ -55,20 +60,106 @@ class RunError(UserError):
 # -- atomic writes --------------------------------------------------------------------
 
 
+class WriteError(RunError):
+    """A file that cannot be written (full disk, no permission, ...); the message names it."""
+
+
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` so that ``path`` is either absent, old, or complete.
 
     The temporary file is created with ``open(..., "xb")`` rather than ``mkstemp`` so
     that it gets the user's usual permissions (umask), not mkstemp's owner-only 0600.
+
+    Raises:
+        WriteError: the file cannot be written (``ENOSPC``, ``EACCES``, ``EROFS``,
+            ``ENOTDIR``, ...); the temporary file is gone and ``path`` is untouched.
     """
     temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
     try:
         with open(temporary, "xb") as stream:
             stream.write(data)
         os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
+    except BaseException as error:
+        with contextlib.suppress(OSError):
+            temporary.unlink(missing_ok=True)
+        if isinstance(error, OSError):
+            raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
         raise
+
+
+def write_failure(path: Path, error: OSError) -> str:
+    """Say in words why writing ``path`` failed.
+
+    >>> write_failure(Path("/x/y.png"), OSError(errno.ENOSPC, "No space left on device"))
+    'no space is left on the device that holds /x'
+    """
+    directory = path.parent
+    reasons = {
+        errno.ENOSPC: f"no space is left on the device that holds {directory}",
+        errno.EDQUOT: f"the disk quota of {directory} is used up",
+        errno.EACCES: f"permission to write in {directory} is denied",
+        errno.EPERM: f"permission to write in {directory} is denied",
+        errno.EROFS: f"{directory} is on a read-only file system",
+        errno.ENOTDIR: f"{_first_non_directory(directory)} is not a directory",
+        errno.EISDIR: "it is a directory",
+        errno.ENAMETOOLONG: "the file name is too long",
+    }
+    if error.errno == errno.ENOENT:
+        if directory.is_dir():
+            return f"files cannot be created in {directory}"
+        return f"the directory {directory} does not exist"
+    return reasons.get(error.errno or 0, error.strerror or str(error))
+
+
+def _first_non_directory(directory: Path) -> Path:
+    """The first existing ancestor of ``directory`` (or itself) that is not a directory."""
+    for candidate in (*reversed(directory.parents), directory):
+        if candidate.exists() and not candidate.is_dir():
+            return candidate
+    return directory
+
+
+def check_output_file(path: Path, option: str, suffixes: tuple[str, ...], force: bool) -> str:
+    """Check, before any expensive work, that ``path`` can be written as asked.
+
+    Args:
+        path: the file a command will write.
+        option: the option that named it (for messages), e.g. ``--out``.
+        suffixes: the extensions that can be written, lower case with the dot.
+        force: whether an existing file may be replaced.
+
+    Returns:
+        The file's extension, lower case, one of ``suffixes``.
+
+    Raises:
+        WriteError: the extension is not supported, the path is a directory, the file
+            exists and ``force`` is not set, or no file can be created in its directory
+            (it does not exist, is not a directory, is read-only, ...).
+    """
+    supported = ", ".join(suffixes)
+    suffix = path.suffix.lower()
+    if path.is_dir():
+        raise WriteError(
+            f"{path}: {option} is a directory; give a file name such as {path / ('out' + suffixes[0])}."
+        )
+    if suffix not in suffixes:
+        raise WriteError(
+            f"{path}: {option} cannot write {'files ending in ' + suffix if suffix else 'a file without an extension'}; "
+            f"give a file name ending in one of {supported}."
+        )
+    if path.exists() and not force:
+        raise WriteError(
+            f"{path}: already exists; pass --force to replace it, or choose another name."
+        )
+    probe = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    try:
+        with open(probe, "xb"):
+            pass
+    except OSError as error:
+        raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
+    with contextlib.suppress(OSError):
+        probe.unlink()
+    return suffix
 
 
 def remove_stale_temporaries(run_dir: Path) -> None:
@@ -140,7 +231,11 @@ def check_output_dir(out: Path) -> None:
 
 def write_config(run_dir: Path, config: Config) -> None:
     """Write the resolved config (every key) as ``config.yaml``."""
-    header = "# Resolved config of this run: every key, defaults filled in.\n"
+    header = (
+        "# Resolved config of this run: every key, defaults filled in.\n"
+        "# `cartpole-q train --resume` continues the run only while nothing here changes\n"
+        "# but train.episodes (which may grow, to extend the run).\n"
+    )
     atomic_write_text(run_dir / CONFIG_FILE, header + config.to_yaml())
 
 
@@ -159,6 +254,7 @@ def write_checkpoint(run_dir: Path, checkpoint: Any) -> None:
         "evaluations": checkpoint.evaluations,
         "train_seconds": checkpoint.train_seconds,
         "wall_seconds": checkpoint.wall_seconds,
+        "config": None if checkpoint.config is None else checkpoint.config.to_yaml(),
     }
     arrays = {
         "q": checkpoint.q,
@@ -207,7 +303,44 @@ def load_checkpoint(run_dir: Path) -> Any:
                 evaluations=meta["evaluations"],
                 train_seconds=float(meta["train_seconds"]),
                 wall_seconds=float(meta["wall_seconds"]),
+                config=_checkpoint_config(meta.get("config")),
             )
+    except (
+        OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError
+    ) as error:  # fmt: skip
+        raise RunError(
+            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
+        ) from None
+
+
+def _checkpoint_config(text: Any) -> Config | None:
+    """The config a checkpoint recorded (``None`` for checkpoints older than that)."""
+    if text is None:
+        return None
+    data = yaml.safe_load(text)
+    if not isinstance(data, dict):
+        raise ValueError("its recorded config is not a mapping")
+    return load_config(data)
+
+
+def read_checkpoint_meta(run_dir: Path) -> dict[str, Any] | None:
+    """The small part of ``checkpoint.npz`` (episode, engine, ...), without its arrays.
+
+    Returns:
+        ``None`` when there is no checkpoint.
+
+    Raises:
+        RunError: the checkpoint is damaged.
+    """
+    path = run_dir / CHECKPOINT_FILE
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+        if not isinstance(meta, dict):
+            raise ValueError("its meta is not a JSON object")
+        return meta
     except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as error:
         raise RunError(
             f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
@@ -230,6 +363,8 @@ def versions() -> dict[str, str]:
 
 def summarize(result: Any) -> dict[str, Any]:
     """The ``summary.json`` content of a :class:`~cartpole_q.training.TrainResult`."""
+    played_in = "twin" if result.engine == "numba" else "gymnasium"
+    greedy = result.first_greedy_success()
     return {
         "episodes": result.episodes,
         "env_steps": result.env_steps,
@@ -247,8 +382,10 @@ def summarize(result: Any) -> dict[str, Any]:
             "episode": result.kept_episode,
             "source": "solve point" if result.solved_episode is not None else "last episode",
         },
-        "eval": None if result.eval is None else result.eval.to_dict(),
-        "first_greedy_success": result.first_greedy_success(),
+        # The numba engine plays its evaluations on the compiled twin (bit-identical to
+        # Gymnasium's environment); `cartpole-q eval` always plays in gymnasium.make.
+        "eval": None if result.eval is None else {**result.eval.to_dict(), "played_in": played_in},
+        "first_greedy_success": (None if greedy is None else {**greedy, "played_in": played_in}),
         "engine": result.engine,
         "seed": result.config.seed,
         "interrupted": result.interrupted,
@@ -278,15 +415,37 @@ def evaluations_csv(evaluations: list[dict[str, Any]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_run(run_dir: Path, result: Any, *, plot: bool = True) -> dict[str, Any]:
+def write_run(
+    run_dir: str | Path, result: Any, *, plot: bool = True, overwrite: bool = False
+) -> dict[str, Any]:
     """Write a :class:`~cartpole_q.training.TrainResult` into ``run_dir``.
 
     Files go in the contract's order: data first, ``summary.json`` last. An interrupted
-    result keeps its ``checkpoint.npz`` for ``--resume``; a finished one removes it.
+    result keeps its ``checkpoint.npz`` for ``--resume``, and so does one that reached
+    ``train.episodes`` (so that it can be extended); a run stopped at its solve point
+    removes it.
+
+    Args:
+        run_dir: the directory to write; it must not exist or be empty.
+        result: the training result.
+        plot: draw ``reward_curve.png``.
+        overwrite: write into a non-empty ``run_dir``, replacing its run files (the
+            command line does this in the directory it created, and on ``--resume``).
 
     Returns:
         The summary that was written.
+
+    Raises:
+        RunError: ``run_dir`` is a file, or a non-empty directory and not ``overwrite``.
     """
+    run_dir = Path(run_dir)
+    if run_dir.exists() and not run_dir.is_dir():
+        raise RunError(f"{run_dir}: is a file; a run directory must be a new or empty directory.")
+    if not overwrite and run_dir.is_dir() and any(run_dir.iterdir()):
+        raise RunError(
+            f"{run_dir}: is not empty; write_run never overwrites a run. Choose a new "
+            "directory, or pass overwrite=True to replace this run's files."
+        )
     run_dir.mkdir(parents=True, exist_ok=True)
     write_config(run_dir, result.config)
     atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
@@ -296,14 +455,17 @@ def write_run(run_dir: Path, result: Any, *, plot: bool = True) -> dict[str, Any
     if plot:
         from cartpole_q.plotting import Curve, figure_png, reward_curve_figure
 
-        curve = Curve(run_dir.name, result.returns, result.solved_episode)
-        figure = reward_curve_figure(
-            [curve], result.reward_threshold, title=f"Training reward: {run_dir.name}"
+        curve = Curve(
+            run_dir.name, result.returns, result.solved_episode, interrupted=result.interrupted
         )
+        title = f"Training reward: {run_dir.name}" + (
+            " (interrupted)" if result.interrupted else ""
+        )
+        figure = reward_curve_figure([curve], result.reward_threshold, title=title)
         atomic_write_bytes(run_dir / CURVE_FILE, figure_png(figure))
     summary = summarize(result)
     write_json(run_dir / SUMMARY_FILE, summary)
-    if not result.interrupted:
+    if not result.interrupted and not result.extendable:
         (run_dir / CHECKPOINT_FILE).unlink(missing_ok=True)
     return summary
 
@@ -357,6 +519,10 @@ def load_run(path: str | Path) -> Run:
             of the wrong shape or dtype, or holds NaN values; the message names the file.
     """
     path = Path(path)
+    if not path.exists():
+        raise RunError(
+            f"{path}: does not exist (expected a run directory from `cartpole-q train`)."
+        )
     if not path.is_dir():
         raise RunError(
             f"{path}: is not a directory (expected a run directory from `cartpole-q train`)."
@@ -399,6 +565,15 @@ def load_array(path: Path, dtype: type) -> np.ndarray:
     """
     if not path.is_file():
         raise RunError(f"{path}: is missing.")
+    try:
+        with open(path, "rb") as stream:
+            magic = stream.read(len(NPY_MAGIC))
+    except OSError as error:
+        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
+    if magic != NPY_MAGIC:
+        raise RunError(
+            f"{path}: is not a NumPy array file (.npy); it was not written by cartpole-q."
+        )
     try:
         array = np.load(path, allow_pickle=False)
     except ValueError as error:

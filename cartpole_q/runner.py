@@ -10,6 +10,7 @@ once. ``--resume`` continues from the checkpoint and gives byte-identical result
 
 from __future__ import annotations
 
+import math
 import signal
 import threading
 from collections.abc import Callable
@@ -19,7 +20,7 @@ from types import FrameType
 from typing import Any
 
 from cartpole_q import rundir
-from cartpole_q.config import Config, load_config
+from cartpole_q.config import NOT_SET, Config, ConfigError, config_differences, load_config
 from cartpole_q.environment import EnvInfo, inspect_env
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.rundir import RunError
@@ -136,15 +137,18 @@ def execute_run(
         RunError: ``resume`` and the checkpoint is missing or damaged.
     """
     reporter = reporter or NullReporter()
+    config = prepared.config
     checkpoint = None
     if resume:
         rundir.remove_stale_temporaries(run_dir)
         # Killed before its first checkpoint: nothing was lost but time; start over.
         if (run_dir / rundir.CHECKPOINT_FILE).is_file():
             checkpoint = rundir.load_checkpoint(run_dir)
+            check_resumable(run_dir, checkpoint, config)
+        # config.yaml says what the run now is (train.episodes may have grown).
+        rundir.write_config(run_dir, config)
         # The run is unfinished again until the new summary is written.
         (run_dir / rundir.SUMMARY_FILE).unlink(missing_ok=True)
-    config = prepared.config
     reporter.start(key, label or run_dir.name, config.train.episodes)
     result = train(
         config,
@@ -154,33 +158,162 @@ def execute_run(
         on_progress=lambda progress: reporter.update(key, progress),
         on_checkpoint=lambda snapshot: rundir.write_checkpoint(run_dir, snapshot),
     )
-    summary = rundir.write_run(run_dir, result)
+    summary = rundir.write_run(run_dir, result, overwrite=True)
     reporter.finish(key, outcome_line(label or run_dir.name, summary))
     return Outcome(run_dir, result, summary)
 
 
-def prepare_resume(run_dir: Path) -> Prepared:
-    """Load an unfinished run's config for ``--resume``.
+def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
+    """Load a run's config for ``--resume``: an unfinished run, or one to extend.
+
+    Args:
+        run_dir: the run directory (or the parent of a multi-seed run).
+        episodes: extend the run to this many episodes in all (``--episodes``); without
+            it, ``train.episodes`` of its ``config.yaml`` (which the user may have raised).
 
     Raises:
-        RunError: ``run_dir`` is not a run directory, or its run already finished.
-        ConfigError: its ``config.yaml`` no longer fits its environment.
+        RunError: ``run_dir`` is not a run directory; its run already finished and there
+            is nothing to extend; or a multi-seed run's seeds were trained with another
+            config than its ``config.yaml`` now says.
+        ConfigError: its ``config.yaml`` is invalid or no longer fits its environment.
     """
-    if not (run_dir / rundir.CONFIG_FILE).is_file():
+    config_path = run_dir / rundir.CONFIG_FILE
+    if not config_path.is_file():
         raise RunError(f"{run_dir}: is not a run directory (it has no {rundir.CONFIG_FILE}).")
-    source = str(run_dir / rundir.CONFIG_FILE)
-    config = load_config(run_dir / rundir.CONFIG_FILE)
-    summary_path = run_dir / rundir.SUMMARY_FILE
-    if summary_path.is_file():
-        import json
-
-        try:
-            interrupted = json.loads(summary_path.read_text(encoding="utf-8")).get("interrupted")
-        except (OSError, ValueError, AttributeError):
-            interrupted = True
-        if not interrupted:
+    overrides = None if episodes is None else {"train.episodes": episodes}
+    config = load_config(config_path, overrides)
+    multi_seed = config.train.seeds is not None
+    if multi_seed and episodes is not None:
+        raise RunError(
+            f"{run_dir}: is a multi-seed run; --episodes extends one run: extend its seeds "
+            f"one by one with `cartpole-q train --resume {run_dir}/seed-NNN --episodes N`."
+        )
+    summary = _read_summary(run_dir / rundir.SUMMARY_FILE)
+    if summary is not None and not summary.get("interrupted", True):
+        if multi_seed:
             raise RunError(f"{run_dir}: this run already finished; there is nothing to resume.")
-    return prepare(config, source)
+        _check_extendable(run_dir, config, summary, episodes is not None)
+    if multi_seed:
+        _check_seed_configs(run_dir, config)
+    return prepare(config, str(config_path))
+
+
+def _read_summary(path: Path) -> dict[str, Any] | None:
+    """A run's ``summary.json``, ``None`` if absent; an unreadable one counts as interrupted."""
+    import json
+
+    if not path.is_file():
+        return None
+    try:
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        summary = None
+    return summary if isinstance(summary, dict) else {"interrupted": True}
+
+
+def _check_extendable(
+    run_dir: Path, config: Config, summary: dict[str, Any], from_option: bool
+) -> None:
+    """Refuse to resume a finished run unless it ended at ``train.episodes`` and more are asked."""
+    done = summary.get("episodes")
+    meta = rundir.read_checkpoint_meta(run_dir)
+    if meta is None:
+        solved = summary.get("solved_episode")
+        if solved is not None and solved == done:
+            reason = (
+                f"it stopped at episode {solved}, where it solved (train.stop_when_solved), so "
+                "a longer run from the start would have stopped there too; only a run that "
+                "ended by reaching train.episodes can be extended"
+            )
+        else:
+            reason = f"it kept no {rundir.CHECKPOINT_FILE} to continue from"
+        raise RunError(
+            f"{run_dir}: this run already finished; there is nothing to resume: {reason}."
+        )
+    trained = int(meta.get("episode", done or 0))
+    if config.train.episodes <= trained:
+        asked = (
+            f"--episodes {config.train.episodes}"
+            if from_option
+            else f"train.episodes in its {rundir.CONFIG_FILE} ({config.train.episodes})"
+        )
+        raise RunError(
+            f"{run_dir}: this run already finished all {trained} episodes and {asked} "
+            f"asks for no more; there is nothing to resume. To train it longer, give "
+            f"`cartpole-q train --resume {run_dir} --episodes N` with N above {trained}."
+        )
+
+
+def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
+    """Refuse to continue a checkpoint under another config than it was trained with.
+
+    Only ``train.episodes`` may differ, and only grow: the continued run is then
+    byte-identical to a run trained that long from the start.
+
+    Raises:
+        RunError: naming the first key that differs, with both values.
+    """
+    where = run_dir / rundir.CONFIG_FILE
+    trained: Config | None = checkpoint.config
+    if trained is None:  # a checkpoint from before configs were recorded in it
+        states = math.prod(config.discretization.bins)
+        if checkpoint.q.shape[0] != states:
+            raise RunError(
+                f"{where}: discretization.bins: {list(config.discretization.bins)} gives "
+                f"{states} states, but the checkpoint's Q-table has {checkpoint.q.shape[0]}; "
+                "--resume continues a run exactly as it was trained."
+            )
+        return
+    for key, old, new in config_differences(trained, config):
+        if key == "train.episodes":
+            if new >= old:
+                continue
+            raise RunError(
+                f"{where}: train.episodes: the run was trained for {old} episodes and cannot "
+                f"be shortened to {new}; --resume only continues or extends a run."
+            )
+        raise RunError(
+            f"{where}: {key}: the run was trained with {_shown(old)}, {rundir.CONFIG_FILE} "
+            f"now says {_shown(new)}. --resume continues a run exactly as it was trained, so "
+            "only train.episodes may change (and only grow); put the value back, or train a "
+            f"new run with `cartpole-q train --config {where}`."
+        )
+
+
+def _check_seed_configs(parent: Path, config: Config) -> None:
+    """Refuse a multi-seed resume whose seeds were started with another config."""
+    from cartpole_q.multiseed import seed_dir
+
+    seeds = config.train.seeds
+    assert seeds is not None
+    for seed in seeds:
+        child = seed_dir(parent, seed, seeds)
+        if not (child / rundir.CONFIG_FILE).is_file():
+            continue
+        try:
+            started = load_config(child / rundir.CONFIG_FILE)
+        except ConfigError as error:
+            raise RunError(
+                f"{child}: its {rundir.CONFIG_FILE} is not a valid config. {error}"
+            ) from None
+        differences = config_differences(started, config.for_seed(seed))
+        if differences:
+            key, old, new = differences[0]
+            raise RunError(
+                f"{parent / rundir.CONFIG_FILE}: {key}: {child.name} was trained with "
+                f"{_shown(old)}, {rundir.CONFIG_FILE} now says {_shown(new)}. A multi-seed "
+                "run resumes exactly as it was configured; put the value back (to train one "
+                f"seed longer: `cartpole-q train --resume {child} --episodes N`)."
+            )
+
+
+def _shown(value: Any) -> str:
+    """A config value as YAML shows it: 0.995, [1, 1, 2, 10], "CartPole-v1", null."""
+    import json
+
+    if value is NOT_SET:
+        return value
+    return json.dumps(value, default=str)
 
 
 def outcome_line(label: str, summary: dict[str, Any]) -> str:

@@ -86,6 +86,8 @@ class Checkpoint:
     evaluations: list[dict[str, Any]]
     train_seconds: float
     wall_seconds: float
+    config: Config | None = None
+    """the config the run was trained with (``None`` in checkpoints older than this field)"""
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,20 @@ class TrainResult:
     def episodes(self) -> int:
         """Episodes trained."""
         return len(self.returns)
+
+    @property
+    def extendable(self) -> bool:
+        """Whether more episodes would continue this run exactly as a longer run would go on.
+
+        True when the run ended by reaching ``train.episodes``: not interrupted, and not
+        stopped at its solve point (a longer run would have stopped there too).
+        """
+        stopped_when_solved = self.solved_episode is not None and self.config.train.stop_when_solved
+        return (
+            not self.interrupted
+            and self.episodes >= self.config.train.episodes
+            and not stopped_when_solved
+        )
 
     @property
     def steps_per_second(self) -> float:
@@ -219,6 +235,7 @@ def _run(
             evaluations=list(state.evaluations),
             train_seconds=train_seconds,
             wall_seconds=wall_before + time.perf_counter() - started,
+            config=config,
         )
 
     finished = state.episode >= total or (
@@ -259,7 +276,9 @@ def _run(
             interrupted = True
             break
 
-    if interrupted and on_checkpoint is not None:
+    stopped_when_solved = state.solved_episode is not None and settings.stop_when_solved
+    if on_checkpoint is not None and (interrupted or not stopped_when_solved):
+        # Interrupted: for --resume. Reached train.episodes: to extend the run later.
         on_checkpoint(snapshot())
     wall_seconds = wall_before + time.perf_counter() - started
 

@@ -60,7 +60,7 @@ def test_train_writes_the_contract_run_directory(trained_run: Path) -> None:
         assert key in summary
     assert set(summary["versions"]) == {"python", "numpy", "gymnasium", "numba", "cartpole_q"}
     assert summary["engine"] == "numba" and summary["seed"] == 0
-    assert set(summary["eval"]) == {"mean", "std", "min", "max", "episodes", "seed"}
+    assert set(summary["eval"]) == {"mean", "std", "min", "max", "episodes", "seed", "played_in"}
     assert summary["q_table"] == {"episode": summary["solved_episode"], "source": "solve point"}
     lines = (trained_run / "metrics.csv").read_text().splitlines()
     assert lines[0] == "episode,return,length,epsilon,alpha"
@@ -82,7 +82,7 @@ def test_default_run_solves_and_evaluates_above_475(trained_run: Path) -> None:
     assert report["episodes"] == 100 and report["seed"] == 1000000
     assert report["mean"] >= 475
     # the evaluation in summary.json ran on the twin and must equal Gymnasium's exactly
-    assert report == summary["eval"]
+    assert {**report, "played_in": "twin"} == summary["eval"]
 
 
 def test_train_prints_the_run_directory_last(in_tmp: Path) -> None:
@@ -175,7 +175,6 @@ def test_training_another_environment_uses_the_gymnasium_engine(tmp_path: Path) 
     ("content", "named"),
     [
         ("seed: [unclosed", "not valid YAML"),
-        ("", "is empty"),
         ("[1, 2]", "must be a mapping"),
         ("seed: !!python/object/apply:os.system ['true']", "tag that is not allowed"),
         ("agent:\n  alpah: 0.1\n", "unknown key 'agent.alpah'; did you mean 'agent.alpha'?"),
@@ -250,7 +249,85 @@ def test_environment_errors_explain_themselves(in_tmp: Path, content: str, named
 
 def test_missing_config_file(in_tmp: Path) -> None:
     assert_refused(invoke("train", "-c", in_tmp / "missing.yaml"), "missing.yaml", "not found")
+    assert_refused(invoke("train", "-c", "blgo"), "blgo", "blog, default, sutton_barto")
     assert not (in_tmp / "runs").exists()
+
+
+def test_configs_lists_the_shipped_configs_and_train_takes_their_names(in_tmp: Path) -> None:
+    listed = invoke("configs")
+    assert listed.exit_code == 0, listed.output
+    names = [line.split()[0] for line in listed.stdout.splitlines()]
+    assert names == ["blog", "default", "sutton_barto"]
+    assert "Sutton & Barto" in listed.stdout
+    out = in_tmp / "run"
+    result = invoke("train", "-c", "sutton_barto", "--episodes", "3", "--out", out, "-q")
+    assert result.exit_code == 0, result.output
+    assert load_config(out / "config.yaml") == load_config(
+        CONFIGS / "sutton_barto.yaml", {"train.episodes": 3}
+    )
+
+
+def test_set_changes_any_key_and_is_validated_like_a_file(in_tmp: Path) -> None:
+    out = in_tmp / "run"
+    result = invoke(
+        "train", "--set", "agent.alpha=5e-4", "--set", "discretization.bins=[1,1,6,12]",
+        "--set", "env.kwargs.max_episode_steps=1000", "--set", "agent.epsilon.k=25",
+        "--set", "train.episodes=4", "--out", out, "-q",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    config = load_config(out / "config.yaml")
+    assert config.agent.alpha.start == 0.0005
+    assert config.discretization.bins == (1, 1, 6, 12)
+    assert config.env.kwargs["max_episode_steps"] == 1000
+    assert (config.agent.epsilon.kind, config.agent.epsilon.rate) == ("log", 25.0)
+    assert config.train.episodes == 4
+    # the default threshold scales with the time limit: 475 of 500 steps is 950 of 1000
+    assert json.loads((out / "summary.json").read_text())["reward_threshold"] == 950.0
+    # an explicit option given after --set wins
+    result = invoke(
+        "train", "--set", "train.episodes=9", "--episodes", "3", "--out", in_tmp / "r2", "-q"
+    )
+    assert load_config(in_tmp / "r2" / "config.yaml").train.episodes == 3
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (["--set", "agent.alpha"], ("--set 'agent.alpha'", "KEY=VALUE")),
+        (["--set", "agent.alpah=0.1"], ("unknown key 'agent.alpah'", "did you mean 'agent.alpha'?")),
+        (["--set", "agent.alpha=2"], ("command line: agent.alpha: must be in (0, 1]",)),
+        (["--set", "discretization.bins=[1,1,6]"], ("discretization.low: has 4 entries",)),
+        (["--set", "env.id=no_such_module_xyz:Env-v0"], ("env.id", "'no_such_module_xyz' cannot be imported")),
+    ],
+)  # fmt: skip
+def test_bad_set_values_are_refused(in_tmp: Path, args: list[str], named: tuple[str, ...]) -> None:
+    assert_refused(invoke("train", *args), *named)
+    assert not (in_tmp / "runs").exists()
+
+
+def test_eval_of_a_run_whose_env_module_cannot_be_imported(
+    trained_run: Path, tmp_path: Path
+) -> None:
+    run = tmp_path / "run"
+    shutil.copytree(trained_run, run)
+    path = run / "config.yaml"
+    path.write_text(path.read_text().replace("id: CartPole-v1", "id: no_such_module_xyz:Env-v0"))
+    assert_refused(
+        invoke("eval", run, "--episodes", "1"), "'no_such_module_xyz' cannot be imported"
+    )
+    video = tmp_path / "x.gif"
+    assert_refused(invoke("eval", run, "--episodes", "1", "--video", video), "'no_such_module_xyz'")
+    assert not video.exists()
+
+
+def test_an_empty_config_file_trains_the_default(in_tmp: Path) -> None:
+    path = in_tmp / "empty.yaml"
+    path.write_text("# nothing to change\n", encoding="utf-8")
+    result = invoke("train", "-c", path, "--episodes", "3", "--out", in_tmp / "run", "-q")
+    assert result.exit_code == 0, result.output
+    assert load_config(in_tmp / "run" / "config.yaml") == load_config(
+        overrides={"train.episodes": 3}
+    )
 
 
 def test_bad_command_line_values(in_tmp: Path) -> None:
@@ -289,7 +366,7 @@ def _damaged(trained_run: Path, tmp_path: Path) -> Path:
 
 @pytest.mark.parametrize("command", ["eval", "plot"])
 def test_not_a_run_directory(tmp_path: Path, command: str) -> None:
-    assert_refused(invoke(command, tmp_path / "nowhere"), "nowhere", "is not a directory")
+    assert_refused(invoke(command, tmp_path / "nowhere"), "nowhere", "does not exist")
     assert_refused(invoke(command, tmp_path), str(tmp_path), "not a run directory")
 
 
@@ -303,7 +380,14 @@ def test_not_a_run_directory(tmp_path: Path, command: str) -> None:
             lambda d: (d / "q_table.npy").write_bytes((d / "q_table.npy").read_bytes()[:100]),
             "q_table.npy",
         ),
-        (lambda d: (d / "q_table.npy").write_bytes(b"not an array"), "q_table.npy"),
+        (
+            lambda d: (d / "q_table.npy").write_bytes(b"not an array"),
+            "q_table.npy: is not a NumPy array file",
+        ),
+        (
+            lambda d: (d / "q_table.npy").write_bytes(np.random.default_rng(0).bytes(256)),
+            "q_table.npy: is not a NumPy array file",
+        ),
         (lambda d: np.save(d / "q_table.npy", np.zeros((3, 3))), "has shape (3, 3)"),
         (
             lambda d: (

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import math
+import re
 from pathlib import Path
 
 import pytest
@@ -19,13 +20,39 @@ from cartpole_q.config import (
     default_yaml_text,
     format_seeds,
     load_config,
+    parse_assignment,
     parse_seeds,
+    shipped_configs,
 )
 from tests.conftest import CONFIGS, write_yaml
 
 
-def test_embedded_default_and_its_twin_in_configs_are_the_same_file() -> None:
+def test_the_repository_configs_are_the_shipped_ones_and_default_is_embedded() -> None:
+    shipped = shipped_configs()
+    assert set(shipped) == {"blog", "default", "sutton_barto"}
+    assert {path.stem for path in CONFIGS.glob("*.yaml")} == set(shipped)
     assert (CONFIGS / "default.yaml").read_text(encoding="utf-8") == default_yaml_text()
+    assert all(description and not description.startswith("#") for description in shipped.values())
+
+
+def test_a_shipped_config_loads_by_its_name(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    assert load_config("blog") == load_config(CONFIGS / "blog.yaml")
+    assert load_config("sutton_barto").train.reward_threshold == 0.0
+    # an existing file of that name wins over the shipped config
+    monkeypatch.chdir(tmp_path)
+    write_yaml(tmp_path / "blog", {"seed": 5})
+    assert load_config("blog").seed == 5
+    with pytest.raises(ConfigError, match=r"not found.*blog, default, sutton_barto"):
+        load_config("blgo")
+
+
+def test_an_empty_config_file_is_the_default(tmp_path: Path) -> None:
+    for text in ("", "# only a comment\n", "\n\n"):
+        path = tmp_path / "empty.yaml"
+        path.write_text(text, encoding="utf-8")
+        assert load_config(path) == load_config()
 
 
 def test_default_config_loads_with_every_section() -> None:
@@ -108,8 +135,6 @@ def _error(tmp_path: Path, text: str) -> str:
     ("text", "named"),
     [
         ("seed: [unclosed", "not valid YAML"),
-        ("", "is empty"),
-        ("# only a comment\n", "is empty"),
         ("- 1\n- 2\n", "must be a mapping"),
         ("just a string", "must be a mapping"),
         ("!!python/object/apply:os.system ['echo hacked']", "tag that is not allowed"),
@@ -139,7 +164,8 @@ def _error(tmp_path: Path, text: str) -> str:
         ),
         ("agent:\n  epsilon: {type: cosine}\n", "agent.epsilon.type: must be one of"),
         ("agent:\n  epsilon: {type: log, k: 25, ned: 0}\n", "did you mean 'agent.epsilon.end'?"),
-        ("agent:\n  epsilon: {type: log, end: 0}\n", "a log schedule needs 'k'"),
+        ("agent:\n  alpha: {type: log, end: 0.1}\n", "a log schedule needs 'k'"),
+        ("agent:\n  alpha: {k: 5}\n", "agent.alpha: a schedule mapping needs 'type'"),
         ("agent:\n  alpha: {type: log, k: 25, end: 0}\n", "agent.alpha.end: must be in (0, 1]"),
         ("train:\n  episodes: 0\n", "train.episodes: must be at least 1"),
         ("train:\n  episodes: -5\n", "train.episodes: must be at least 1"),
@@ -199,6 +225,142 @@ def test_missing_file_and_directory_are_config_errors(tmp_path: Path) -> None:
 def test_override_errors_name_the_command_line() -> None:
     with pytest.raises(ConfigError, match=r"^command line: train\.seeds"):
         load_config(overrides={"train.seeds": "x-y"})
+
+
+# -- overrides merge exactly as a file does (issue 8, bug 8) ---------------------------
+
+
+def test_a_nested_override_merges_into_its_section() -> None:
+    config = load_config(overrides={"agent": {"gamma": 0.9}})
+    default = load_config()
+    assert config.agent.gamma == 0.9
+    assert (config.agent.alpha, config.agent.epsilon) == (
+        default.agent.alpha,
+        default.agent.epsilon,
+    )
+
+
+def test_a_dotted_override_of_a_schedule_field_keeps_its_other_fields() -> None:
+    assert load_config(overrides={"agent.epsilon.k": 25}).agent.epsilon == Schedule(
+        "log", 1.0, 0.0, 25.0
+    )
+    assert load_config(overrides={"agent": {"epsilon": {"end": 0.05}}}).agent.epsilon == Schedule(
+        "log", 1.0, 0.05, 9.0
+    )
+    # another type replaces the schedule; a number replaces it too
+    exponential = {"type": "exponential", "start": 1, "decay": 0.99, "end": 0.01}
+    assert load_config(overrides={"agent.epsilon": exponential}).agent.epsilon == Schedule(
+        "exponential", 1.0, 0.01, 0.99
+    )
+    assert load_config(overrides={"agent.epsilon": 0.2}).agent.epsilon == Schedule(
+        "constant", 0.2, 0.2
+    )
+    # overrides apply in order, like successive --set options
+    overrides = {"agent.epsilon": exponential, "agent.epsilon.decay": 0.5}
+    assert load_config(overrides=overrides).agent.epsilon.rate == 0.5
+
+
+def test_overrides_and_files_merge_the_same_way(tmp_path: Path) -> None:
+    nested = {"agent": {"epsilon": {"k": 30}}, "env": {"kwargs": {"max_episode_steps": 1000}}}
+    from_file = load_config(write_yaml(tmp_path / "c.yaml", nested))
+    assert load_config(overrides=nested) == from_file
+    dotted = {"agent.epsilon.k": 30, "env.kwargs.max_episode_steps": 1000}
+    assert load_config(overrides=dotted) == from_file
+    assert load_config(nested) == from_file  # a mapping in place of the file
+
+
+@pytest.mark.parametrize(
+    ("overrides", "named"),
+    [
+        (
+            {"agent.alpah": 0.1},
+            "command line: unknown key 'agent.alpah'; did you mean 'agent.alpha'?",
+        ),
+        ({"agent": {"alpah": 0.1}}, "unknown key 'agent.alpah'; did you mean 'agent.alpha'?"),
+        ({"agnet.alpha": 0.1}, "unknown key 'agnet'; did you mean 'agent'?"),
+        (
+            {"agent.epsilon.kk": 5},
+            "unknown key 'agent.epsilon.kk'; did you mean 'agent.epsilon.k'?",
+        ),
+        ({"agent.epsilon.k": 0}, "command line: agent.epsilon.k: must be in (0, inf)"),
+        ({"agent.alpha.k": 5}, "command line: agent.alpha: a schedule mapping needs 'type'"),
+        ({"agent.gamma.x": 1}, "command line: agent.gamma: must be a number"),
+        ({"agent..gamma": 1}, "'agent..gamma' is not a config key"),
+        ({"train": 5}, "command line: train: must be a mapping"),
+    ],
+)
+def test_bad_overrides_raise_config_error_naming_the_key(overrides: dict, named: str) -> None:
+    with pytest.raises(ConfigError) as caught:
+        load_config(overrides=overrides)
+    assert named in str(caught.value)
+
+
+def test_errors_blame_the_file_or_the_command_line_for_each_key(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "c.yaml", {"agent": {"gamma": 2}})
+    with pytest.raises(ConfigError, match=f"^{re.escape(str(path))}: agent.gamma"):
+        load_config(path, {"agent.alpha": 0.5})
+    with pytest.raises(ConfigError, match=r"^command line: agent\.alpha"):
+        load_config(tmp_path / "c.yaml", {"agent": {"alpha": 2, "gamma": 0.5}})
+
+
+def test_a_mapping_config_names_itself_in_errors() -> None:
+    with pytest.raises(ConfigError, match=r"^config mapping: unknown key 'sed'"):
+        load_config({"sed": 3})
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("agent.alpha=5e-4", ("agent.alpha", "5e-4")),
+        ("discretization.bins=[1,1,6,12]", ("discretization.bins", [1, 1, 6, 12])),
+        ("env.kwargs.max_episode_steps=1000", ("env.kwargs.max_episode_steps", 1000)),
+        ("train.stop_when_solved=false", ("train.stop_when_solved", False)),
+        ("env.id=CartPole-v0", ("env.id", "CartPole-v0")),
+        ("train.reward_threshold=", ("train.reward_threshold", None)),
+        (
+            "agent.epsilon={type: log, k: 25, end: 0}",
+            ("agent.epsilon", {"type": "log", "k": 25, "end": 0}),
+        ),
+    ],
+)
+def test_set_assignments_read_the_value_as_yaml(text: str, expected: tuple) -> None:
+    assert parse_assignment(text) == expected
+
+
+@pytest.mark.parametrize(
+    "text", ["agent.alpha", "=3", "agent.alpha=[1,", "seed=!!python/name:os.system"]
+)
+def test_malformed_set_assignments_are_config_errors(text: str) -> None:
+    with pytest.raises(ConfigError, match=r"^--set"):
+        parse_assignment(text)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "threshold"),
+    [
+        ({}, 475.0),
+        ({"env.kwargs.max_episode_steps": 1000}, 950.0),
+        ({"env.kwargs.max_episode_steps": 200}, 190.0),
+        ({"env.kwargs.max_episode_steps": 1000, "train.reward_threshold": 480}, 480.0),
+        ({"env.id": "CartPole-v0", "env.kwargs.max_episode_steps": 400}, 390.0),
+        ({"env.id": "Acrobot-v1", "discretization.bins": [2] * 6, "discretization.low": [-1] * 6,
+          "discretization.high": [1] * 6, "env.kwargs.max_episode_steps": 1000}, -100.0),
+    ],
+)  # fmt: skip
+def test_cartpole_threshold_scales_with_the_time_limit(overrides: dict, threshold: float) -> None:
+    from cartpole_q.environment import inspect_env
+
+    assert inspect_env(load_config(overrides=overrides)).reward_threshold == threshold
+
+
+def test_an_env_module_that_cannot_be_imported_is_a_config_error() -> None:
+    from cartpole_q.environment import inspect_env, make_env
+
+    config = load_config(overrides={"env.id": "no_such_module_xyz:Env-v0"})
+    with pytest.raises(ConfigError, match=r"^c\.yaml: env\.id: .*'no_such_module_xyz' cannot be"):
+        inspect_env(config, "c.yaml")
+    with pytest.raises(ConfigError, match="no_such_module_xyz"):
+        make_env(config.env, render_mode="rgb_array")
 
 
 def test_seed_lists() -> None:

@@ -14,7 +14,9 @@ from rich.console import Console
 from cartpole_q.plotting import (
     Curve,
     SeedBand,
+    action_names,
     bootstrap_band,
+    dimension_names,
     figure_png,
     moving_average,
     policy_figure,
@@ -23,6 +25,7 @@ from cartpole_q.plotting import (
 )
 from cartpole_q.progress import NullReporter, PlainReporter, RichReporter
 from cartpole_q.training import Progress
+from cartpole_q.video import FINAL_FRAME_MILLISECONDS, VideoRecorder
 from tests.conftest import invoke
 
 
@@ -85,7 +88,9 @@ def test_policy_plot_command(run_dir: Path, tmp_path: Path) -> None:
     result = invoke("plot", run_dir, "--policy", "--out", out)
     assert result.exit_code == 0, result.output
     assert decoded(out).size == (1350, 420)
-    assert invoke("plot", run_dir, "--policy", "--dims", "3,2", "--out", out).exit_code == 0
+    assert (
+        invoke("plot", run_dir, "--policy", "--dims", "3,2", "--out", out, "--force").exit_code == 0
+    )
     for bad in ("2", "2,2", "1,9", "a,b"):
         result = invoke("plot", run_dir, "--policy", "--dims", bad, "--out", out)
         assert result.exit_code == 2 and "--dims" in result.stderr
@@ -101,6 +106,65 @@ def test_reward_curve_with_seed_band_decodes() -> None:
     labels = [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
     assert labels[0] == "default: mean of 3 seeds, 95% CI, median solve 165"
     assert labels[-1] == "reward threshold 475"
+
+
+def test_policy_map_has_one_labelled_colour_per_action() -> None:
+    q = np.random.default_rng(0).normal(size=(1, 1, 4, 5, 3))
+    names = action_names("MountainCar-v0", 3)
+    figure = policy_figure(q, None, (2, 3), [0] * 4, [1] * 4, list("abcd"), "t", names)
+    image = figure.axes[0].images[0]
+    assert image.cmap.N == 3 and image.norm(np.array([0, 1, 2])).tolist() == [0, 1, 2]
+    bar = figure.axes[3]  # the colour bar next to the first panel
+    figure_png(figure)  # draw, so that tick labels exist
+    labels = [label.get_text() for label in bar.get_yticklabels()]
+    assert labels == ["0: accelerate left", "1: don't accelerate", "2: accelerate right"]
+    assert action_names("CartPole-v1", 2) == ["push left", "push right"]
+    assert action_names("Acrobot-v1", 3) == ["torque -1", "torque 0", "torque +1"]
+    assert action_names("CartPole-v1", 3) is None
+
+
+def test_known_environments_name_their_axes() -> None:
+    assert dimension_names("CartPole-v1", 4)[0] == "cart position (m)"
+    assert dimension_names("MountainCar-v0", 2) == ["position", "velocity"]
+    assert dimension_names("Acrobot-v1", 6)[:2] == ["cos θ1", "sin θ1"]
+    assert dimension_names("Acrobot-v1", 6)[4].startswith("θ1 velocity")
+    assert dimension_names("Mine-v0", 2) == ["observation 0", "observation 1"]
+
+
+def test_seed_band_label_says_the_faint_lines_are_seed_averages() -> None:
+    rng = np.random.default_rng(0)
+    band = SeedBand("s", [rng.uniform(0, 500, 120) for _ in range(3)], [None] * 3)
+    label = reward_curve_figure([band], 475.0).axes[0].get_ylabel()
+    assert "each episode" not in label and "each seed" in label
+
+
+def test_runs_with_different_thresholds_draw_each() -> None:
+    rng = np.random.default_rng(0)
+    curves = [
+        Curve("short", rng.uniform(0, 100, 50), None, threshold=95.0),
+        Curve("long", rng.uniform(0, 500, 50), None, threshold=475.0),
+    ]
+    figure = reward_curve_figure(curves, None)
+    labels = [text.get_text() for text in figure.axes[0].get_legend().get_texts()]
+    assert "short: reward threshold 95" in labels and "long: reward threshold 475" in labels
+    same = [Curve("a", curves[0].returns, None, 475.0), Curve("b", curves[1].returns, None, 475.0)]
+    labels = [
+        t.get_text() for t in reward_curve_figure(same, None).axes[0].get_legend().get_texts()
+    ]
+    assert labels[-1] == "reward threshold 475" and len(labels) == 3
+
+
+def test_an_interrupted_run_says_so_on_its_plot(run_dir: Path, tmp_path: Path) -> None:
+    curve = Curve("run", np.arange(40.0), None, interrupted=True)
+    labels = [
+        t.get_text() for t in reward_curve_figure([curve], 475.0).axes[0].get_legend().get_texts()
+    ]
+    assert labels[0] == "run (interrupted at episode 40)"
+    band = SeedBand("seeds", [np.arange(40.0)] * 3, [None] * 3, interrupted=2)
+    labels = [
+        t.get_text() for t in reward_curve_figure([band], 475.0).axes[0].get_legend().get_texts()
+    ]
+    assert labels[0].endswith(", 2 interrupted")
 
 
 def test_bootstrap_band_brackets_the_mean() -> None:
@@ -127,9 +191,54 @@ def test_video_gif_decodes_with_the_renderer_size(run_dir: Path, tmp_path: Path)
     assert json.loads(result.stdout)["episodes"] == 2  # stdout stays pure JSON
     image = Image.open(gif)
     assert image.format == "GIF" and image.size == (600, 400)
-    assert image.n_frames == 500 // 3 + 1  # a 500-step episode, every third frame
-    image.seek(image.n_frames - 1)
-    image.load()
+    # a 500-step episode: every third step from 0 to 498, and the final step 500
+    assert image.n_frames == 500 // 3 + 2
+    durations = []
+    for index in range(image.n_frames):
+        image.seek(index)
+        image.load()
+        durations.append(image.info["duration"])
+    # CartPole's 50 steps per second: three steps are 60 ms, the last two 40 ms
+    assert set(durations[:-2]) == {60} and durations[-2:] == [40, FINAL_FRAME_MILLISECONDS]
+
+
+class _FakeEnv:
+    """An environment that only renders: a uniform frame at a given frame rate."""
+
+    def __init__(self, fps: float, colour: tuple[int, int, int]) -> None:
+        self.metadata = {"render_fps": fps}
+        self._frame = np.full((120, 300, 3), colour, dtype=np.uint8)
+
+    def render(self) -> np.ndarray:
+        return self._frame
+
+
+def _record(path: Path, env: _FakeEnv, lengths: list[int]) -> Image.Image:
+    recorder = VideoRecorder(path, episodes=len(lengths))
+    for episode, length in enumerate(lengths):
+        for step in range(length + 1):
+            recorder.on_frame(env, episode, step)
+    recorder.save()
+    return Image.open(path)
+
+
+def test_gif_timing_follows_the_environments_frame_rate(tmp_path: Path) -> None:
+    # Acrobot renders 15 steps per second: three steps last 200 ms
+    image = _record(tmp_path / "slow.gif", _FakeEnv(15, (255, 255, 255)), [7, 4])
+    durations = []
+    for index in range(image.n_frames):
+        image.seek(index)
+        durations.append(image.info["duration"])
+    # episode 1: steps 0, 3, 6, 7 (final); episode 2: steps 0, 3, 4 (final)
+    assert durations == [200, 200, 70, 500, 200, 70, 500]
+
+
+def test_gif_text_is_readable_on_dark_frames(tmp_path: Path) -> None:
+    image = _record(tmp_path / "dark.gif", _FakeEnv(50, (0, 0, 0)), [3]).convert("L")
+    text_area = np.asarray(image)[:30, :200]
+    assert (text_area > 200).sum() > 100  # white letters
+    image = _record(tmp_path / "light.gif", _FakeEnv(50, (255, 255, 255)), [3]).convert("L")
+    assert (np.asarray(image)[:30, :200] < 50).sum() > 100  # their black outline
 
 
 def test_render_without_a_display_is_refused(

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import random
@@ -13,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from PIL import Image
 from typer.testing import CliRunner
 
@@ -48,7 +50,12 @@ def _assert_same_results(run: Path, reference: Path) -> None:
     ):
         assert summary[key] == expected[key], key
     assert summary["interrupted"] is False
-    assert not (run / rundir.CHECKPOINT_FILE).exists()
+    # a run that reached train.episodes keeps its checkpoint, so that it can be extended
+    extendable = (
+        summary["solved_episode"] is None
+        or not load_config(run / "config.yaml").train.stop_when_solved
+    )
+    assert (run / rundir.CHECKPOINT_FILE).exists() == extendable
 
 
 @pytest.mark.parametrize("engine", ["numba", "gymnasium"])
@@ -86,9 +93,13 @@ def test_resume_refuses_a_finished_run_and_other_options(tmp_path: Path) -> None
     reference = _reference(tmp_path, {"train.episodes": 5})
     runner = CliRunner()
     result = runner.invoke(app, ["train", "--resume", str(reference)])
+    assert result.exit_code == 2 and "already finished all 5 episodes" in result.stderr
+    assert "--episodes N" in result.stderr
+    result = runner.invoke(app, ["train", "--resume", str(reference), "--episodes", "5"])
     assert result.exit_code == 2 and "already finished" in result.stderr
-    result = runner.invoke(app, ["train", "--resume", str(reference), "--seed", "3"])
-    assert result.exit_code == 2 and "--seed" in result.stderr
+    for option in (["--seed", "3"], ["--set", "seed=3"], ["-c", "blog"]):
+        result = runner.invoke(app, ["train", "--resume", str(reference), *option])
+        assert result.exit_code == 2 and option[0] in result.stderr
     result = runner.invoke(app, ["train", "--resume", str(tmp_path / "nothing")])
     assert result.exit_code == 2 and "not a run directory" in result.stderr
 
@@ -102,6 +113,152 @@ def test_damaged_checkpoint_is_refused(tmp_path: Path) -> None:
     (run / rundir.CHECKPOINT_FILE).write_bytes(b"PK\x03\x04 truncated")
     result = CliRunner().invoke(app, ["train", "--resume", str(run)])
     assert result.exit_code == 2 and "checkpoint is damaged" in result.stderr
+
+
+# -- resume checks the config it continues; a finished run can be extended (issue 8) ----
+
+
+def _interrupted(tmp_path: Path, overrides: dict, polls: int = 2) -> Path:
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    remaining = iter(range(polls, 0, -1))
+    execute_run(run, prepared, should_stop=lambda: next(remaining) <= 1)
+    assert (run / rundir.CHECKPOINT_FILE).is_file()
+    return run
+
+
+def _edit_config(run: Path, section: str, key: str, value: object) -> None:
+    path = run / "config.yaml"
+    data = yaml.safe_load(path.read_text())
+    data[section][key] = value
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+INTERRUPTIBLE = {
+    "seed": 4, "train.episodes": 120, "train.stop_when_solved": False,
+    "train.checkpoint_every": 20, "train.eval_every": 10,
+}  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("section", "key", "value", "named"),
+    [
+        ("agent", "gamma", 0.9, "agent.gamma: the run was trained with 0.995, config.yaml now says 0.9"),
+        ("discretization", "bins", [1, 1, 6, 12], "discretization.bins: the run was trained with [1, 1, 2, 10]"),
+        ("train", "eval_every", 5, "train.eval_every"),
+        ("train", "episodes", 30, "cannot be shortened to 30"),
+    ],
+)  # fmt: skip
+def test_resume_refuses_an_edited_config(
+    tmp_path: Path, section: str, key: str, value: object, named: str
+) -> None:
+    run = _interrupted(tmp_path, INTERRUPTIBLE)
+    checkpoint = (run / rundir.CHECKPOINT_FILE).read_bytes()
+    _edit_config(run, section, key, value)
+    result = CliRunner().invoke(app, ["train", "--resume", str(run)])
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output and named in result.stderr, result.stderr
+    assert result.stderr.strip().count("\n") == 0
+    # nothing was touched: put the value back and the run resumes
+    assert (run / rundir.CHECKPOINT_FILE).read_bytes() == checkpoint
+    assert (run / "summary.json").is_file()
+
+
+def test_a_checkpoint_without_a_recorded_config_still_refuses_other_bins(tmp_path: Path) -> None:
+    run = _interrupted(tmp_path, INTERRUPTIBLE)
+    checkpoint = rundir.load_checkpoint(run)
+    rundir.write_checkpoint(run, dataclasses.replace(checkpoint, config=None))
+    _edit_config(run, "discretization", "bins", [1, 1, 6, 12])
+    result = CliRunner().invoke(app, ["train", "--resume", str(run)])
+    assert result.exit_code == 2 and "discretization.bins" in result.stderr, result.output
+
+
+def test_an_interrupted_run_resumes_to_more_episodes_byte_identically(tmp_path: Path) -> None:
+    run = _interrupted(tmp_path, INTERRUPTIBLE)
+    _edit_config(run, "train", "episodes", 200)
+    result = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"])
+    assert result.exit_code == 0, result.output
+    _assert_same_results(run, _reference(tmp_path, {**INTERRUPTIBLE, "train.episodes": 200}))
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+@pytest.mark.parametrize("how", ["option", "config"])
+def test_a_finished_run_extends_byte_identically(tmp_path: Path, engine: str, how: str) -> None:
+    # episodes 120 stops before the solve (about episode 175); 230 goes past it
+    overrides = {**INTERRUPTIBLE, "engine": engine, "train.checkpoint_every": 25}
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    execute_run(run, prepared)
+    assert json.loads((run / "summary.json").read_text())["episodes"] == 120
+    assert (run / rundir.CHECKPOINT_FILE).is_file()
+    if how == "option":
+        args = ["train", "--resume", str(run), "--episodes", "230", "-q"]
+    else:
+        _edit_config(run, "train", "episodes", 230)
+        args = ["train", "--resume", str(run), "-q"]
+    result = CliRunner().invoke(app, args, catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    assert load_config(run / "config.yaml").train.episodes == 230
+    reference = _reference(tmp_path, {**overrides, "train.episodes": 230})
+    _assert_same_results(run, reference)
+    assert (run / "config.yaml").read_bytes() == (reference / "config.yaml").read_bytes()
+
+
+def test_a_run_stopped_at_its_solve_point_cannot_be_extended(tmp_path: Path) -> None:
+    reference = _reference(tmp_path, {"seed": 2, "train.episodes": 300})
+    summary = json.loads((reference / "summary.json").read_text())
+    assert summary["solved_episode"] == summary["episodes"] < 300
+    assert not (reference / rundir.CHECKPOINT_FILE).exists()
+    result = CliRunner().invoke(app, ["train", "--resume", str(reference), "--episodes", "400"])
+    assert result.exit_code == 2
+    assert "where it solved (train.stop_when_solved)" in result.stderr, result.stderr
+
+
+def test_a_multi_seed_resume_refuses_a_config_its_seeds_were_not_trained_with(
+    tmp_path: Path,
+) -> None:
+    run = tmp_path / "seeds"
+    result = CliRunner().invoke(
+        app,
+        ["train", "--seeds", "0-1", "--episodes", "5", "--workers", "1", "--out", str(run), "-q"],
+    )
+    assert result.exit_code == 0, result.output
+    (run / "summary.json").unlink()  # as if killed before the aggregate was written
+    _edit_config(run, "agent", "gamma", 0.9)
+    result = CliRunner().invoke(app, ["train", "--resume", str(run)])
+    assert result.exit_code == 2, result.output
+    assert "agent.gamma: seed-000 was trained with 0.995" in result.stderr, result.stderr
+    result = CliRunner().invoke(app, ["train", "--resume", str(run), "--episodes", "9"])
+    assert result.exit_code == 2 and "seed-NNN --episodes N" in result.stderr, result.stderr
+
+
+def test_write_run_refuses_a_non_empty_directory(tmp_path: Path) -> None:
+    import cartpole_q
+
+    result = cartpole_q.train({"seed": 3, "train": {"episodes": 5}})
+    assert result.config.seed == 3
+    run = tmp_path / "run"
+    cartpole_q.write_run(run, result)
+    before = {path.name: path.read_bytes() for path in run.iterdir()}
+    with pytest.raises(rundir.RunError, match="is not empty"):
+        cartpole_q.write_run(run, result)
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "notes.txt").write_text("mine")
+    with pytest.raises(rundir.RunError, match="is not empty"):
+        cartpole_q.write_run(str(tmp_path / "other"), result)
+    assert {path.name: path.read_bytes() for path in run.iterdir()} == before
+    cartpole_q.write_run(run, result, overwrite=True)
+
+
+def test_train_takes_a_path_a_name_or_a_mapping(tmp_path: Path) -> None:
+    import cartpole_q
+
+    path = write_yaml(tmp_path / "c.yaml", {"seed": 3, "train": {"episodes": 4}})
+    by_path = cartpole_q.train(path, final_eval=False)
+    by_mapping = cartpole_q.train({"seed": 3, "train": {"episodes": 4}}, final_eval=False)
+    assert by_path.config == by_mapping.config
+    assert np.array_equal(by_path.q_table, by_mapping.q_table)
+    assert cartpole_q.train("sutton_barto", final_eval=False).config.name == "sutton-barto"
 
 
 # -- real signals, in a subprocess ---------------------------------------------------------

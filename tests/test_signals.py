@@ -1,0 +1,265 @@
+"""Real signals to real multi-seed commands: exit 130 within seconds, no process left behind.
+
+Each command runs in its own session (``start_new_session``), so the test can signal the
+whole process group as a terminal's Ctrl-C does, and find every process the command
+started (workers, multiprocessing's resource tracker) by their session id, even after
+they have been orphaned.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from cartpole_q import rundir
+from cartpole_q.config import load_config
+from cartpole_q.multiseed import aggregate, run_seeds, seed_dir
+from cartpole_q.report import print_multi_summary
+from cartpole_q.runner import prepare, start_run
+from tests.conftest import invoke, write_yaml
+
+SEEDS = (0, 1, 2)
+# Two workers for three seeds: when the first checkpoint appears, seeds 0 and 1 are
+# training and seed 2 waits, so a stop always leaves work for --resume.
+MULTI_SEED = {
+    "name": "sig",
+    "engine": "numba",
+    "train": {
+        "episodes": 4000, "seeds": "0-2", "stop_when_solved": False,
+        "eval_every": 0, "checkpoint_every": 500,
+    },
+    "eval": {"episodes": 10},
+}  # fmt: skip
+RESULT_FILES = ("q_table.npy", "visits.npy", "metrics.csv")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An uninterrupted multi-seed run of ``MULTI_SEED``, trained in this process."""
+    base = tmp_path_factory.mktemp("signals")
+    config = write_yaml(base / "multi.yaml", MULTI_SEED)
+    prepared = prepare(load_config(config), str(config))
+    parent = start_run(prepared, base / "reference")
+    summary = run_seeds(prepared, parent, workers=1)
+    assert summary["finished"] == len(SEEDS)
+    return parent
+
+
+def _start(tmp_path: Path, *args: object) -> subprocess.Popen[bytes]:
+    """Start ``cartpole-q ARGS`` in a new session; its output goes to files in ``tmp_path``."""
+    with (tmp_path / "stdout").open("wb") as out, (tmp_path / "stderr").open("wb") as err:
+        return subprocess.Popen(
+            [sys.executable, "-m", "cartpole_q", *map(str, args)],
+            stdout=out, stderr=err, start_new_session=True, cwd=tmp_path,
+            env={**os.environ},  # the current numba cache (XDG_CACHE_HOME) stays warm
+        )  # fmt: skip
+
+
+def _session(sid: int) -> dict[int, str]:
+    """Live (not zombie) processes of session ``sid``: pid -> command line."""
+    found = {}
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            cmdline = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except OSError:
+            continue  # it ended meanwhile
+        state, _ppid, _pgrp, session = stat.rsplit(")", 1)[1].split()[:4]
+        if int(session) == sid and state != "Z":
+            found[int(entry.name)] = cmdline
+    return found
+
+
+def _wait_until(condition: Callable[[], bool], what: str, timeout: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"{what} never happened"
+        time.sleep(0.05)
+
+
+def _signal(process: subprocess.Popen[bytes], signum: int, count: int, group: bool) -> None:
+    for number in range(count):
+        if number:
+            time.sleep(0.2)  # two signals at once would reach the handler as one
+        if group:
+            os.killpg(process.pid, signum)
+        else:
+            process.send_signal(signum)
+
+
+def _assert_ends_cleanly(process: subprocess.Popen[bytes], tmp_path: Path) -> str:
+    """Exit code 130, no traceback, and no process of its session survives it."""
+    try:
+        process.wait(timeout=30)
+    finally:
+        if process.returncode is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    stderr = (tmp_path / "stderr").read_text()
+    left: dict[int, str] = {}
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline:
+        left = _session(process.pid)
+        if not left:
+            break
+        time.sleep(0.1)
+    for pid in left:  # do not leave them running after a failure either
+        os.kill(pid, signal.SIGKILL)
+    assert not left, f"processes left behind: {left}\n{stderr}"
+    assert process.returncode == 130, stderr
+    assert "Traceback" not in stderr, stderr
+    return stderr
+
+
+SIGNALS = [
+    pytest.param(signal.SIGTERM, 1, True, id="SIGTERM-group"),
+    pytest.param(signal.SIGINT, 2, True, id="SIGINT-twice-group"),
+    pytest.param(signal.SIGTERM, 2, False, id="SIGTERM-twice-parent"),
+]
+
+
+def _workers_running(process: subprocess.Popen[bytes]) -> Callable[[], bool]:
+    def running() -> bool:
+        session = _session(process.pid).values()
+        return sum("spawn_main" in cmdline for cmdline in session) >= 2
+
+    return running
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("signum", "count", "group", "starting"),
+    [
+        *[pytest.param(*param.values, False, id=param.id) for param in SIGNALS],
+        # While the workers are still starting (importing): they must ignore it already.
+        pytest.param(signal.SIGTERM, 1, True, True, id="SIGTERM-group-at-start"),
+    ],
+)
+def test_train_seeds_ends_on_signals_and_resumes_byte_identically(
+    reference: Path, tmp_path: Path, signum: int, count: int, group: bool, starting: bool
+) -> None:
+    config = write_yaml(tmp_path / "multi.yaml", MULTI_SEED)
+    parent = tmp_path / "run"
+    process = _start(tmp_path, "train", "-c", config, "--workers", 2, "--out", parent, "-q")
+    if starting:
+        _wait_until(_workers_running(process), "two worker processes starting")
+    else:
+        first = seed_dir(parent, SEEDS[0], SEEDS) / rundir.CHECKPOINT_FILE
+        _wait_until(first.exists, f"{first} appearing")
+        assert len(_session(process.pid)) >= 3, "the parent and its workers should be running"
+    _signal(process, signum, count, group)
+    stderr = _assert_ends_cleanly(process, tmp_path)
+    assert f"cartpole-q train --resume {parent}" in stderr
+    if count == 1:  # stopped at the end of an episode: the aggregate says what finished
+        summary = json.loads((parent / rundir.SUMMARY_FILE).read_text())
+        assert summary["interrupted"] is True and summary["finished"] < len(SEEDS)
+
+    resumed = subprocess.run(
+        [sys.executable, "-m", "cartpole_q", "train", "--resume", parent, "-q", "--workers", "2"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert resumed.returncode == 0, resumed.stderr
+    assert json.loads((parent / rundir.SUMMARY_FILE).read_text())["finished"] == len(SEEDS)
+    for seed in SEEDS:
+        for name in RESULT_FILES:
+            got = (seed_dir(parent, seed, SEEDS) / name).read_bytes()
+            assert got == (seed_dir(reference, seed, SEEDS) / name).read_bytes(), (seed, name)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("signum", "count", "group"), SIGNALS)
+def test_multi_seed_eval_ends_on_signals(
+    reference: Path, tmp_path: Path, signum: int, count: int, group: bool
+) -> None:
+    # Long enough never to finish: 10^6 greedy episodes of up to 500 steps per seed.
+    process = _start(tmp_path, "eval", reference, "--episodes", 10**6, "--workers", 2)
+
+    _wait_until(_workers_running(process), "two worker processes starting")
+    time.sleep(0.5)  # into their imports or their episodes
+    _signal(process, signum, count, group)
+    _assert_ends_cleanly(process, tmp_path)
+
+
+# -- an interrupted multi-seed run: what its summary and its evaluation say ---------------
+
+
+def _mark_interrupted(run: Path) -> None:
+    path = run / rundir.SUMMARY_FILE
+    summary = json.loads(path.read_text())
+    path.write_text(json.dumps({**summary, "interrupted": True}))
+
+
+def test_interrupted_multi_seed_summary_is_over_the_finished_seeds(
+    reference: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    parent = tmp_path / "parent"
+    shutil.copytree(reference, parent)
+    _mark_interrupted(seed_dir(parent, 1, SEEDS))
+    (seed_dir(parent, 2, SEEDS) / rundir.SUMMARY_FILE).unlink()  # killed: no result
+
+    summary = aggregate(parent, SEEDS, 1.0, interrupted=True)
+    assert summary["finished"] == 1 and summary["unfinished"] == 2
+    assert summary["successes"] == 1 and summary["success_rate"] == 1.0
+    assert summary["eval_mean"]["mean"] == 500.0
+    assert summary["interrupted_seeds"] == "1" and summary["no_result_seeds"] == "2"
+    print_multi_summary(parent, summary)
+    out = capsys.readouterr().out
+    assert "success                    1/1 greedy eval mean >= 475.0 (over the 1 finished" in out
+    assert "eval mean                  mean 500.0, min 500.0" in out
+    assert (
+        "unfinished                 2 of 3: seed 1 interrupted (greedy eval mean so far 500.0), "
+        "seed 2 without a result"
+    ) in out
+
+    _mark_interrupted(seed_dir(parent, 0, SEEDS))
+    summary = aggregate(parent, SEEDS, 1.0, interrupted=True)
+    assert summary["finished"] == 0 and summary["success_rate"] is None
+    print_multi_summary(parent, summary)
+    out = capsys.readouterr().out
+    assert "nan" not in out and "0/3" not in out
+    assert "success                    - (no seed has finished)" in out
+    assert "unfinished                 3 of 3: seeds 0-1 interrupted" in out
+
+
+def test_multi_seed_eval_names_missing_and_unfinished_seeds(
+    reference: Path, tmp_path: Path
+) -> None:
+    parent = tmp_path / "parent"
+    shutil.copytree(reference, parent)
+    shutil.rmtree(seed_dir(parent, 1, SEEDS))
+    _mark_interrupted(seed_dir(parent, 2, SEEDS))
+    note = (
+        f"{parent}: 2 of 3 seeds not evaluated: seed-001 is missing; seed-002 has not "
+        f"finished (finish them with `cartpole-q train --resume {parent}`)"
+    )
+
+    result = invoke("eval", parent, "--episodes", 2, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert [line.split(":")[0] for line in lines[:-2]] == ["seed 0"]
+    assert lines[-2].startswith(f"{parent}: 1/1 finished seeds with greedy mean >= 475")
+    assert lines[-1] == note
+
+    result = invoke("eval", parent, "--episodes", 2, "--workers", 1, "--json")
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    assert [run["run_seed"] for run in report["runs"]] == [0] and report["seeds"] == 3
+    assert report["missing"] == ["seed-001"] and report["unfinished"] == ["seed-002"]
+    assert result.stderr.strip() == f"warning: {note}"
+
+    shutil.rmtree(seed_dir(parent, 0, SEEDS))
+    result = invoke("eval", parent, "--episodes", 2)
+    assert result.exit_code == 2
+    assert "none of its seed runs has finished" in result.stderr
+    assert "seed-000, seed-001 are missing" in result.stderr
