@@ -1,0 +1,1 @@
+"""Making Gymnasium environments and their compiled twins."""
