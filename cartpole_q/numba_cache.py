@@ -38,6 +38,12 @@ COMPILED_MODULES = (
     "engines/gymnasium_engine.py",
     "engines/numba_engine.py",
     "engines/rng_handle.py",
+    "envs/twins/acrobot.py",
+    "envs/twins/mountaincar.py",
+    "rl/algorithms.py",
+    "rl/binning.py",
+    "rl/policy.py",
+    "rl/schedules.py",
 )
 """the modules whose functions numba compiles, or whose constants and functions they inline
 (a test checks that every module defining compiled functions is listed)"""
