@@ -40,6 +40,13 @@ class _Command(TyperCommand):
     as given (``[RUN_DIR]`` when optional, ``RUN_DIR...`` when repeatable).
     """
 
+    def format_help(self, ctx: Any, formatter: Any) -> None:
+        """Help without Typer's type column for arguments (``<list[Path]>``): the name says it."""
+        for param in self.params:
+            if param.param_type_name == "argument":
+                param.display_type_rich = lambda ctx: None  # type: ignore[attr-defined]
+        super().format_help(ctx, formatter)
+
     def collect_usage_pieces(self, ctx: Any) -> list[str]:
         """The usage line after the command's name."""
         pieces = [self.options_metavar] if self.options_metavar else []
@@ -140,16 +147,20 @@ def train(
             "--set agent.alpha=5e-4 --set discretization.bins=[1,1,6,12]. Repeatable.",
         ),
     ] = None,
-    seed: Annotated[int | None, typer.Option(min=0, help="Run seed (overrides `seed`).")] = None,
+    seed: Annotated[
+        int | None, typer.Option(metavar="N", min=0, help="Run seed (overrides `seed`).")
+    ] = None,
     seeds: Annotated[
         str | None,
         typer.Option(
-            help="Train one run per seed, in parallel, e.g. 0-99 or 0,3,7 (overrides `train.seeds`)."
+            metavar="LIST",
+            help="Train one run per seed, in parallel, e.g. 0-99 or 0,3,7 (overrides `train.seeds`).",
         ),
     ] = None,
     episodes: Annotated[
         int | None,
         typer.Option(
+            metavar="N",
             min=1,
             help="Training episodes (overrides `train.episodes`); with --resume, extend the "
             "run to N episodes in all.",
@@ -161,6 +172,7 @@ def train(
     out: Annotated[
         Path | None,
         typer.Option(
+            metavar="DIR",
             help="Run directory to create; it must not exist or be empty.",
             show_default="runs/<name>-<YYYYmmdd-HHMMSS>",
         ),
@@ -168,19 +180,41 @@ def train(
     resume: Annotated[
         Path | None,
         typer.Option(
+            metavar="DIR",
             help="Continue an interrupted run directory to its configured episodes, or "
-            "extend a run that reached them (with --episodes N, or a raised train.episodes)."
+            "extend a run that reached them (with --episodes N, or a raised train.episodes).",
         ),
     ] = None,
     workers: Annotated[
         int | None,
         typer.Option(
-            min=1, help="Worker processes for several seeds.", show_default="one per core"
+            metavar="N",
+            min=1,
+            help="Worker processes for several seeds.",
+            show_default="one per core",
         ),
     ] = None,
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="Print nothing but the run directory.")
     ] = False,
+    watch: Annotated[
+        int,
+        typer.Option(
+            metavar="N",
+            min=0,
+            help="Every N episodes, play one greedy episode in Gymnasium's window (needs a "
+            "display; one run only). 0: never.",
+        ),
+    ] = 0,
+    video_every: Annotated[
+        int,
+        typer.Option(
+            metavar="N",
+            min=0,
+            help="Every N episodes, record one greedy episode as videos/episode-NNNNNN.gif in "
+            "the run directory (one run only). 0: never.",
+        ),
+    ] = 0,
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with _exit_codes():
@@ -199,6 +233,7 @@ def train(
                     f"combined with {', '.join(clashing)} (only --episodes, to extend it)."
                 )
             prepared = runner.prepare_resume(resume, episodes)
+            _check_viewing(prepared.config.train.seeds, watch, video_every)
             run_dir = resume
         else:
             if seed is not None and seeds is not None:
@@ -213,14 +248,36 @@ def train(
             if engine is not None:
                 overrides["engine"] = engine.value
             loaded = load_config(config, overrides)
+            _check_viewing(loaded.train.seeds, watch, video_every)
             source = str(resolve_config_path(config)) if config else "default config"
             prepared = runner.prepare(loaded, source)
             run_dir = runner.start_run(prepared, out)
-        _train_into(run_dir, prepared, resume is not None, workers, quiet)
+        _train_into(run_dir, prepared, resume is not None, workers, quiet, watch, video_every)
+
+
+def _check_viewing(seeds: Any, watch: int, video_every: int) -> None:
+    """Refuse --watch and --video-every where they cannot work, before a run starts."""
+    if seeds is not None and (watch or video_every):
+        raise UserError(
+            "--watch and --video-every follow one run; with several seeds, train one of "
+            "them with --seed N to watch it."
+        )
+    if watch:
+        from cartpole_q.environment import display_problem
+
+        problem = display_problem()
+        if problem is not None:
+            raise UserError(f"--watch needs a window, but {problem}; use --video-every N instead.")
 
 
 def _train_into(
-    run_dir: Path, prepared: Any, resume: bool, workers: int | None, quiet: bool
+    run_dir: Path,
+    prepared: Any,
+    resume: bool,
+    workers: int | None,
+    quiet: bool,
+    watch: int = 0,
+    video_every: int = 0,
 ) -> None:
     from cartpole_q import runner
     from cartpole_q.progress import make_reporter
@@ -234,8 +291,9 @@ def _train_into(
         try:
             if seeds is None:
                 outcome = runner.execute_run(
-                    run_dir, prepared, resume=resume, should_stop=stop.is_set, reporter=reporter
-                )
+                    run_dir, prepared, resume=resume, should_stop=stop.is_set, reporter=reporter,
+                    watch_every=watch, video_every=video_every,
+                )  # fmt: skip
                 summary = outcome.summary
             else:
                 from cartpole_q.multiseed import default_workers, run_seeds
@@ -276,15 +334,25 @@ def configs_command() -> None:
 @app.command("eval", cls=_Command)
 def eval_command(
     run_dir: Annotated[
-        Path, typer.Argument(help="A run directory, or the parent of a multi-seed run.")
+        Path,
+        typer.Argument(
+            metavar="RUN_DIR", help="A run directory, or the parent of a multi-seed run."
+        ),
     ],
     episodes: Annotated[
         int | None,
-        typer.Option(min=1, help="Greedy episodes.", show_default="the run's eval.episodes"),
+        typer.Option(
+            metavar="N", min=1, help="Greedy episodes.", show_default="the run's eval.episodes"
+        ),
     ] = None,
     seed: Annotated[
         int | None,
-        typer.Option(min=0, help="Seed of the first reset.", show_default="the run's eval.seed"),
+        typer.Option(
+            metavar="N",
+            min=0,
+            help="Seed of the first reset.",
+            show_default="the run's eval.seed",
+        ),
     ] = None,
     json_output: Annotated[
         bool,
@@ -299,7 +367,7 @@ def eval_command(
         ),
     ] = None,
     video_episodes: Annotated[
-        int, typer.Option(min=1, help="How many of the episodes --video records.")
+        int, typer.Option(metavar="N", min=1, help="How many of the episodes --video records.")
     ] = 1,
     force: Annotated[
         bool, typer.Option("--force", help="Let --video replace an existing file.")
@@ -311,7 +379,10 @@ def eval_command(
     workers: Annotated[
         int | None,
         typer.Option(
-            min=1, help="Worker processes for a multi-seed run.", show_default="one per core"
+            metavar="N",
+            min=1,
+            help="Worker processes for a multi-seed run.",
+            show_default="one per core",
         ),
     ] = None,
 ) -> None:
@@ -396,7 +467,12 @@ def _eval_seeds(
 @app.command(cls=_Command)
 def plot(
     run_dirs: Annotated[
-        list[Path], typer.Argument(help="Run directories (single or multi-seed) to draw together.")
+        list[Path],
+        typer.Argument(
+            metavar="RUN_DIR",
+            help="Run directories (single or multi-seed) to draw together.",
+            show_default=False,
+        ),
     ],
     out: Annotated[
         Path | None,
@@ -418,6 +494,7 @@ def plot(
     dims: Annotated[
         str | None,
         typer.Option(
+            metavar="D1,D2",
             help="The two observation dimensions of --policy, e.g. 2,3.",
             show_default="the two with the most bins (pole angle, angular velocity)",
         ),

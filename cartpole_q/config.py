@@ -753,11 +753,11 @@ class _Reader:
                     else self.number("train.reward_threshold")
                 ),
                 eval_every=self.integer("train.eval_every", minimum=0),
-                eval_episodes=self.integer("train.eval_episodes", minimum=1),
+                eval_episodes=self.integer("train.eval_episodes", minimum=1, maximum=MAX_EPISODES),
                 checkpoint_every=self.integer("train.checkpoint_every", minimum=0),
             ),
             eval=EvalConfig(
-                episodes=self.integer("eval.episodes", minimum=1),
+                episodes=self.integer("eval.episodes", minimum=1, maximum=MAX_EPISODES),
                 seed=self.integer("eval.seed", minimum=0),
             ),
         )

@@ -393,17 +393,26 @@ class _PipeReporter:
         self._conn = conn
         self._min_interval = min_interval
         self._last = 0.0
+        self._unsent: Progress | None = None
 
     def start(self, key: Any, label: str, episodes: int) -> None:
         _send(self._conn, ("start", key, label, episodes))
 
     def update(self, key: Any, progress: Progress) -> None:
         now = time.monotonic()
+        self._unsent = progress
         if now - self._last >= self._min_interval:
             self._last = now
-            _send(self._conn, ("update", key, *dataclasses.astuple(progress)))
+            self._send_update(key)
+
+    def _send_update(self, key: Any) -> None:
+        if self._unsent is not None:
+            _send(self._conn, ("update", key, *dataclasses.astuple(self._unsent)))
+            self._unsent = None
 
     def finish(self, key: Any, line: str) -> None:
+        # the last update may have been throttled: the bar must end on the real count
+        self._send_update(key)
         _send(self._conn, ("finish", key, line))
 
     def close(self) -> None:

@@ -120,6 +120,8 @@ def execute_run(
     reporter: Reporter | None = None,
     key: Any = None,
     label: str | None = None,
+    watch_every: int = 0,
+    video_every: int = 0,
 ) -> Outcome:
     """Train ``prepared.config`` into ``run_dir`` (which holds its ``config.yaml``).
 
@@ -132,6 +134,10 @@ def execute_run(
         reporter: receives progress under ``key``.
         key: the reporter's key for this run.
         label: the reporter's label (default: the directory name).
+        watch_every: every this many episodes, play one greedy episode in Gymnasium's
+            window (``train --watch``; 0: never).
+        video_every: every this many episodes, record one greedy episode as
+            ``videos/episode-NNNNNN.gif`` in the run directory (``train --video-every``).
 
     Raises:
         RunError: ``resume`` and the checkpoint is missing or damaged.
@@ -157,10 +163,42 @@ def execute_run(
         should_stop=should_stop,
         on_progress=lambda progress: reporter.update(key, progress),
         on_checkpoint=lambda snapshot: rundir.write_checkpoint(run_dir, snapshot),
+        snapshot_every=math.gcd(watch_every, video_every),
+        on_snapshot=_greedy_viewer(run_dir, config, watch_every, video_every),
     )
     summary = rundir.write_run(run_dir, result, overwrite=True)
     reporter.finish(key, outcome_line(label or run_dir.name, summary))
     return Outcome(run_dir, result, summary)
+
+
+VIDEOS_DIR = "videos"
+"""where ``train --video-every`` puts its recordings, inside the run directory"""
+
+
+def _greedy_viewer(
+    run_dir: Path, config: Config, watch_every: int, video_every: int
+) -> Callable[[int, Any], None] | None:
+    """Show or record the current greedy policy at snapshots, as the options ask."""
+    if not (watch_every or video_every):
+        return None
+    from cartpole_q.evaluation import evaluate
+
+    def view(episode: int, q_table: Any) -> None:
+        if watch_every and episode % watch_every == 0:
+            evaluate(q_table, config, episodes=1, render_mode="human")
+        if video_every and episode % video_every == 0:
+            from cartpole_q.video import VideoRecorder, offscreen_rendering
+
+            videos = run_dir / VIDEOS_DIR
+            videos.mkdir(exist_ok=True)
+            path = videos / f"episode-{episode:06d}.gif"
+            with VideoRecorder(path, episodes=1, force=True) as recorder:
+                with offscreen_rendering():
+                    evaluate(q_table, config, episodes=1, render_mode="rgb_array",
+                             on_frame=recorder.on_frame)  # fmt: skip
+                recorder.save()
+
+    return view
 
 
 def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:

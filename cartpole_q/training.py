@@ -164,6 +164,8 @@ def train(
     on_progress: Callable[[Progress], None] | None = None,
     on_checkpoint: Callable[[Checkpoint], None] | None = None,
     final_eval: bool = True,
+    snapshot_every: int = 0,
+    on_snapshot: Callable[[int, np.ndarray], None] | None = None,
 ) -> TrainResult:
     """Train a Q-table as the config says.
 
@@ -177,6 +179,11 @@ def train(
         on_progress: called after every chunk.
         on_checkpoint: called every ``train.checkpoint_every`` episodes, and on interruption.
         final_eval: run the final greedy evaluation of the kept table.
+        snapshot_every: call ``on_snapshot`` every this many episodes (0: never), e.g. to
+            watch or record the greedy policy while it learns (``train --watch``,
+            ``--video-every``). Results do not depend on it.
+        on_snapshot: called with the episodes finished and a copy of the current table,
+            shape ``(*bins, n_actions)``.
 
     Raises:
         ConfigError: the config does not fit its environment.
@@ -193,7 +200,7 @@ def train(
     try:
         engine.warm_up(state)
         return _run(config, env_info, engine, state, resume, should_stop, on_progress,
-                    on_checkpoint, final_eval)  # fmt: skip
+                    on_checkpoint, final_eval, snapshot_every, on_snapshot)  # fmt: skip
     finally:
         engine.close()
 
@@ -208,8 +215,11 @@ def _run(
     on_progress: Callable[[Progress], None] | None,
     on_checkpoint: Callable[[Checkpoint], None] | None,
     final_eval: bool,
+    snapshot_every: int = 0,
+    on_snapshot: Callable[[int, np.ndarray], None] | None = None,
 ) -> TrainResult:
     settings = config.train
+    table_shape = (*config.discretization.bins, env_info.n_actions)
     total = settings.episodes
     train_seconds = 0.0 if resume is None else resume.train_seconds
     wall_before = 0.0 if resume is None else resume.wall_seconds
@@ -247,6 +257,7 @@ def _run(
             state.episode + engine.chunk_episodes,
             _next_multiple(state.episode, settings.eval_every),
             _next_multiple(state.episode, settings.checkpoint_every),
+            _next_multiple(state.episode, snapshot_every if on_snapshot else 0),
         )
         chunk_started = time.perf_counter()
         solved = engine.run(state, stop, check_solved=state.solved_episode is None)
@@ -263,6 +274,8 @@ def _run(
                 {"episode": state.episode, "env_steps": state.env_steps, **periodic.to_dict()}
             )
         finished = state.episode >= total or (solved is not None and settings.stop_when_solved)
+        if on_snapshot is not None and snapshot_every and state.episode % snapshot_every == 0:
+            on_snapshot(state.episode, state.q.reshape(table_shape).copy())
         if (
             on_checkpoint is not None
             and settings.checkpoint_every
@@ -292,7 +305,6 @@ def _run(
         report = EvalReport.from_returns(
             engine.evaluate(kept, config.eval.episodes, config.eval.seed), config.eval.seed
         )
-    table_shape = (*config.discretization.bins, env_info.n_actions)
     episode = state.episode
     return TrainResult(
         config=config,

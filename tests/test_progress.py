@@ -65,3 +65,20 @@ def test_plain_reporter_names_its_rate() -> None:
     reporter.start("run", "run", 10)
     reporter.update("run", _progress(5, 1000, 0.01))
     assert "train steps/s" in stream.getvalue()
+
+
+def test_a_workers_last_progress_reaches_the_parent_before_its_outcome() -> None:
+    import multiprocessing
+
+    from cartpole_q.multiseed import _PipeReporter
+
+    receiver, sender = multiprocessing.Pipe(duplex=False)
+    reporter = _PipeReporter(sender, min_interval=3600.0)
+    reporter.update("w", _progress(10, 300, 0.1))
+    reporter.update("w", _progress(173, 50_000, 0.2))  # throttled
+    reporter.finish("w", "seed 0: solved at episode 173")
+    messages = []
+    while receiver.poll():
+        messages.append(receiver.recv())
+    assert [m[0] for m in messages][-2:] == ["update", "finish"]
+    assert messages[-2][2] == 173
