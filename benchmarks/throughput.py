@@ -25,7 +25,7 @@ import numpy as np
 from rich.console import Console
 
 from cartpole_q.config import load_config
-from cartpole_q.environment import inspect_env
+from cartpole_q.envs.gym import inspect_env
 from cartpole_q.progress import RichReporter
 from cartpole_q.training import train
 

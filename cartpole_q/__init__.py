@@ -21,8 +21,8 @@ __all__ = ["__version__", "evaluate", "load_config", "load_run", "train", "write
 _LAZY = {
     "load_config": "cartpole_q.config",
     "evaluate": "cartpole_q.evaluation",
-    "load_run": "cartpole_q.rundir",
-    "write_run": "cartpole_q.rundir",
+    "load_run": "cartpole_q.store.rundir",
+    "write_run": "cartpole_q.store.rundir",
 }
 
 if TYPE_CHECKING:
@@ -31,7 +31,7 @@ if TYPE_CHECKING:
 
     from cartpole_q.config import Config, load_config
     from cartpole_q.evaluation import evaluate
-    from cartpole_q.rundir import load_run, write_run
+    from cartpole_q.store.rundir import load_run, write_run
     from cartpole_q.training import TrainResult
 
 

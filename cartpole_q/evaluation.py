@@ -7,18 +7,16 @@ environment's random stream.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from cartpole_q.config import MAX_EPISODES, Config, ConfigError
-from cartpole_q.discretize import state_index
 from cartpole_q.engines.base import AgentParams
-
-FrameCallback = Callable[[Any, int, int], None]
-"""called with ``(env, episode, step)`` after every reset and step, e.g. to render"""
+from cartpole_q.engines.play import FrameCallback, play_greedy
+from cartpole_q.envs.gym import inspect_env, make_env
+from cartpole_q.errors import RunError
 
 
 @dataclass(frozen=True)
@@ -62,47 +60,6 @@ class EvalReport:
         return cls(returns=tuple(float(r) for r in returns), seed=seed)
 
 
-def play_greedy(
-    env: Any,
-    q: np.ndarray,
-    params: AgentParams,
-    episodes: int,
-    seed: int,
-    on_frame: FrameCallback | None = None,
-) -> np.ndarray:
-    """Play the greedy policy of a 2-D ``(n_states, n_actions)`` Q-table.
-
-    Args:
-        env: a Gymnasium environment (from ``gymnasium.make``).
-        q: the Q-table as ``(n_states, n_actions)``.
-        params: the discretisation the table was trained with.
-        episodes: how many episodes to play.
-        seed: the seed of the first reset.
-        on_frame: called after every reset and step, e.g. to record video frames.
-
-    Returns:
-        The return of each episode.
-    """
-    # Plain Python lists make the uncompiled binning rule about twice as fast per step.
-    low, high, bins = params.low.tolist(), params.high.tolist(), params.bins.tolist()
-    returns = np.zeros(episodes, dtype=np.float64)
-    for episode in range(episodes):
-        observation, _ = env.reset(seed=seed if episode == 0 else None)
-        if on_frame is not None:
-            on_frame(env, episode, 0)
-        step = 0
-        while True:
-            action = int(np.argmax(q[state_index(observation, low, high, bins)]))
-            observation, reward, terminated, truncated, _ = env.step(action)
-            step += 1
-            returns[episode] += reward
-            if on_frame is not None:
-                on_frame(env, episode, step)
-            if terminated or truncated:
-                break
-    return returns
-
-
 def evaluate(
     q_table: np.ndarray,
     config: Config,
@@ -124,11 +81,8 @@ def evaluate(
 
     Raises:
         ConfigError: ``episodes`` is not between 1 and ``MAX_EPISODES``.
-        cartpole_q.rundir.RunError: the table does not fit the config and environment.
+        RunError: the table does not fit the config and environment.
     """
-    from cartpole_q.environment import inspect_env, make_env
-    from cartpole_q.rundir import check_q_table
-
     episodes = config.eval.episodes if episodes is None else episodes
     if not 1 <= episodes <= MAX_EPISODES:
         raise ConfigError(
@@ -141,8 +95,32 @@ def evaluate(
     env = make_env(config.env, render_mode=render_mode)
     try:
         returns = play_greedy(
-            env, q_table.reshape(-1, env_info.n_actions), params, episodes, seed, on_frame
+            env, q_table.reshape(-1, env_info.n_actions), params.grid, episodes, seed, on_frame
         )
     finally:
         env.close()
     return EvalReport.from_returns(returns, seed)
+
+
+def check_q_table(
+    q_table: np.ndarray, bins: tuple[int, ...], n_actions: int | None, source: str
+) -> None:
+    """Check a Q-table against its config's grid (and the environment's actions).
+
+    Raises:
+        RunError: wrong dtype or shape, or a non-finite value.
+    """
+    if q_table.dtype != np.float64:
+        raise RunError(f"{source}: must hold float64 values, found {q_table.dtype}.")
+    expected = f"(*bins, n_actions) = ({', '.join(map(str, bins))}, {n_actions or 'n_actions'})"
+    if q_table.ndim != len(bins) + 1 or tuple(q_table.shape[:-1]) != tuple(bins):
+        raise RunError(
+            f"{source}: has shape {q_table.shape}, which does not match its config: expected {expected}."
+        )
+    if n_actions is not None and q_table.shape[-1] != n_actions:
+        raise RunError(
+            f"{source}: has {q_table.shape[-1]} actions per state but the environment has "
+            f"{n_actions}: expected {expected}."
+        )
+    if not np.isfinite(q_table).all():
+        raise RunError(f"{source}: holds NaN or infinite values.")

@@ -21,9 +21,10 @@ import numpy as np
 
 from cartpole_q.config import Config
 from cartpole_q.engines import make_engine, resolve_engine
-from cartpole_q.engines.base import Engine, TrainingState
-from cartpole_q.environment import SOLVE_WINDOW, EnvInfo, inspect_env
+from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingState
+from cartpole_q.envs.gym import EnvInfo, inspect_env
 from cartpole_q.evaluation import EvalReport
+from cartpole_q.rl.solve import SOLVE_WINDOW
 
 
 def derive_generators(seed: int) -> tuple[np.random.Generator, int]:
@@ -73,12 +74,10 @@ class Checkpoint:
     engine: str
     episode: int
     env_steps: int
-    q: np.ndarray
-    visits: np.ndarray
-    returns: np.ndarray
-    lengths: np.ndarray
-    epsilons: np.ndarray
-    alphas: np.ndarray
+    tables: Tables
+    """the live tables (Double Q-learning's ``q_b`` included)"""
+    metrics: EpisodeMetrics
+    """the metrics of the finished episodes (views of the live arrays)"""
     agent_rng_state: dict[str, Any]
     env_rng_state: dict[str, Any]
     solved_episode: int | None
@@ -103,10 +102,8 @@ class TrainResult:
     """the episode after which the kept table was taken"""
     visits: np.ndarray
     """how often each (state, action) was taken in training, same shape as ``q_table``"""
-    returns: np.ndarray
-    lengths: np.ndarray
-    epsilons: np.ndarray
-    alphas: np.ndarray
+    metrics: EpisodeMetrics
+    """one value per training episode: returns, lengths, epsilons, alphas"""
     env_steps: int
     solved_episode: int | None
     """first episode whose 100-episode average return reached the threshold"""
@@ -124,7 +121,17 @@ class TrainResult:
     @property
     def episodes(self) -> int:
         """Episodes trained."""
-        return len(self.returns)
+        return len(self.metrics.returns)
+
+    @property
+    def returns(self) -> np.ndarray:
+        """The return of each training episode."""
+        return self.metrics.returns
+
+    @property
+    def lengths(self) -> np.ndarray:
+        """The length (env steps) of each training episode."""
+        return self.metrics.lengths
 
     @property
     def extendable(self) -> bool:
@@ -197,12 +204,23 @@ def train(
     engine = make_engine(
         engine_name, config, env_info, env_seed, None if resume is None else resume.env_rng_state
     )
+    hooks = _Hooks(should_stop, on_progress, on_checkpoint, snapshot_every, on_snapshot)
     try:
         engine.warm_up(state)
-        return _run(config, env_info, engine, state, resume, should_stop, on_progress,
-                    on_checkpoint, final_eval, snapshot_every, on_snapshot)  # fmt: skip
+        return _run(config, env_info, engine, state, resume, hooks, final_eval)
     finally:
         engine.close()
+
+
+@dataclass(frozen=True)
+class _Hooks:
+    """The caller's callbacks (see :func:`train`)."""
+
+    should_stop: Callable[[], bool] | None
+    on_progress: Callable[[Progress], None] | None
+    on_checkpoint: Callable[[Checkpoint], None] | None
+    snapshot_every: int
+    on_snapshot: Callable[[int, np.ndarray], None] | None
 
 
 def _run(
@@ -211,14 +229,16 @@ def _run(
     engine: Engine,
     state: TrainingState,
     resume: Checkpoint | None,
-    should_stop: Callable[[], bool] | None,
-    on_progress: Callable[[Progress], None] | None,
-    on_checkpoint: Callable[[Checkpoint], None] | None,
+    hooks: _Hooks,
     final_eval: bool,
-    snapshot_every: int = 0,
-    on_snapshot: Callable[[int, np.ndarray], None] | None = None,
 ) -> TrainResult:
     settings = config.train
+    should_stop, on_progress, on_checkpoint = (
+        hooks.should_stop,
+        hooks.on_progress,
+        hooks.on_checkpoint,
+    )
+    snapshot_every, on_snapshot = hooks.snapshot_every, hooks.on_snapshot
     table_shape = (*config.discretization.bins, env_info.n_actions)
     total = settings.episodes
     train_seconds = 0.0 if resume is None else resume.train_seconds
@@ -232,12 +252,8 @@ def _run(
             engine=engine.name,
             episode=episode,
             env_steps=state.env_steps,
-            q=state.q,
-            visits=state.visits,
-            returns=state.returns[:episode],
-            lengths=state.lengths[:episode],
-            epsilons=state.epsilons[:episode],
-            alphas=state.alphas[:episode],
+            tables=state.tables,
+            metrics=EpisodeMetrics(*(column[:episode] for column in state.metrics)),
             agent_rng_state=dict(state.agent_rng.bit_generator.state),
             env_rng_state=engine.env_rng_state(),
             solved_episode=state.solved_episode,
@@ -265,17 +281,18 @@ def _run(
         if solved is not None:
             state.solved_episode = solved + 1
             if not settings.stop_when_solved:
-                state.solved_q = state.q.copy()
+                state.solved_q = state.policy_table().copy()
         if settings.eval_every and state.episode % settings.eval_every == 0:
             periodic = EvalReport.from_returns(
-                engine.evaluate(state.q, settings.eval_episodes, config.eval.seed), config.eval.seed
+                engine.evaluate(state.policy_table(), settings.eval_episodes, config.eval.seed),
+                config.eval.seed,
             )
             state.evaluations.append(
                 {"episode": state.episode, "env_steps": state.env_steps, **periodic.to_dict()}
             )
         finished = state.episode >= total or (solved is not None and settings.stop_when_solved)
         if on_snapshot is not None and snapshot_every and state.episode % snapshot_every == 0:
-            on_snapshot(state.episode, state.q.reshape(table_shape).copy())
+            on_snapshot(state.episode, state.policy_table().reshape(table_shape).copy())
         if (
             on_checkpoint is not None
             and settings.checkpoint_every
@@ -296,10 +313,10 @@ def _run(
     wall_seconds = wall_before + time.perf_counter() - started
 
     if state.solved_episode is not None:
-        kept = state.q if state.solved_q is None else state.solved_q
+        kept = state.policy_table() if state.solved_q is None else state.solved_q
         kept_episode = state.solved_episode
     else:
-        kept, kept_episode = state.q, state.episode
+        kept, kept_episode = state.policy_table(), state.episode
     report: EvalReport | None = None
     if final_eval:
         report = EvalReport.from_returns(
@@ -311,11 +328,8 @@ def _run(
         engine=engine.name,
         q_table=kept.reshape(table_shape).copy(),
         kept_episode=kept_episode,
-        visits=state.visits.reshape(table_shape).copy(),
-        returns=state.returns[:episode].copy(),
-        lengths=state.lengths[:episode].copy(),
-        epsilons=state.epsilons[:episode].copy(),
-        alphas=state.alphas[:episode].copy(),
+        visits=state.tables.visits.reshape(table_shape).copy(),
+        metrics=state.metrics.head(episode),
         env_steps=state.env_steps,
         solved_episode=state.solved_episode,
         reward_threshold=env_info.reward_threshold,
@@ -329,12 +343,10 @@ def _run(
 
 def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     episode = checkpoint.episode
-    state.q[...] = checkpoint.q
-    state.visits[...] = checkpoint.visits
-    state.returns[:episode] = checkpoint.returns
-    state.lengths[:episode] = checkpoint.lengths
-    state.epsilons[:episode] = checkpoint.epsilons
-    state.alphas[:episode] = checkpoint.alphas
+    for live, saved in zip(state.tables, checkpoint.tables, strict=True):
+        live[...] = saved
+    for column, saved in zip(state.metrics, checkpoint.metrics, strict=True):
+        column[:episode] = saved
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
     state.episode = episode
     state.env_steps = checkpoint.env_steps
@@ -352,13 +364,14 @@ def _next_multiple(episode: int, every: int) -> int:
 
 def _progress(state: TrainingState, total: int, elapsed: float, train_seconds: float) -> Progress:
     episode = state.episode
-    window = state.returns[max(0, episode - SOLVE_WINDOW) : episode]
+    returns, epsilons = state.metrics.returns, state.metrics.epsilons
+    window = returns[max(0, episode - SOLVE_WINDOW) : episode]
     return Progress(
         episode=episode,
         episodes=total,
-        last_return=float(state.returns[episode - 1]) if episode else 0.0,
+        last_return=float(returns[episode - 1]) if episode else 0.0,
         moving_average=float(window.mean()) if episode else 0.0,
-        epsilon=float(state.epsilons[episode - 1]) if episode else 0.0,
+        epsilon=float(epsilons[episode - 1]) if episode else 0.0,
         env_steps=state.env_steps,
         elapsed=elapsed,
         solved_episode=state.solved_episode,

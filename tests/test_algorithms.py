@@ -11,10 +11,17 @@ from cartpole_q.rl.algorithms import (
     EXPECTED_SARSA,
     Q_LEARNING,
     SARSA,
-    first_action,
-    greedy_action,
-    learn_step,
+    STEP_FUNCTIONS,
 )
+from cartpole_q.rl.policy import epsilon_greedy, epsilon_greedy_on_sum
+
+
+def learn_step(algorithm, q, q_b, visits, *transition):  # type: ignore[no-untyped-def]
+    """What compiled code's ``learn_step`` becomes for a constant algorithm code."""
+    if algorithm == DOUBLE_Q_LEARNING:
+        return STEP_FUNCTIONS[algorithm](q, q_b, visits, *transition)
+    return STEP_FUNCTIONS[algorithm](q, visits, *transition)
+
 
 NO_B = np.zeros((0, 3))
 
@@ -133,6 +140,5 @@ def test_double_q_learning_acts_on_the_sum_of_its_tables() -> None:
     q_a = np.array([[0.0, 3.0, 1.0]])
     q_b = np.array([[5.0, 1.0, 1.0]])  # sums 5, 4, 2
     rng = np.random.default_rng(0)
-    assert first_action(DOUBLE_Q_LEARNING, q_a, q_b, 0, 0.0, rng) == 0
-    assert greedy_action(DOUBLE_Q_LEARNING, q_a, q_b, 0) == 0
-    assert first_action(Q_LEARNING, q_a, q_b, 0, 0.0, rng) == 1
+    assert epsilon_greedy_on_sum(q_a, q_b, 0, 0.0, rng) == 0
+    assert epsilon_greedy(q_a, 0, 0.0, rng) == 1

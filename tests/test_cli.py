@@ -153,10 +153,16 @@ def test_eval_and_plot(trained_run: Path, tmp_path: Path) -> None:
         assert image.size == (800, 450)
 
 
-def test_training_another_environment_uses_the_gymnasium_engine(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    ("kwargs", "engine"),
+    [({}, "numba"), ({"render_mode": "rgb_array"}, "gymnasium")],  # the twin cannot render
+)
+def test_training_another_environment_picks_its_engine(
+    tmp_path: Path, kwargs: dict, engine: str
+) -> None:
     config = write_yaml(tmp_path / "mc.yaml", {
         "name": "mountaincar",
-        "env": {"id": "MountainCar-v0"},
+        "env": {"id": "MountainCar-v0", "kwargs": kwargs},
         "discretization": {"bins": [6, 6], "low": [-1.2, -0.07], "high": [0.6, 0.07]},
         "train": {"episodes": 3, "eval_every": 0},
         "eval": {"episodes": 1},
@@ -164,7 +170,7 @@ def test_training_another_environment_uses_the_gymnasium_engine(tmp_path: Path) 
     result = invoke("train", "-c", config, "--out", tmp_path / "run", "-q")
     assert result.exit_code == 0, result.output
     summary = json.loads((tmp_path / "run/summary.json").read_text())
-    assert summary["engine"] == "gymnasium" and summary["env_steps"] == 600
+    assert summary["engine"] == engine and summary["env_steps"] == 600
     assert summary["reward_threshold"] == -110.0
 
 

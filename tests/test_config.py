@@ -348,13 +348,13 @@ def test_malformed_set_assignments_are_config_errors(text: str) -> None:
     ],
 )  # fmt: skip
 def test_cartpole_threshold_scales_with_the_time_limit(overrides: dict, threshold: float) -> None:
-    from cartpole_q.environment import inspect_env
+    from cartpole_q.envs.gym import inspect_env
 
     assert inspect_env(load_config(overrides=overrides)).reward_threshold == threshold
 
 
 def test_an_env_module_that_cannot_be_imported_is_a_config_error() -> None:
-    from cartpole_q.environment import inspect_env, make_env
+    from cartpole_q.envs.gym import inspect_env, make_env
 
     config = load_config(overrides={"env.id": "no_such_module_xyz:Env-v0"})
     with pytest.raises(ConfigError, match=r"^c\.yaml: env\.id: .*'no_such_module_xyz' cannot be"):

@@ -8,10 +8,11 @@ import pytest
 from gymnasium.utils import seeding
 
 from cartpole_q.config import ConfigError, load_config
-from cartpole_q.engines import cartpole_twin as twin
 from cartpole_q.engines import make_engine, resolve_engine
-from cartpole_q.environment import inspect_env
-from cartpole_q.rundir import atomic_save_npy, metrics_csv
+from cartpole_q.envs.gym import inspect_env
+from cartpole_q.envs.registry import TwinSettings, twin_settings
+from cartpole_q.envs.twins import cartpole as twin
+from cartpole_q.store.rundir import atomic_save_npy, metrics_csv
 from cartpole_q.training import derive_generators, train
 from tests.conftest import CONFIGS
 
@@ -19,12 +20,12 @@ from tests.conftest import CONFIGS
 def _compare_trajectory(env_kwargs: dict, seed: int, steps: int, choose) -> int:  # type: ignore[no-untyped-def]
     """Step Gymnasium and the twin side by side; return how many steps were compared."""
     env = gym.make("CartPole-v1", **env_kwargs)
-    settings = twin.twin_settings("CartPole-v1", env_kwargs, 500)
-    assert isinstance(settings, twin.TwinSettings)
+    settings = twin_settings("CartPole-v1", env_kwargs, 500)
+    assert isinstance(settings, TwinSettings)
     rng = seeding.np_random(seed)[0]
     state, observation = np.empty(4), np.empty(4, dtype=np.float32)
     gym_observation, _ = env.reset(seed=seed)
-    twin.reset(state, observation, rng)
+    twin.reset(state, observation, rng, settings.params)
     length = 0
     for step in range(steps):
         assert np.array_equal(state, env.unwrapped.state), f"state differs at step {step}"
@@ -33,14 +34,14 @@ def _compare_trajectory(env_kwargs: dict, seed: int, steps: int, choose) -> int:
         )
         action = choose(step, gym_observation)
         gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(action)
-        reward, terminated = twin.step(state, action, observation, settings.sutton_barto_reward)
+        reward, terminated = twin.step(state, action, observation, settings.params)
         length += 1
         truncated = length >= settings.max_episode_steps
         assert (reward, terminated, truncated) == (gym_reward, gym_terminated, gym_truncated), step
         assert state.dtype == np.float64 and observation.dtype == np.float32
         if terminated or truncated:
             gym_observation, _ = env.reset()
-            twin.reset(state, observation, rng)
+            twin.reset(state, observation, rng, settings.params)
             length = 0
     return steps
 
@@ -68,9 +69,9 @@ def test_twin_follows_closed_loop_play_exactly() -> None:
 
 
 def test_twin_refuses_what_it_cannot_reproduce() -> None:
-    assert "no compiled twin" in twin.twin_settings("MountainCar-v0", {}, 200)
-    assert "'render_mode'" in twin.twin_settings("CartPole-v1", {"render_mode": "human"}, 500)
-    assert "positive integer" in twin.twin_settings("CartPole-v1", {"max_episode_steps": 0}, 500)
+    assert "no compiled twin" in twin_settings("LunarLander-v3", {}, 1000)  # type: ignore[operator]
+    assert "'render_mode'" in twin_settings("CartPole-v1", {"render_mode": "human"}, 500)  # type: ignore[operator]
+    assert "positive integer" in twin_settings("CartPole-v1", {"max_episode_steps": 0}, 500)  # type: ignore[operator]
     config = load_config(overrides={"engine": "numba", "env.kwargs": {"render_mode": "rgb_array"}})
     with pytest.raises(
         ConfigError, match=r"engine: numba cannot run this config: env\.kwargs key 'render_mode'"
@@ -89,7 +90,7 @@ def _trained_bytes(
         overrides["train.episodes"] = episodes
     result = train(load_config(config_path, overrides), final_eval=False)
     assert result.engine == engine
-    return result.q_table.tobytes(), metrics_csv(result)
+    return result.q_table.tobytes(), metrics_csv(result.metrics)
 
 
 @pytest.mark.parametrize(
@@ -112,7 +113,7 @@ def test_numba_and_gymnasium_engines_give_byte_identical_runs(
         atomic_save_npy(directory / "q_table.npy", result.q_table)
         files[engine] = (
             (directory / "q_table.npy").read_bytes(),
-            metrics_csv(result),
+            metrics_csv(result.metrics),
             result.evaluations,
         )
         assert result.env_steps > 0
@@ -153,7 +154,7 @@ def test_chunking_does_not_change_results() -> None:
     chunked = train(load_config(overrides={**base, "train.eval_every": 7, "train.checkpoint_every": 13}),
                     on_checkpoint=lambda _: None, final_eval=False)  # fmt: skip
     assert plain.q_table.tobytes() == chunked.q_table.tobytes()
-    assert metrics_csv(plain) == metrics_csv(chunked)
+    assert metrics_csv(plain.metrics) == metrics_csv(chunked.metrics)
     assert len(chunked.evaluations) == 120 // 7
 
 
@@ -184,10 +185,11 @@ def test_kept_table_is_the_solve_point_when_training_goes_on() -> None:
 
 
 @pytest.mark.parametrize("name", ["numba", "gymnasium"])
-def test_warm_up_touches_no_state_and_draws_nothing(name: str) -> None:
+@pytest.mark.parametrize("algorithm", ["q_learning", "double_q_learning"])
+def test_warm_up_touches_no_state_and_draws_nothing(name: str, algorithm: str) -> None:
     from cartpole_q.engines.base import TrainingState
 
-    config = load_config()
+    config = load_config(overrides={"agent.algorithm": algorithm})
     info = inspect_env(config)
     rng = np.random.default_rng(5)
     generator_state = rng.bit_generator.state
@@ -197,4 +199,5 @@ def test_warm_up_touches_no_state_and_draws_nothing(name: str) -> None:
     engine.warm_up(state)
     assert rng.bit_generator.state == generator_state
     assert engine.env_rng_state() == env_state
-    assert (state.q == config.agent.q_init).all() and not state.visits.any() and state.episode == 0
+    assert (state.tables.q == config.agent.q_init).all() and not state.tables.visits.any()
+    assert state.episode == 0

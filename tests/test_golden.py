@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from cartpole_q.config import load_config
-from cartpole_q.rundir import metrics_csv
+from cartpole_q.store.rundir import metrics_csv
 from cartpole_q.training import train
 from tests.conftest import CONFIGS
 
@@ -36,4 +36,4 @@ def test_results_equal_the_recorded_ones(key: str, engine: str) -> None:
     buffer = io.BytesIO()
     np.save(buffer, result.q_table, allow_pickle=False)
     assert _sha256(buffer.getvalue()) == GOLDEN[key]["q_table.npy"]
-    assert _sha256(metrics_csv(result).encode()) == GOLDEN[key]["metrics.csv"]
+    assert _sha256(metrics_csv(result.metrics).encode()) == GOLDEN[key]["metrics.csv"]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from cartpole_q.config import load_config
-from cartpole_q.environment import inspect_env
+from cartpole_q.envs.gym import inspect_env
 from cartpole_q.evaluation import evaluate
 from cartpole_q.training import train
 from tests.conftest import CONFIGS

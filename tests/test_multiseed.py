@@ -9,8 +9,8 @@ import pytest
 from PIL import Image
 
 from cartpole_q.config import load_config
-from cartpole_q.multiseed import run_seeds, seed_dir
-from cartpole_q.runner import prepare, start_run
+from cartpole_q.experiments.multiseed import run_seeds, seed_dir
+from cartpole_q.experiments.run import prepare, start_run
 from tests.conftest import invoke
 
 

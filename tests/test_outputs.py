@@ -15,9 +15,10 @@ from typing import Any
 
 import pytest
 
-from cartpole_q import rundir
-from cartpole_q.environment import display_problem
-from cartpole_q.errors import UserError
+from cartpole_q.envs.gym import display_problem
+from cartpole_q.errors import UserError, WriteError
+from cartpole_q.store import atomic
+from cartpole_q.store.atomic import atomic_write_bytes
 from tests.conftest import invoke
 
 UNWRITABLE = [
@@ -94,7 +95,7 @@ def no_play(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.mark.parametrize(("path", "reason"), UNWRITABLE)
 def test_atomic_write_failure_is_a_user_error_naming_the_file(path: str, reason: str) -> None:
     with pytest.raises(UserError) as caught:
-        rundir.atomic_write_bytes(Path(path), b"data")
+        atomic_write_bytes(Path(path), b"data")
     assert str(caught.value).startswith(f"{path}: cannot be written: ")
     assert reason in str(caught.value)
 
@@ -122,9 +123,9 @@ def test_a_failed_write_leaves_no_partial_file(
 
     target = tmp_path / "curve.png"
     target.write_bytes(b"old")
-    monkeypatch.setattr(rundir, "open", FillsUp, raising=False)
-    with pytest.raises(rundir.WriteError, match="no space is left on the device"):
-        rundir.atomic_write_bytes(target, b"new content")
+    monkeypatch.setattr(atomic, "open", FillsUp, raising=False)
+    with pytest.raises(WriteError, match="no space is left on the device"):
+        atomic_write_bytes(target, b"new content")
     assert target.read_bytes() == b"old"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.png"]
 
@@ -282,10 +283,10 @@ def test_render_refuses_pygames_invisible_drivers(
 def test_recording_a_video_does_not_leave_the_dummy_driver_set(
     run_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    import cartpole_q.video
+    import cartpole_q.store.video
 
     monkeypatch.delenv("SDL_VIDEODRIVER", raising=False)
-    importlib.reload(cartpole_q.video)  # as if imported for the first time
+    importlib.reload(cartpole_q.store.video)  # as if imported for the first time
     result = invoke("eval", run_dir, "--episodes", "1", "--video", tmp_path / "v.gif")
     assert result.exit_code == 0, result.output
     assert "SDL_VIDEODRIVER" not in os.environ

@@ -11,7 +11,7 @@ import pytest
 from PIL import Image
 from rich.console import Console
 
-from cartpole_q.plotting import (
+from cartpole_q.figures import (
     Curve,
     SeedBand,
     action_names,
@@ -24,8 +24,8 @@ from cartpole_q.plotting import (
     reward_curve_figure,
 )
 from cartpole_q.progress import NullReporter, PlainReporter, RichReporter
+from cartpole_q.store.video import FINAL_FRAME_MILLISECONDS, VideoRecorder
 from cartpole_q.training import Progress
-from cartpole_q.video import FINAL_FRAME_MILLISECONDS, VideoRecorder
 from tests.conftest import invoke
 
 

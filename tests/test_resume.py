@@ -18,10 +18,11 @@ import yaml
 from PIL import Image
 from typer.testing import CliRunner
 
-from cartpole_q import rundir
 from cartpole_q.cli import app
 from cartpole_q.config import load_config
-from cartpole_q.runner import execute_run, prepare, start_run
+from cartpole_q.experiments.run import execute_run, prepare, start_run
+from cartpole_q.store import rundir
+from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
 from tests.conftest import write_yaml
 
 RESULT_FILES = ("q_table.npy", "visits.npy", "metrics.csv", "evaluations.csv")
@@ -166,8 +167,8 @@ def test_resume_refuses_an_edited_config(
 
 def test_a_checkpoint_without_a_recorded_config_still_refuses_other_bins(tmp_path: Path) -> None:
     run = _interrupted(tmp_path, INTERRUPTIBLE)
-    checkpoint = rundir.load_checkpoint(run)
-    rundir.write_checkpoint(run, dataclasses.replace(checkpoint, config=None))
+    checkpoint = load_checkpoint(run)
+    write_checkpoint(run, dataclasses.replace(checkpoint, config=None))
     _edit_config(run, "discretization", "bins", [1, 1, 6, 12])
     result = CliRunner().invoke(app, ["train", "--resume", str(run)])
     assert result.exit_code == 2 and "discretization.bins" in result.stderr, result.output
@@ -291,7 +292,7 @@ def _check_every_file_loads(run: Path) -> int:
         if path.suffix == ".yaml":
             load_config(path)
         elif path.name == rundir.CHECKPOINT_FILE:
-            rundir.load_checkpoint(run)
+            load_checkpoint(run)
         elif path.suffix == ".npy":
             assert np.load(path, allow_pickle=False).size > 0
         elif path.suffix == ".csv":

@@ -20,11 +20,11 @@ from pathlib import Path
 
 import pytest
 
-from cartpole_q import rundir
+from cartpole_q.cli.report import print_multi_summary
 from cartpole_q.config import load_config
-from cartpole_q.multiseed import aggregate, run_seeds, seed_dir
-from cartpole_q.report import print_multi_summary
-from cartpole_q.runner import prepare, start_run
+from cartpole_q.experiments.multiseed import aggregate, run_seeds, seed_dir
+from cartpole_q.experiments.run import prepare, start_run
+from cartpole_q.store import rundir
 from tests.conftest import invoke, write_yaml
 
 SEEDS = (0, 1, 2)

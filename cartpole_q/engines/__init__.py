@@ -1,8 +1,8 @@
-"""Training engines: ``gymnasium`` (real environments) and ``numba`` (compiled twin).
+"""Training engines: ``gymnasium`` (real environments) and ``numba`` (compiled twins).
 
-Both drive the same agent functions with the same random draws; choosing one changes
-speed, never results. Engine modules are imported only when an engine is made, so this
-package costs nothing to import.
+Both drive the same compiled step functions with the same random draws; choosing one
+changes speed, never results. Engine modules are imported only when an engine is made, so
+this package costs nothing to import.
 """
 
 from __future__ import annotations
@@ -11,17 +11,17 @@ from typing import Any
 
 from cartpole_q.config import Config, ConfigError
 from cartpole_q.engines.base import AgentParams, Engine
-from cartpole_q.environment import EnvInfo
+from cartpole_q.envs.gym import EnvInfo
 
 
 def resolve_engine(config: Config, env_info: EnvInfo, source: str = "config") -> str:
     """Return the engine that will run: ``auto`` becomes numba where a twin exists.
 
     Raises:
-        ConfigError: ``engine: numba`` was asked for an environment the twin cannot
-            reproduce (the message names the id or key).
+        ConfigError: ``engine: numba`` was asked for an environment no twin reproduces
+            (the message names the id or key).
     """
-    from cartpole_q.engines.cartpole_twin import TwinSettings, twin_settings
+    from cartpole_q.envs.registry import TwinSettings, twin_settings
 
     if config.engine == "gymnasium":
         return "gymnasium"
@@ -49,8 +49,8 @@ def make_engine(
     """
     params = AgentParams.from_config(config, env_info)
     if name == "numba":
-        from cartpole_q.engines.cartpole_twin import TwinSettings, twin_settings
         from cartpole_q.engines.numba_engine import NumbaEngine
+        from cartpole_q.envs.registry import TwinSettings, twin_settings
 
         settings = twin_settings(config.env.id, config.env.kwargs, env_info.max_episode_steps)
         assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it

@@ -1,39 +1,105 @@
-"""What every engine shares: the agent's parameters, the training state, the interface."""
+"""What every engine shares: parameters as compiled code takes them, state, interface.
+
+The compiled code takes a few typed records (named tuples of numbers and arrays) rather
+than long lists of positional arguments: :class:`Grid`, :class:`AgentRecord`,
+:class:`Tables` and :class:`EpisodeMetrics`.
+"""
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from cartpole_q.config import Config, Schedule
-from cartpole_q.environment import EnvInfo
-
-ScheduleParams = tuple[int, float, float, float]
+from cartpole_q.config import ALGORITHMS, Config, Schedule
+from cartpole_q.envs.gym import EnvInfo
 
 
-def schedule_params(schedule: Schedule) -> ScheduleParams:
-    """Return a schedule as the ``(kind, start, end, rate)`` tuple the compiled code takes."""
-    return (schedule.code, schedule.start, schedule.end, schedule.rate)
+class ScheduleRecord(NamedTuple):
+    """A schedule as the compiled code takes it (see :mod:`cartpole_q.rl.schedules`)."""
+
+    kind: int
+    start: float
+    end: float
+    rate: float
+
+    @classmethod
+    def of(cls, schedule: Schedule) -> ScheduleRecord:
+        """The record of a config's schedule."""
+        return cls(schedule.code, schedule.start, schedule.end, schedule.rate)
+
+
+class AgentRecord(NamedTuple):
+    """The algorithm and its hyperparameters, as the compiled code takes them."""
+
+    algorithm: int
+    """the code of ``agent.algorithm`` (see :mod:`cartpole_q.rl.algorithms`)"""
+    gamma: float
+    alpha: ScheduleRecord
+    epsilon: ScheduleRecord
+    threshold: float
+    """the solve threshold; ``inf`` when the environment has none (never solved)"""
+
+
+class Grid(NamedTuple):
+    """The binning grid: float64 edges and int64 bins per observation dimension."""
+
+    low: np.ndarray
+    high: np.ndarray
+    bins: np.ndarray
+
+
+class Tables(NamedTuple):
+    """The learned tables, as 2-D ``(n_states, n_actions)`` views.
+
+    ``q_b`` is Double Q-learning's second table (``(0, n_actions)`` for the others).
+    """
+
+    q: np.ndarray
+    q_b: np.ndarray
+    visits: np.ndarray
+
+
+class EpisodeMetrics(NamedTuple):
+    """One value per training episode: the columns of ``metrics.csv`` after ``episode``."""
+
+    returns: np.ndarray
+    """float64"""
+    lengths: np.ndarray
+    """int64"""
+    epsilons: np.ndarray
+    """float64"""
+    alphas: np.ndarray
+    """float64"""
+
+    @classmethod
+    def empty(cls, episodes: int) -> EpisodeMetrics:
+        """Zeroed arrays for ``episodes`` episodes."""
+        return cls(
+            np.zeros(episodes, dtype=np.float64),
+            np.zeros(episodes, dtype=np.int64),
+            np.zeros(episodes, dtype=np.float64),
+            np.zeros(episodes, dtype=np.float64),
+        )
+
+    def head(self, episodes: int) -> EpisodeMetrics:
+        """Copies of the first ``episodes`` values."""
+        return EpisodeMetrics(*(column[:episodes].copy() for column in self))
 
 
 @dataclass(frozen=True)
 class AgentParams:
-    """The config's agent settings as the arrays and numbers the compiled functions take."""
+    """A config's grid and agent settings, ready for the compiled code."""
 
-    low: np.ndarray
-    """grid lower edges, float64"""
-    high: np.ndarray
-    """grid upper edges, float64"""
-    bins: np.ndarray
-    """bins per dimension, int64"""
-    gamma: float
-    alpha: ScheduleParams
-    epsilon: ScheduleParams
-    threshold: float
-    """the solve threshold; ``inf`` when the environment has none (never solved)"""
+    grid: Grid
+    agent: AgentRecord
+
+    @property
+    def double(self) -> bool:
+        """Whether the algorithm keeps two tables (Double Q-learning)."""
+        return self.agent.algorithm == ALGORITHMS.index("double_q_learning")
 
     @classmethod
     def from_config(cls, config: Config, env_info: EnvInfo) -> AgentParams:
@@ -41,13 +107,18 @@ class AgentParams:
         d = config.discretization
         threshold = env_info.reward_threshold
         return cls(
-            low=np.array(d.low, dtype=np.float64),
-            high=np.array(d.high, dtype=np.float64),
-            bins=np.array(d.bins, dtype=np.int64),
-            gamma=config.agent.gamma,
-            alpha=schedule_params(config.agent.alpha),
-            epsilon=schedule_params(config.agent.epsilon),
-            threshold=math.inf if threshold is None else float(threshold),
+            grid=Grid(
+                np.array(d.low, dtype=np.float64),
+                np.array(d.high, dtype=np.float64),
+                np.array(d.bins, dtype=np.int64),
+            ),
+            agent=AgentRecord(
+                algorithm=ALGORITHMS.index(config.agent.algorithm),
+                gamma=config.agent.gamma,
+                alpha=ScheduleRecord.of(config.agent.alpha),
+                epsilon=ScheduleRecord.of(config.agent.epsilon),
+                threshold=math.inf if threshold is None else float(threshold),
+            ),
         )
 
 
@@ -55,18 +126,14 @@ class AgentParams:
 class TrainingState:
     """Everything that changes while training; an engine advances it episode by episode.
 
-    ``q`` and ``visits`` are the 2-D ``(n_states, n_actions)`` views the compiled code
-    addresses; the per-episode arrays are allocated for the configured episodes and filled
-    up to ``episode``.
+    The tables are the 2-D ``(n_states, n_actions)`` views the compiled code addresses;
+    the per-episode metrics are allocated for the configured episodes and filled up to
+    ``episode``.
     """
 
-    q: np.ndarray
-    visits: np.ndarray
+    tables: Tables
     agent_rng: np.random.Generator
-    returns: np.ndarray
-    lengths: np.ndarray
-    epsilons: np.ndarray
-    alphas: np.ndarray
+    metrics: EpisodeMetrics
     episode: int = 0
     """episodes finished"""
     env_steps: int = 0
@@ -74,7 +141,7 @@ class TrainingState:
     solved_episode: int | None = None
     """1-based episode at which the 100-episode average first reached the threshold"""
     solved_q: np.ndarray | None = None
-    """a copy of ``q`` at the solve point, kept when training goes on past it"""
+    """the policy table at the solve point, kept when training goes on past it"""
     evaluations: list[dict[str, Any]] = field(default_factory=list)
     """periodic greedy evaluations: episode, env_steps, mean, std, min, max"""
 
@@ -84,20 +151,30 @@ class TrainingState:
     ) -> TrainingState:
         """Allocate the state of a run that has not started."""
         n_states = math.prod(config.discretization.bins)
-        episodes = config.train.episodes
+        shape = (n_states, env_info.n_actions)
+        double = config.agent.algorithm == "double_q_learning"
         return cls(
-            q=np.full((n_states, env_info.n_actions), config.agent.q_init, dtype=np.float64),
-            visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
+            tables=Tables(
+                q=np.full(shape, config.agent.q_init, dtype=np.float64),
+                q_b=np.full(shape if double else (0, shape[1]), config.agent.q_init),
+                visits=np.zeros(shape, dtype=np.int64),
+            ),
             agent_rng=agent_rng,
-            returns=np.zeros(episodes, dtype=np.float64),
-            lengths=np.zeros(episodes, dtype=np.int64),
-            epsilons=np.zeros(episodes, dtype=np.float64),
-            alphas=np.zeros(episodes, dtype=np.float64),
+            metrics=EpisodeMetrics.empty(config.train.episodes),
         )
+
+    def policy_table(self) -> np.ndarray:
+        """The table whose greedy actions are the policy: ``Q``, or ``0.5 * (A + B)``.
+
+        Halving is exact in binary floating point, so ``0.5 * (A + B)`` has the greedy
+        actions (and ties) of ``A + B``, on which Double Q-learning acts.
+        """
+        q, q_b = self.tables.q, self.tables.q_b
+        return 0.5 * (q + q_b) if q_b.size else q
 
 
 class Engine(Protocol):
-    """Drives an environment around the shared agent functions."""
+    """Drives an environment around the shared compiled step functions."""
 
     name: str
     """``numba`` or ``gymnasium``, as recorded in ``summary.json``"""

@@ -1,43 +1,58 @@
-"""The gymnasium engine: real ``gymnasium.make`` environments, stepped from Python."""
+"""The gymnasium engine: real ``gymnasium.make`` environments, stepped from Python.
+
+Each step calls compiled code built on the same
+:func:`~cartpole_q.rl.algorithms.learn_step` as the numba engine's loop.
+"""
 
 from __future__ import annotations
 
+import functools
 from typing import Any
 
 import numpy as np
-from numba import njit
 
-from cartpole_q.agent import (
-    begin_episode,
-    learn_step,
+from cartpole_q.config import Config
+from cartpole_q.engines.base import AgentParams, Tables, TrainingState
+from cartpole_q.engines.kernel import (
+    compiled,
+    episode_rates,
     reaches_threshold,
     record_episode,
-    schedule_value,
 )
-from cartpole_q.config import Config
-from cartpole_q.engines.base import AgentParams, TrainingState
+from cartpole_q.engines.play import play_greedy
 from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
-from cartpole_q.environment import make_env
-from cartpole_q.evaluation import play_greedy
+from cartpole_q.envs.gym import make_env
 from cartpole_q.numba_cache import configure as configure_numba_cache
+from cartpole_q.rl.algorithms import ENDED, first_action, learn_step
+from cartpole_q.rl.policy import state_index
 
 configure_numba_cache()  # before any cache=True function is defined
 
 
-@njit(cache=True, nogil=True)
-def _begin(handle, q, observation, low, high, bins, epsilon):
-    return begin_episode(q, observation, low, high, bins, epsilon, handle.rng)
+@functools.cache
+def step_functions(algorithm: int) -> tuple[Any, Any]:
+    """The compiled first and next step of one algorithm, for a Python loop.
 
+    They take the agent's generator wrapped in a handle (see :mod:`rng_handle`) and call
+    :func:`~cartpole_q.rl.algorithms.first_action` and
+    :func:`~cartpole_q.rl.algorithms.learn_step` with the algorithm as a constant, as the
+    numba engine's loop does.
+    """
 
-@njit(cache=True, nogil=True)
-def _learn(
-    handle, q, visits, state, action, reward, observation, terminated, truncated,
-    low, high, bins, alpha, gamma, epsilon,
-):  # fmt: skip
-    return learn_step(
-        q, visits, state, action, reward, observation, terminated, truncated,
-        low, high, bins, alpha, gamma, epsilon, handle.rng,
-    )  # fmt: skip
+    def first(handle, tables, grid, observation, epsilon):
+        state = state_index(observation, grid.low, grid.high, grid.bins)
+        return state, first_action(algorithm, tables.q, tables.q_b, state, epsilon, handle.rng)
+
+    def following(handle, tables, grid, gamma, state, action, reward, observation,
+                  terminated, truncated, alpha, epsilon):  # fmt: skip
+        next_state = state_index(observation, grid.low, grid.high, grid.bins)
+        next_action = learn_step(
+            algorithm, tables.q, tables.q_b, tables.visits, state, action, reward, next_state,
+            terminated, truncated, alpha, gamma, epsilon, handle.rng,
+        )  # fmt: skip
+        return next_state, next_action
+
+    return compiled(first, f"first_step_{algorithm}"), compiled(following, f"next_step_{algorithm}")
 
 
 class GymnasiumEngine:
@@ -66,10 +81,12 @@ class GymnasiumEngine:
             generator.bit_generator.state = env_rng_state
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
+        self._first, self._next = step_functions(params.agent.algorithm)
         self._handle: GeneratorHandle | None = None
         self._handle_rng: np.random.Generator | None = None
 
     def _rng_handle(self, rng: np.random.Generator) -> GeneratorHandle:
+        # A numba call that takes a Generator costs ~6 microseconds; a handle ~0.5.
         if self._handle_rng is not rng:
             self._handle, self._handle_rng = wrap_generator(rng), rng
         assert self._handle is not None
@@ -77,33 +94,25 @@ class GymnasiumEngine:
 
     def run(self, state: TrainingState, stop: int, check_solved: bool) -> int | None:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`)."""
-        p, env, q, visits = self._params, self._env, state.q, state.visits
-        low, high, bins, gamma = p.low, p.high, p.bins, p.gamma
+        grid, agent = self._params.grid, self._params.agent
+        env, tables, metrics = self._env, state.tables, state.metrics
         handle = self._rng_handle(state.agent_rng)
         for episode in range(state.episode, stop):
-            epsilon = schedule_value(*p.epsilon, episode)
-            alpha = schedule_value(*p.alpha, episode)
+            epsilon, alpha = episode_rates(agent, episode)
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
-            s, a = _begin(handle, q, observation, low, high, bins, epsilon)
+            s, a = self._first(handle, tables, grid, observation, epsilon)
             episode_return, length = 0.0, 0
-            while True:
+            while a != ENDED:
                 observation, reward, terminated, truncated, _ = env.step(a)
                 length += 1
                 episode_return += reward
-                s, a = _learn(
-                    handle, q, visits, s, a, float(reward), observation, terminated, truncated,
-                    low, high, bins, alpha, gamma, epsilon,
-                )  # fmt: skip
-                if terminated or truncated:
-                    break
-            record_episode(
-                state.returns, state.lengths, state.epsilons, state.alphas,
-                episode, episode_return, length, epsilon, alpha,
-            )  # fmt: skip
+                s, a = self._next(handle, tables, grid, agent.gamma, s, a, float(reward),
+                                  observation, terminated, truncated, alpha, epsilon)  # fmt: skip
+            record_episode(metrics, episode, episode_return, length, epsilon, alpha)
             state.episode = episode + 1
             state.env_steps += length
-            if check_solved and reaches_threshold(state.returns, episode, p.threshold):
+            if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
                 return episode
         return None
 
@@ -111,23 +120,28 @@ class GymnasiumEngine:
         """Compile the per-step functions on a one-row scratch table.
 
         The observation sits on every lower grid edge, so it maps to row 0; epsilon 0 and a
-        terminated step draw nothing from the agent's generator.
+        terminated step draw nothing from the agent's generator, except Double
+        Q-learning's coin, which is drawn from a scratch generator here.
         """
-        p = self._params
+        grid, agent = self._params.grid, self._params.agent
         space = self._env.observation_space
-        observation = p.low.astype(space.dtype)
-        q = np.zeros((1, state.q.shape[1]))
-        visits = np.zeros((1, state.q.shape[1]), dtype=np.int64)
-        handle = self._rng_handle(state.agent_rng)
-        _begin(handle, q, observation, p.low, p.high, p.bins, 0.0)
-        _learn(handle, q, visits, 0, 0, 0.0, observation, True, False,
-               p.low, p.high, p.bins, 0.0, p.gamma, 0.0)  # fmt: skip
+        observation = grid.low.astype(space.dtype)
+        n_actions = state.tables.q.shape[1]
+        scratch = Tables(
+            np.zeros((1, n_actions)),
+            np.zeros((1 if state.tables.q_b.size else 0, n_actions)),
+            np.zeros((1, n_actions), dtype=np.int64),
+        )
+        handle = wrap_generator(np.random.default_rng(0))
+        self._first(handle, scratch, grid, observation, 0.0)
+        self._next(handle, scratch, grid, agent.gamma, 0, 0, 0.0, observation, True, False,
+                   0.0, 0.0)  # fmt: skip
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
         env = make_env(self._config.env)
         try:
-            return play_greedy(env, q, self._params, episodes, seed)
+            return play_greedy(env, q, self._params.grid, episodes, seed)
         finally:
             env.close()
 

@@ -178,7 +178,8 @@ def iqm_rows(samples: ArrayLike) -> FloatArray:
     if n == 0:
         return np.full(ordered.shape[0], _NAN)
     cut = int(0.25 * n)
-    return ordered[:, cut : n - cut].mean(axis=1)
+    trimmed: np.ndarray = ordered[:, cut : n - cut].mean(axis=1)
+    return trimmed
 
 
 def iqm(values: ArrayLike) -> float:
@@ -286,7 +287,8 @@ def improvement_rows(x_samples: ArrayLike, y_samples: ArrayLike) -> FloatArray:
             for start in range(0, rows, block)
         ]
     )
-    return (rank_sums - n * (n + 1) / 2.0) / (n * m)
+    improvement: np.ndarray = (rank_sums - n * (n + 1) / 2.0) / (n * m)
+    return improvement
 
 
 def _x_rank_sums(x: FloatArray, y: FloatArray) -> FloatArray:
@@ -306,7 +308,8 @@ def _x_rank_sums(x: FloatArray, y: FloatArray) -> FloatArray:
     first = np.maximum.accumulate(np.where(starts, positions, 0), axis=1)
     last = np.minimum.accumulate(np.where(ends, positions, total - 1)[:, ::-1], axis=1)[:, ::-1]
     mid_ranks = (first + last) / 2.0 + 1.0
-    return np.where(order < n, mid_ranks, 0.0).sum(axis=1)
+    sums: np.ndarray = np.where(order < n, mid_ranks, 0.0).sum(axis=1)
+    return sums
 
 
 # ------------------------------------------------------------------------------ bootstrap

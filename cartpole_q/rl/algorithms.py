@@ -10,16 +10,16 @@ Stated precisely in ``design.md`` ("Algorithms"); per step, after the environmen
 - the next action is the epsilon-greedy draw for the next state, made only when the
   episode goes on, except for SARSA, which draws it before its update, also at truncation.
 
-Every function takes the same arguments, so that the training loops of both engines call
-:func:`learn_step` and :func:`first_action` with an algorithm code and nothing is written
-twice. ``q_b`` is Double Q-learning's second table; the other algorithms ignore it (an
-empty ``(0, n_actions)`` array is passed).
+Every step function takes the same arguments, so that the training loops of both engines
+call :func:`learn_step` and :func:`first_action` with an algorithm code and nothing is
+written twice. ``q_b`` is Double Q-learning's second table; the other algorithms' step
+functions do not take it (the engines hold an empty ``(0, n_actions)`` array there).
 
 >>> import numpy as np
->>> q, q_b = np.array([[1.0, 0.0], [2.0, 3.0]]), np.zeros((0, 2))
+>>> q = np.array([[1.0, 0.0], [2.0, 3.0]])
 >>> visits = np.zeros((2, 2), dtype=np.int64)
 >>> rng = np.random.default_rng(0)
->>> learn_step(Q_LEARNING, q, q_b, visits, 0, 0, 1.0, 1, False, True, 0.5, 0.9, 0.0, rng)
+>>> q_learning_step(q, visits, 0, 0, 1.0, 1, False, True, 0.5, 0.9, 0.0, rng)
 -1
 >>> float(q[0, 0])  # truncated, so it bootstraps: 1 + 0.5 * (1 + 0.9 * 3 - 1) = 2.35
 2.35
@@ -27,13 +27,16 @@ empty ``(0, n_actions)`` array is passed).
 
 from __future__ import annotations
 
-import numpy as np
-from numba import njit
+from typing import Any
 
+import numpy as np
+from numba import njit, types
+from numba.extending import overload
+
+from cartpole_q.config.schema import ALGORITHMS
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.policy import (
     best_action,
-    best_action_of_sum,
     best_value,
     epsilon_greedy,
     epsilon_greedy_on_sum,
@@ -41,8 +44,6 @@ from cartpole_q.rl.policy import (
 
 configure_numba_cache()  # before any cache=True function is defined
 
-ALGORITHMS = ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
-"""``agent.algorithm`` values; the index of each is the code the compiled code takes"""
 Q_LEARNING, SARSA, EXPECTED_SARSA, DOUBLE_Q_LEARNING = range(len(ALGORITHMS))
 ENDED = -1
 """the next action returned when the episode ended"""
@@ -54,7 +55,7 @@ def _update(q: np.ndarray, state: int, action: int, target: float, alpha: float)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def q_learning_step(q, q_b, visits, state, action, reward, next_state, terminated, truncated,
+def q_learning_step(q, visits, state, action, reward, next_state, terminated, truncated,
                     alpha, gamma, epsilon, rng):  # fmt: skip
     """Q-learning: target ``r + gamma * max_b Q(s', b)``; update, then draw the next action."""
     visits[state, action] += 1
@@ -68,7 +69,7 @@ def q_learning_step(q, q_b, visits, state, action, reward, next_state, terminate
 
 
 @njit(cache=True, nogil=True, inline="always")
-def sarsa_step(q, q_b, visits, state, action, reward, next_state, terminated, truncated,
+def sarsa_step(q, visits, state, action, reward, next_state, terminated, truncated,
                alpha, gamma, epsilon, rng):  # fmt: skip
     """SARSA: draw ``a'`` first (also at truncation), target ``r + gamma * Q(s', a')``."""
     visits[state, action] += 1
@@ -95,7 +96,7 @@ def expected_sarsa_value(q: np.ndarray, state: int, epsilon: float) -> float:
 
 
 @njit(cache=True, nogil=True, inline="always")
-def expected_sarsa_step(q, q_b, visits, state, action, reward, next_state, terminated, truncated,
+def expected_sarsa_step(q, visits, state, action, reward, next_state, terminated, truncated,
                         alpha, gamma, epsilon, rng):  # fmt: skip
     """Expected SARSA: the target averages ``Q(s', .)`` under the epsilon-greedy policy."""
     visits[state, action] += 1
@@ -117,51 +118,86 @@ def double_q_learning_step(q, q_b, visits, state, action, reward, next_state, te
     actions are chosen epsilon-greedily on ``A + B``.
     """
     visits[state, action] += 1
+    # Two explicit branches rather than swapped names: an array alias costs reference
+    # counting on every step.
     if rng.random() < 0.5:
-        updated, other = q, q_b
+        target = reward
+        if not terminated:
+            target = reward + gamma * q_b[next_state, best_action(q, next_state)]
+        _update(q, state, action, target, alpha)
     else:
-        updated, other = q_b, q
-    target = reward
-    if not terminated:
-        target = reward + gamma * other[next_state, best_action(updated, next_state)]
-    _update(updated, state, action, target, alpha)
+        target = reward
+        if not terminated:
+            target = reward + gamma * q[next_state, best_action(q_b, next_state)]
+        _update(q_b, state, action, target, alpha)
     if terminated or truncated:
         return ENDED
     return epsilon_greedy_on_sum(q, q_b, next_state, epsilon, rng)
 
 
-@njit(cache=True, nogil=True, inline="always")
+STEP_FUNCTIONS = (q_learning_step, sarsa_step, expected_sarsa_step, double_q_learning_step)
+"""each algorithm's step function, indexed by its code"""
+
+
 def learn_step(algorithm, q, q_b, visits, state, action, reward, next_state, terminated,
                truncated, alpha, gamma, epsilon, rng):  # fmt: skip
-    """Learn from one transition with the algorithm ``algorithm`` (a code of :data:`ALGORITHMS`).
+    """Learn from one transition with the algorithm ``algorithm`` (a code of ``ALGORITHMS``).
+
+    Compiled code only, with ``algorithm`` a compile-time constant: the call becomes that
+    algorithm's step function, inlined, with no branch on the code left (see
+    :func:`~cartpole_q.engines.kernel.training_kernel`).
 
     Returns:
         The next action, or :data:`ENDED` when the episode ended.
     """
-    if algorithm == SARSA:
-        return sarsa_step(q, q_b, visits, state, action, reward, next_state, terminated,
-                          truncated, alpha, gamma, epsilon, rng)  # fmt: skip
-    if algorithm == EXPECTED_SARSA:
-        return expected_sarsa_step(q, q_b, visits, state, action, reward, next_state,
-                                   terminated, truncated, alpha, gamma, epsilon, rng)  # fmt: skip
-    if algorithm == DOUBLE_Q_LEARNING:
-        return double_q_learning_step(q, q_b, visits, state, action, reward, next_state,
-                                      terminated, truncated, alpha, gamma, epsilon, rng)  # fmt: skip
-    return q_learning_step(q, q_b, visits, state, action, reward, next_state, terminated,
-                           truncated, alpha, gamma, epsilon, rng)  # fmt: skip
+    raise NotImplementedError("learn_step is called from compiled code only")
 
 
-@njit(cache=True, nogil=True, inline="always")
+@overload(learn_step, inline="always")
+def _learn_step(algorithm, q, q_b, visits, state, action, reward, next_state, terminated,
+                truncated, alpha, gamma, epsilon, rng):  # fmt: skip
+    if not isinstance(algorithm, types.IntegerLiteral):
+        return None  # numba then retries with the constant's literal type
+    step: Any = STEP_FUNCTIONS[algorithm.literal_value]
+    if algorithm.literal_value == DOUBLE_Q_LEARNING:
+
+        def two_tables(algorithm, q, q_b, visits, state, action, reward, next_state,
+                       terminated, truncated, alpha, gamma, epsilon, rng):  # fmt: skip
+            return step(q, q_b, visits, state, action, reward, next_state, terminated,
+                        truncated, alpha, gamma, epsilon, rng)  # fmt: skip
+
+        return two_tables
+
+    # The one-table algorithms do not take q_b: every array handed to an inlined function
+    # costs reference counting on every step.
+    def one_table(algorithm, q, q_b, visits, state, action, reward, next_state,
+                  terminated, truncated, alpha, gamma, epsilon, rng):  # fmt: skip
+        return step(q, visits, state, action, reward, next_state, terminated, truncated,
+                    alpha, gamma, epsilon, rng)  # fmt: skip
+
+    return one_table
+
+
 def first_action(algorithm, q, q_b, state, epsilon, rng):
-    """The first action of an episode: epsilon-greedy (on ``A + B`` for Double Q-learning)."""
-    if algorithm == DOUBLE_Q_LEARNING:
-        return epsilon_greedy_on_sum(q, q_b, state, epsilon, rng)
-    return epsilon_greedy(q, state, epsilon, rng)
+    """The first action of an episode: epsilon-greedy (on ``A + B`` for Double Q-learning).
+
+    Compiled code only, with ``algorithm`` a compile-time constant (as :func:`learn_step`).
+    """
+    raise NotImplementedError("first_action is called from compiled code only")
 
 
-@njit(cache=True, nogil=True, inline="always")
-def greedy_action(algorithm, q, q_b, state):
-    """The greedy action of the learned table(s), the lowest on ties."""
-    if algorithm == DOUBLE_Q_LEARNING:
-        return best_action_of_sum(q, q_b, state)
-    return best_action(q, state)
+@overload(first_action, inline="always")
+def _first_action(algorithm, q, q_b, state, epsilon, rng):
+    if not isinstance(algorithm, types.IntegerLiteral):
+        return None
+    if algorithm.literal_value == DOUBLE_Q_LEARNING:
+
+        def on_sum(algorithm, q, q_b, state, epsilon, rng):
+            return epsilon_greedy_on_sum(q, q_b, state, epsilon, rng)
+
+        return on_sum
+
+    def on_q(algorithm, q, q_b, state, epsilon, rng):
+        return epsilon_greedy(q, state, epsilon, rng)
+
+    return on_q

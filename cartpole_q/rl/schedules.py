@@ -19,12 +19,11 @@ import math
 
 from numba import njit
 
+from cartpole_q.config.schema import SCHEDULE_KINDS
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-SCHEDULE_KINDS = ("constant", "exponential", "log")
-"""the kinds of schedule; the index of each is the code the compiled code takes"""
 CONSTANT, EXPONENTIAL, LOG = range(len(SCHEDULE_KINDS))
 
 

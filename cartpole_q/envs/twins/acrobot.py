@@ -39,6 +39,7 @@ from numba import njit, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from cartpole_q.envs.twins import unsupported_key
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
@@ -107,20 +108,17 @@ SIN_POLY_F32 = tuple(
 ZERO_F32, ONE_F32 = _f32(0.0), _f32(1.0)
 
 
-def twin_params(kwargs: Mapping[str, Any]) -> np.ndarray | str:
+def twin_params(kwargs: Mapping[str, Any]) -> tuple[float, ...] | str:
     """Return ``params`` for ``gymnasium.make("Acrobot-v1", **kwargs)``, or why not.
 
     Returns:
-        An empty float64 array, or a sentence naming the first key the twin cannot
+        An empty tuple, or a sentence naming the first key the twin cannot
         reproduce.
     """
-    for key in kwargs:
-        if key not in SUPPORTED_KWARGS:
-            return (
-                f"env.kwargs key {key!r} is not reproduced by the compiled twin "
-                f"(it supports {', '.join(SUPPORTED_KWARGS)})"
-            )
-    return np.zeros(0, dtype=np.float64)
+    problem = unsupported_key(kwargs, SUPPORTED_KWARGS)
+    if problem is not None:
+        return problem
+    return ()
 
 
 def _c_library_pow_address() -> int:
@@ -265,7 +263,7 @@ def _write_observation(state: np.ndarray, observation: np.ndarray) -> None:
 
 @njit(cache=True, nogil=True, inline="always")
 def reset(
-    state: np.ndarray, observation: np.ndarray, rng: np.random.Generator, params: np.ndarray
+    state: np.ndarray, observation: np.ndarray, rng: np.random.Generator, params: tuple[float, ...]
 ) -> None:
     """Draw a start state into ``state`` and write its float32 ``observation``.
 
@@ -286,7 +284,7 @@ def reset(
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, params: np.ndarray
+    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
 ) -> tuple[float, bool]:
     """Advance ``state`` by one RK4 step in place; write the observation.
 

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from cartpole_q.envs.twins import unsupported_key
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
@@ -46,19 +47,16 @@ GRAVITY = 0.0025
 RESET_LOW, RESET_HIGH = -0.6, -0.4
 
 
-def twin_params(kwargs: Mapping[str, Any]) -> np.ndarray | str:
+def twin_params(kwargs: Mapping[str, Any]) -> tuple[float, ...] | str:
     """Return ``params`` for ``gymnasium.make("MountainCar-v0", **kwargs)``, or why not.
 
     Returns:
-        A float64 array ``[goal_velocity]``, or a sentence naming the first key the twin
+        The tuple ``(goal_velocity,)``, or a sentence naming the first key the twin
         cannot reproduce.
     """
-    for key in kwargs:
-        if key not in SUPPORTED_KWARGS:
-            return (
-                f"env.kwargs key {key!r} is not reproduced by the compiled twin "
-                f"(it supports {', '.join(SUPPORTED_KWARGS)})"
-            )
+    problem = unsupported_key(kwargs, SUPPORTED_KWARGS)
+    if problem is not None:
+        return problem
     goal_velocity = kwargs.get("goal_velocity", 0.0)
     if (
         isinstance(goal_velocity, bool)
@@ -67,12 +65,12 @@ def twin_params(kwargs: Mapping[str, Any]) -> np.ndarray | str:
         or float(goal_velocity) != goal_velocity  # an int a float64 cannot hold
     ):
         return f"env.kwargs key 'goal_velocity' must be a finite number, got {goal_velocity!r}"
-    return np.array([goal_velocity], dtype=np.float64)
+    return (float(goal_velocity),)
 
 
 @njit(cache=True, nogil=True, inline="always")
 def reset(
-    state: np.ndarray, observation: np.ndarray, rng: np.random.Generator, params: np.ndarray
+    state: np.ndarray, observation: np.ndarray, rng: np.random.Generator, params: tuple[float, ...]
 ) -> None:
     """Draw a start state into ``state`` and write its float32 ``observation``."""
     state[0] = rng.uniform(RESET_LOW, RESET_HIGH)
@@ -83,7 +81,7 @@ def reset(
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, params: np.ndarray
+    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
 ) -> tuple[float, bool]:
     """Advance ``state`` by one step in place; write the observation.
 

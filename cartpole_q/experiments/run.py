@@ -19,11 +19,18 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from cartpole_q import rundir
 from cartpole_q.config import NOT_SET, Config, ConfigError, config_differences, load_config
-from cartpole_q.environment import EnvInfo, inspect_env
+from cartpole_q.envs.gym import EnvInfo, inspect_env
+from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
-from cartpole_q.rundir import RunError
+from cartpole_q.store import rundir
+from cartpole_q.store.atomic import remove_stale_temporaries
+from cartpole_q.store.checkpoint import (
+    CHECKPOINT_FILE,
+    load_checkpoint,
+    read_checkpoint_meta,
+    write_checkpoint,
+)
 from cartpole_q.training import TrainResult, train
 
 
@@ -146,10 +153,10 @@ def execute_run(
     config = prepared.config
     checkpoint = None
     if resume:
-        rundir.remove_stale_temporaries(run_dir)
+        remove_stale_temporaries(run_dir)
         # Killed before its first checkpoint: nothing was lost but time; start over.
-        if (run_dir / rundir.CHECKPOINT_FILE).is_file():
-            checkpoint = rundir.load_checkpoint(run_dir)
+        if (run_dir / CHECKPOINT_FILE).is_file():
+            checkpoint = load_checkpoint(run_dir)
             check_resumable(run_dir, checkpoint, config)
         # config.yaml says what the run now is (train.episodes may have grown).
         rundir.write_config(run_dir, config)
@@ -162,7 +169,7 @@ def execute_run(
         resume=checkpoint,
         should_stop=should_stop,
         on_progress=lambda progress: reporter.update(key, progress),
-        on_checkpoint=lambda snapshot: rundir.write_checkpoint(run_dir, snapshot),
+        on_checkpoint=lambda snapshot: write_checkpoint(run_dir, snapshot),
         snapshot_every=math.gcd(watch_every, video_every),
         on_snapshot=_greedy_viewer(run_dir, config, watch_every, video_every),
     )
@@ -187,7 +194,7 @@ def _greedy_viewer(
         if watch_every and episode % watch_every == 0:
             evaluate(q_table, config, episodes=1, render_mode="human")
         if video_every and episode % video_every == 0:
-            from cartpole_q.video import VideoRecorder, offscreen_rendering
+            from cartpole_q.store.video import VideoRecorder, offscreen_rendering
 
             videos = run_dir / VIDEOS_DIR
             videos.mkdir(exist_ok=True)
@@ -254,7 +261,7 @@ def _check_extendable(
 ) -> None:
     """Refuse to resume a finished run unless it ended at ``train.episodes`` and more are asked."""
     done = summary.get("episodes")
-    meta = rundir.read_checkpoint_meta(run_dir)
+    meta = read_checkpoint_meta(run_dir)
     if meta is None:
         solved = summary.get("solved_episode")
         if solved is not None and solved == done:
@@ -264,7 +271,7 @@ def _check_extendable(
                 "ended by reaching train.episodes can be extended"
             )
         else:
-            reason = f"it kept no {rundir.CHECKPOINT_FILE} to continue from"
+            reason = f"it kept no {CHECKPOINT_FILE} to continue from"
         raise RunError(
             f"{run_dir}: this run already finished; there is nothing to resume: {reason}."
         )
@@ -295,10 +302,10 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
     trained: Config | None = checkpoint.config
     if trained is None:  # a checkpoint from before configs were recorded in it
         states = math.prod(config.discretization.bins)
-        if checkpoint.q.shape[0] != states:
+        if checkpoint.tables.q.shape[0] != states:
             raise RunError(
                 f"{where}: discretization.bins: {list(config.discretization.bins)} gives "
-                f"{states} states, but the checkpoint's Q-table has {checkpoint.q.shape[0]}; "
+                f"{states} states, but the checkpoint's Q-table has {checkpoint.tables.q.shape[0]}; "
                 "--resume continues a run exactly as it was trained."
             )
         return
@@ -320,7 +327,7 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
 
 def _check_seed_configs(parent: Path, config: Config) -> None:
     """Refuse a multi-seed resume whose seeds were started with another config."""
-    from cartpole_q.multiseed import seed_dir
+    from cartpole_q.experiments.multiseed import seed_dir
 
     seeds = config.train.seeds
     assert seeds is not None

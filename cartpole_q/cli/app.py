@@ -218,8 +218,8 @@ def train(
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with _exit_codes():
-        from cartpole_q import runner
         from cartpole_q.config import load_config, parse_assignment, resolve_config_path
+        from cartpole_q.experiments import run as runner
 
         if resume is not None:
             given = {
@@ -263,7 +263,7 @@ def _check_viewing(seeds: Any, watch: int, video_every: int) -> None:
             "them with --seed N to watch it."
         )
     if watch:
-        from cartpole_q.environment import display_problem
+        from cartpole_q.envs.gym import display_problem
 
         problem = display_problem()
         if problem is not None:
@@ -279,9 +279,9 @@ def _train_into(
     watch: int = 0,
     video_every: int = 0,
 ) -> None:
-    from cartpole_q import runner
+    from cartpole_q.cli.report import print_multi_summary, print_single_summary
+    from cartpole_q.experiments import run as runner
     from cartpole_q.progress import make_reporter
-    from cartpole_q.report import print_multi_summary, print_single_summary
 
     seeds = prepared.config.train.seeds
     reporter = make_reporter(quiet)
@@ -296,7 +296,7 @@ def _train_into(
                 )  # fmt: skip
                 summary = outcome.summary
             else:
-                from cartpole_q.multiseed import default_workers, run_seeds
+                from cartpole_q.experiments.multiseed import default_workers, run_seeds
 
                 summary = run_seeds(
                     prepared, run_dir, workers=workers or default_workers(len(seeds)),
@@ -388,8 +388,8 @@ def eval_command(
 ) -> None:
     """Play a run's greedy policy in gymnasium.make and report its returns."""
     with _exit_codes():
-        from cartpole_q import rundir
-        from cartpole_q.report import eval_line
+        from cartpole_q.cli.report import eval_line
+        from cartpole_q.store import rundir
 
         if rundir.is_multi_seed(run_dir):
             if video is not None or render:
@@ -403,7 +403,7 @@ def eval_command(
         if render and video is not None:
             raise UserError("--render and --video cannot be combined: choose one.")
         if render:
-            from cartpole_q.environment import display_problem
+            from cartpole_q.envs.gym import display_problem
 
             problem = display_problem()
             if problem is not None:
@@ -436,7 +436,7 @@ def _evaluate_run(
             run.q_table, run.config, episodes=episodes, seed=seed,
             render_mode="human" if render else None,
         )  # fmt: skip
-    from cartpole_q.video import VideoRecorder, offscreen_rendering
+    from cartpole_q.store.video import VideoRecorder, offscreen_rendering
 
     # The recorder checks the file (extension, directory, an existing file) before playing.
     with VideoRecorder(video, episodes=video_episodes, force=force) as recorder:
@@ -452,8 +452,8 @@ def _evaluate_run(
 def _eval_seeds(
     parent: Path, episodes: int | None, seed: int | None, json_output: bool, workers: int | None
 ) -> None:
-    from cartpole_q.multiseed import evaluate_seeds
-    from cartpole_q.report import eval_seeds_text
+    from cartpole_q.cli.report import eval_seeds_text
+    from cartpole_q.experiments.multiseed import evaluate_seeds
 
     result = evaluate_seeds(parent, episodes=episodes, seed=seed, workers=workers)
     if json_output:
@@ -502,7 +502,7 @@ def plot(
 ) -> None:
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with _exit_codes():
-        from cartpole_q.plotting import plot_policy, plot_rewards
+        from cartpole_q.experiments.plots import plot_policy, plot_rewards
 
         if policy:
             if len(run_dirs) != 1:

@@ -91,7 +91,7 @@ class VideoRecorder:
     """
 
     def __init__(self, path: Path, episodes: int = 1, force: bool = False) -> None:
-        from cartpole_q.rundir import check_output_file
+        from cartpole_q.store.atomic import check_output_file
 
         self._format = check_output_file(path, "--video", VIDEO_SUFFIXES, force)
         self._encoder = mp4_encoder(path) if self._format == ".mp4" else None
@@ -131,7 +131,7 @@ class VideoRecorder:
 
     def save(self) -> Path:
         """Write the video atomically; return its path."""
-        from cartpole_q.rundir import atomic_write_bytes
+        from cartpole_q.store.atomic import atomic_write_bytes
 
         self._flush()
         if not self._steps:

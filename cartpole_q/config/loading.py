@@ -1,4 +1,4 @@
-"""Run configuration: frozen dataclasses, safe YAML loading and validation.
+"""Loading a run configuration: safe YAML, merging onto the default, validation.
 
 A config file may give only some keys; every key it leaves out takes the value of the
 embedded default (``cartpole_q/default.yaml``). Loading never constructs Python objects
@@ -23,7 +23,6 @@ import math
 import os
 import re
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
@@ -31,185 +30,25 @@ from typing import Any
 
 import yaml
 
-from cartpole_q.errors import UserError
+from cartpole_q.config.schema import (
+    ALGORITHMS,
+    ENGINES,
+    MAX_EPISODES,
+    MAX_SEEDS,
+    SCHEDULE_KINDS,
+    AgentConfig,
+    Config,
+    DiscretizationConfig,
+    EnvConfig,
+    EvalConfig,
+    Schedule,
+    TrainConfig,
+)
+from cartpole_q.errors import ConfigError
 
-ENGINES = ("auto", "numba", "gymnasium")
-SCHEDULE_KINDS = ("constant", "exponential", "log")
-MAX_EPISODES = 10_000_000
-MAX_SEEDS = 10_000
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 _NUMBER_PATTERN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 _MISSING = object()
-
-
-class ConfigError(UserError):
-    """A configuration that cannot be used.
-
-    The message is one paragraph that names the source (file or command line) and the
-    field, so the command line can print it as is and exit with code 2.
-    """
-
-
-@dataclass(frozen=True)
-class Schedule:
-    """A value that may change once per episode (learning rate, exploration rate).
-
-    For episode index ``e`` (0 for the first episode):
-
-    - ``constant``: ``start``;
-    - ``exponential``: ``max(end, start * rate ** e)``; the blog's ``epsilon *= 0.995``
-      down to 0.01 is ``start=1.0, rate=0.995, end=0.01``;
-    - ``log``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the
-      constant ``k``; with ``start=1`` this is the classic tabular CartPole schedule.
-    """
-
-    kind: str
-    """one of ``constant``, ``exponential``, ``log``"""
-    start: float
-    """the value at the first episode (the cap of the log schedule)"""
-    end: float
-    """the floor the value never goes below (equals ``start`` for a constant)"""
-    rate: float = 1.0
-    """the decay factor per episode (exponential) or ``k`` (log); unused for a constant"""
-
-    @property
-    def code(self) -> int:
-        """The kind as the integer the compiled agent functions take."""
-        return SCHEDULE_KINDS.index(self.kind)
-
-    def to_yaml(self) -> float | dict[str, Any]:
-        """Return the YAML form: a number for a constant, else a mapping."""
-        if self.kind == "constant":
-            return self.start
-        if self.kind == "exponential":
-            return {"type": "exponential", "start": self.start, "decay": self.rate, "end": self.end}
-        return {"type": "log", "k": self.rate, "end": self.end, "start": self.start}
-
-
-@dataclass(frozen=True)
-class EnvConfig:
-    """Which Gymnasium environment to learn."""
-
-    id: str
-    """the id given to ``gymnasium.make``"""
-    kwargs: Mapping[str, Any]
-    """keyword arguments forwarded to ``gymnasium.make`` (read-only mapping)"""
-
-
-@dataclass(frozen=True)
-class DiscretizationConfig:
-    """The grid that turns a continuous observation into a Q-table row."""
-
-    bins: tuple[int, ...]
-    """bins per observation dimension; a dimension with 1 bin is ignored"""
-    low: tuple[float, ...]
-    """lower edge of the grid per dimension; values below fall in the first bin"""
-    high: tuple[float, ...]
-    """upper edge of the grid per dimension; values above fall in the last bin"""
-
-
-@dataclass(frozen=True)
-class AgentConfig:
-    """Q-learning hyperparameters."""
-
-    gamma: float
-    """discount factor in [0, 1]"""
-    alpha: Schedule
-    """learning rate, every value in (0, 1]"""
-    epsilon: Schedule
-    """exploration rate of the epsilon-greedy policy, every value in [0, 1]"""
-    q_init: float
-    """initial value of every Q-table entry"""
-    max_q_table_bytes: int
-    """refuse to allocate a Q-table larger than this many bytes"""
-
-
-@dataclass(frozen=True)
-class TrainConfig:
-    """How long to train and what to record on the way."""
-
-    episodes: int
-    """number of training episodes (an upper bound when ``stop_when_solved``)"""
-    seeds: tuple[int, ...] | None
-    """train one run per seed, in parallel; ``None`` trains the single top-level seed"""
-    stop_when_solved: bool
-    """stop at the first episode whose 100-episode average return reaches the threshold"""
-    reward_threshold: float | None
-    """the solve threshold; ``None`` takes the environment's registered threshold"""
-    eval_every: int
-    """run a greedy evaluation every this many episodes; 0 disables it"""
-    eval_episodes: int
-    """episodes per periodic greedy evaluation"""
-    checkpoint_every: int
-    """write a resumable checkpoint every this many episodes; 0 disables it"""
-
-
-@dataclass(frozen=True)
-class EvalConfig:
-    """The greedy evaluation recorded in ``summary.json`` and used by ``cartpole-q eval``."""
-
-    episodes: int
-    """number of greedy episodes"""
-    seed: int
-    """seed of the evaluation environment's first reset"""
-
-
-@dataclass(frozen=True)
-class Config:
-    """A complete, validated run configuration. Never mutated after loading."""
-
-    name: str
-    """run-name prefix: letters, digits, '-', '_'"""
-    seed: int
-    """the run's seed; every random generator of the run is derived from it"""
-    engine: str
-    """``auto``, ``numba`` or ``gymnasium``"""
-    env: EnvConfig
-    discretization: DiscretizationConfig
-    agent: AgentConfig
-    train: TrainConfig
-    eval: EvalConfig
-
-    def to_dict(self) -> dict[str, Any]:
-        """Return the config as plain YAML-ready data, every key present."""
-        return {
-            "name": self.name,
-            "seed": self.seed,
-            "engine": self.engine,
-            "env": {"id": self.env.id, "kwargs": _plain(self.env.kwargs)},
-            "discretization": {
-                "bins": list(self.discretization.bins),
-                "low": list(self.discretization.low),
-                "high": list(self.discretization.high),
-            },
-            "agent": {
-                "gamma": self.agent.gamma,
-                "alpha": self.agent.alpha.to_yaml(),
-                "epsilon": self.agent.epsilon.to_yaml(),
-                "q_init": self.agent.q_init,
-                "max_q_table_bytes": self.agent.max_q_table_bytes,
-            },
-            "train": {
-                "episodes": self.train.episodes,
-                "seeds": None if self.train.seeds is None else format_seeds(self.train.seeds),
-                "stop_when_solved": self.train.stop_when_solved,
-                "reward_threshold": self.train.reward_threshold,
-                "eval_every": self.train.eval_every,
-                "eval_episodes": self.train.eval_episodes,
-                "checkpoint_every": self.train.checkpoint_every,
-            },
-            "eval": {"episodes": self.eval.episodes, "seed": self.eval.seed},
-        }
-
-    def to_yaml(self) -> str:
-        """Return the resolved config as YAML; loading it gives back an equal config."""
-        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None)
-
-    def for_seed(self, seed: int) -> Config:
-        """Return this config as the single run of ``seed`` (no ``train.seeds``)."""
-        return dataclasses.replace(
-            self, seed=seed, train=dataclasses.replace(self.train, seeds=None)
-        )
 
 
 _SECTIONS: dict[str, type] = {
@@ -737,6 +576,7 @@ class _Reader:
             env=EnvConfig(id=self.string("env.id"), kwargs=self.kwargs("env.kwargs")),
             discretization=discretization,
             agent=AgentConfig(
+                algorithm=self.choice("agent.algorithm", ALGORITHMS),
                 gamma=self.number("agent.gamma", low=0.0, high=1.0, interval="[0, 1]"),
                 alpha=self.schedule("agent.alpha", low=0.0, low_open=True, interval="(0, 1]"),
                 epsilon=self.schedule("agent.epsilon", low=0.0, low_open=False, interval="[0, 1]"),
@@ -854,25 +694,6 @@ def parse_seeds(value: Any) -> tuple[int, ...]:
     return tuple(unique)
 
 
-def format_seeds(seeds: Iterable[int]) -> str:
-    """Write seeds compactly: ``(0, 1, 2, 3, 7)`` becomes ``"0-3,7"``.
-
-    >>> format_seeds([0, 1, 2, 3, 7])
-    '0-3,7'
-    """
-    parts: list[str] = []
-    ordered = sorted(set(seeds))
-    start = previous = None
-    for seed in [*ordered, None]:
-        if previous is not None and (seed is None or seed != previous + 1):
-            parts.append(str(start) if start == previous else f"{start}-{previous}")
-            start = seed
-        elif start is None:
-            start = seed
-        previous = seed
-    return ",".join(parts)
-
-
 def _as_number(value: Any) -> float | None:
     """Return ``value`` as a float if it is a number or a numeric string like ``5e-4``."""
     if isinstance(value, bool):
@@ -893,12 +714,3 @@ def _type_name(value: Any) -> str:
 def _shown(value: Any) -> str:
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
-
-
-def _plain(value: Any) -> Any:
-    """Turn read-only mappings back into plain dicts for YAML and JSON."""
-    if isinstance(value, Mapping):
-        return {key: _plain(item) for key, item in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(item) for item in value]
-    return value

@@ -6,26 +6,34 @@ float64 state; the observation is that state rounded to float32. Reset draws fou
 ``uniform(-0.05, 0.05)`` values from a NumPy Generator seeded the way Gymnasium seeds
 ``env.np_random``. Tests compare trajectories with Gymnasium's by exact equality.
 
-What the twin reproduces of ``gymnasium.make``'s arguments: ``sutton_barto_reward`` and
-``max_episode_steps``. Anything else is refused by :func:`twin_settings`.
+What the twin reproduces of ``gymnasium.make``'s arguments: ``sutton_barto_reward`` (in
+``params``) and ``max_episode_steps`` (the caller's time limit). Anything else is refused by
+:func:`twin_params`.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numba import njit
 
+from cartpole_q.envs.twins import unsupported_key
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-TWIN_ENV_IDS = ("CartPole-v1", "CartPole-v0")
-SUPPORTED_KWARGS = ("sutton_barto_reward", "max_episode_steps")
+ENV_IDS = ("CartPole-v1", "CartPole-v0")
+STATE_SIZE = 4
+OBSERVATION_SIZE = 4
+N_ACTIONS = 2
+PARAM_NAMES = ("sutton_barto_reward",)
+"""the ``gymnasium.make`` arguments in ``params``, in order"""
+SUTTON_BARTO_REWARD = 0
+"""index of ``sutton_barto_reward`` (1.0 or 0.0) in ``params``"""
+SUPPORTED_KWARGS = (*PARAM_NAMES, "max_episode_steps")
 
 # The constants of CartPoleEnv.__init__, computed the same way.
 GRAVITY = 9.8
@@ -41,44 +49,26 @@ X_THRESHOLD = 2.4
 RESET_LOW, RESET_HIGH = -0.05, 0.05
 
 
-@dataclass(frozen=True)
-class TwinSettings:
-    """The environment arguments the twin runs with."""
-
-    max_episode_steps: int
-    """the time limit (truncation), as ``gymnasium.make`` applies it"""
-    sutton_barto_reward: bool
-    """0 per surviving step and -1 on termination, instead of +1 per step"""
-
-
-def twin_settings(
-    env_id: str, kwargs: Mapping[str, Any], spec_max_steps: int | None
-) -> TwinSettings | str:
-    """Return the twin's settings for an environment, or why it cannot reproduce it.
+def twin_params(kwargs: Mapping[str, Any]) -> tuple[float, ...] | str:
+    """Return ``params`` for ``gymnasium.make("CartPole-v1", **kwargs)``, or why not.
 
     Returns:
-        ``TwinSettings`` when the twin reproduces ``gymnasium.make(env_id, **kwargs)``
-        exactly, else a sentence naming the id or key it cannot reproduce.
+        The tuple ``(sutton_barto_reward,)`` (1.0 or 0.0), or a sentence naming the
+        first key the twin cannot reproduce.
     """
-    if env_id not in TWIN_ENV_IDS:
-        return f"env.id {env_id!r} has no compiled twin (only {', '.join(TWIN_ENV_IDS)} do)"
-    for key in kwargs:
-        if key not in SUPPORTED_KWARGS:
-            return (
-                f"env.kwargs key {key!r} is not reproduced by the compiled twin "
-                f"(it supports {', '.join(SUPPORTED_KWARGS)})"
-            )
-    max_steps = kwargs.get("max_episode_steps", spec_max_steps)
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
-        return f"env.kwargs key 'max_episode_steps' must be a positive integer, got {max_steps!r}"
+    problem = unsupported_key(kwargs, SUPPORTED_KWARGS)
+    if problem is not None:
+        return problem
     sutton_barto = kwargs.get("sutton_barto_reward", False)
     if not isinstance(sutton_barto, bool):
         return f"env.kwargs key 'sutton_barto_reward' must be true or false, got {sutton_barto!r}"
-    return TwinSettings(max_episode_steps=max_steps, sutton_barto_reward=sutton_barto)
+    return (1.0 if sutton_barto else 0.0,)
 
 
 @njit(cache=True, nogil=True, inline="always")
-def reset(state: np.ndarray, observation: np.ndarray, rng: np.random.Generator) -> None:
+def reset(
+    state: np.ndarray, observation: np.ndarray, rng: np.random.Generator, params: tuple[float, ...]
+) -> None:
     """Draw a start state into ``state`` and write its float32 ``observation``."""
     for i in range(4):
         state[i] = rng.uniform(RESET_LOW, RESET_HIGH)
@@ -87,7 +77,7 @@ def reset(state: np.ndarray, observation: np.ndarray, rng: np.random.Generator) 
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, sutton_barto_reward: bool
+    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
 ) -> tuple[float, bool]:
     """Advance ``state`` by one step in place; write the observation.
 
@@ -117,6 +107,6 @@ def step(
         or theta < -THETA_THRESHOLD_RADIANS
         or theta > THETA_THRESHOLD_RADIANS
     )
-    if sutton_barto_reward:
+    if params[SUTTON_BARTO_REWARD] != 0.0:
         return (-1.0 if terminated else 0.0), terminated
     return 1.0, terminated

@@ -10,14 +10,13 @@ from __future__ import annotations
 import io
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
-from cartpole_q.environment import SOLVE_WINDOW
+from cartpole_q.rl.solve import SOLVE_WINDOW
 
 DPI = 100
 CURVE_SIZE = (8.0, 4.5)
@@ -284,7 +283,7 @@ def figure_png(figure: Figure) -> bytes:
     """Render a figure to PNG bytes."""
     canvas = FigureCanvasAgg(figure)
     buffer = io.BytesIO()
-    canvas.print_png(buffer)
+    canvas.print_png(buffer)  # type: ignore[no-untyped-call]
     return buffer.getvalue()
 
 
@@ -307,97 +306,6 @@ def _colours(count: int) -> list[tuple[float, ...]]:
         return [tuple(palette(i)) for i in range(count)]
     palette = colormaps["turbo"]
     return [tuple(palette(x)) for x in np.linspace(0.05, 0.95, count)]
-
-
-# -- the plot command -----------------------------------------------------------------
-
-
-def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Path:
-    """Draw the reward curves of single and multi-seed runs on one figure; write ``out``.
-
-    Args:
-        run_dirs: run directories, single or multi-seed.
-        out: a ``.png``, ``.svg`` or ``.pdf`` file.
-        force: replace ``out`` if it exists.
-
-    Raises:
-        RunError: a directory is not a complete run.
-        WriteError: ``out`` cannot be written (checked before the figure is drawn).
-    """
-    from cartpole_q import rundir
-    from cartpole_q.multiseed import load_seed_runs
-
-    items: list[Curve | SeedBand] = []
-    for path in run_dirs:
-        if rundir.is_multi_seed(path):
-            runs = load_seed_runs(path)
-            thresholds = {run.summary.get("reward_threshold") for run in runs}
-            items.append(SeedBand(
-                path.name, [run.metrics.returns for run in runs],
-                [run.summary.get("solved_episode") for run in runs],
-                threshold=thresholds.pop() if len(thresholds) == 1 else None,
-                interrupted=sum(bool(run.summary.get("interrupted")) for run in runs),
-            ))  # fmt: skip
-        else:
-            run = rundir.load_run(path)
-            items.append(Curve(
-                path.name, run.metrics.returns, run.summary.get("solved_episode"),
-                threshold=run.summary.get("reward_threshold"),
-                interrupted=bool(run.summary.get("interrupted")),
-            ))  # fmt: skip
-    suffix = rundir.check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
-    if len(items) == 1 and isinstance(items[0], Curve) and items[0].interrupted:
-        title += " (interrupted)"
-    figure = reward_curve_figure(items, None, title)
-    rundir.atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
-
-
-def plot_policy(run_dir: Path, out: Path, dims_text: str | None, force: bool = False) -> Path:
-    """Draw one run's policy map over two binned dimensions; write ``out``.
-
-    Raises:
-        RunError: the directory is not a complete run.
-        UserError: ``dims_text`` does not name two distinct dimensions of the grid.
-        WriteError: ``out`` cannot be written (checked before the figure is drawn).
-    """
-    from cartpole_q import rundir
-
-    run = rundir.load_run(run_dir)
-    bins = run.config.discretization.bins
-    dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
-    suffix = rundir.check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    env_id = run.config.env.id
-    title = f"Policy of {run_dir.name}"
-    if run.summary.get("interrupted"):
-        title += f" (training interrupted at episode {run.summary.get('episodes')})"
-    figure = policy_figure(
-        run.q_table, run.visits, dims, run.config.discretization.low,
-        run.config.discretization.high, dimension_names(env_id, len(bins)), title,
-        action_names=action_names(env_id, run.q_table.shape[-1]),
-    )  # fmt: skip
-    rundir.atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
-
-
-def parse_dims(text: str, bins: Sequence[int]) -> tuple[int, int]:
-    """Parse ``--dims`` such as ``2,3``.
-
-    Raises:
-        UserError: not two distinct dimension numbers of the grid.
-    """
-    from cartpole_q.errors import UserError
-
-    parts = [part.strip() for part in text.split(",")]
-    if len(parts) != 2 or not all(part.isdigit() for part in parts):
-        raise UserError(f"--dims: expected two dimension numbers like 2,3, got {text!r}.")
-    first, second = int(parts[0]), int(parts[1])
-    if first == second or max(first, second) >= len(bins):
-        raise UserError(
-            f"--dims: expected two different dimensions between 0 and {len(bins) - 1}, got {text!r}."
-        )
-    return first, second
 
 
 def default_dims(bins: Sequence[int]) -> tuple[int, int]:

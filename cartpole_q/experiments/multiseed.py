@@ -28,11 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q import rundir
 from cartpole_q.config import format_seeds, load_config
-from cartpole_q.errors import UserError
+from cartpole_q.errors import RunError, UserError
+from cartpole_q.experiments.run import Prepared, execute_run, prepare
 from cartpole_q.progress import NullReporter, Reporter
-from cartpole_q.runner import Prepared, execute_run, prepare
+from cartpole_q.store import rundir
+from cartpole_q.store.atomic import write_json
 from cartpole_q.training import Progress
 
 
@@ -109,7 +110,7 @@ def run_seeds(
         interrupted = any(result is not False for result in results)
 
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
-    rundir.write_json(parent / rundir.SUMMARY_FILE, summary)
+    write_json(parent / rundir.SUMMARY_FILE, summary)
     return summary
 
 
@@ -542,7 +543,7 @@ def load_seed_runs(parent: Path) -> list[rundir.Run]:
         if (seed_dir(parent, seed, seeds) / rundir.SUMMARY_FILE).is_file()
     ]
     if not runs:
-        raise rundir.RunError(f"{parent}: none of its seed runs has finished.")
+        raise RunError(f"{parent}: none of its seed runs has finished.")
     return runs
 
 
@@ -625,9 +626,7 @@ def evaluate_seeds(
     """
     status = seed_status(parent)
     if not status.finished:
-        raise rundir.RunError(
-            f"{parent}: none of its seed runs has finished; {status.note(parent)}"
-        )
+        raise RunError(f"{parent}: none of its seed runs has finished; {status.note(parent)}")
     paths = [str(path) for _, path in status.finished]
     # Loading every seed first refuses a damaged one before any work starts.
     for path in paths:

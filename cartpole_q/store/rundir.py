@@ -18,26 +18,29 @@ Arrays are read with ``allow_pickle=False`` only.
 
 from __future__ import annotations
 
-import contextlib
 import csv
-import errno
 import io
 import json
-import os
 import platform
-import secrets
 import time
-import zipfile
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from cartpole_q.config import Config, ConfigError, load_config
-from cartpole_q.errors import UserError
+from cartpole_q.engines.base import EpisodeMetrics
+from cartpole_q.errors import RunError
+from cartpole_q.evaluation import check_q_table
+from cartpole_q.store.atomic import (
+    atomic_save_npy,
+    atomic_write_bytes,
+    atomic_write_text,
+    write_json,
+)
+from cartpole_q.store.checkpoint import CHECKPOINT_FILE
 
 CONFIG_FILE = "config.yaml"
 Q_TABLE_FILE = "q_table.npy"
@@ -46,138 +49,10 @@ METRICS_FILE = "metrics.csv"
 EVALUATIONS_FILE = "evaluations.csv"
 CURVE_FILE = "reward_curve.png"
 SUMMARY_FILE = "summary.json"
-CHECKPOINT_FILE = "checkpoint.npz"
 METRICS_HEADER = ("episode", "return", "length", "epsilon", "alpha")
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
 NPY_MAGIC = b"\x93NUMPY"
 """the first bytes of every ``.npy`` file"""
-
-
-class RunError(UserError):
-    """A run directory, or a file in it, that cannot be used; the message names it."""
-
-
-# -- atomic writes --------------------------------------------------------------------
-
-
-class WriteError(RunError):
-    """A file that cannot be written (full disk, no permission, ...); the message names it."""
-
-
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` so that ``path`` is either absent, old, or complete.
-
-    The temporary file is created with ``open(..., "xb")`` rather than ``mkstemp`` so
-    that it gets the user's usual permissions (umask), not mkstemp's owner-only 0600.
-
-    Raises:
-        WriteError: the file cannot be written (``ENOSPC``, ``EACCES``, ``EROFS``,
-            ``ENOTDIR``, ...); the temporary file is gone and ``path`` is untouched.
-    """
-    temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with open(temporary, "xb") as stream:
-            stream.write(data)
-        os.replace(temporary, path)
-    except BaseException as error:
-        with contextlib.suppress(OSError):
-            temporary.unlink(missing_ok=True)
-        if isinstance(error, OSError):
-            raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
-        raise
-
-
-def write_failure(path: Path, error: OSError) -> str:
-    """Say in words why writing ``path`` failed.
-
-    >>> write_failure(Path("/x/y.png"), OSError(errno.ENOSPC, "No space left on device"))
-    'no space is left on the device that holds /x'
-    """
-    directory = path.parent
-    reasons = {
-        errno.ENOSPC: f"no space is left on the device that holds {directory}",
-        errno.EDQUOT: f"the disk quota of {directory} is used up",
-        errno.EACCES: f"permission to write in {directory} is denied",
-        errno.EPERM: f"permission to write in {directory} is denied",
-        errno.EROFS: f"{directory} is on a read-only file system",
-        errno.ENOTDIR: f"{_first_non_directory(directory)} is not a directory",
-        errno.EISDIR: "it is a directory",
-        errno.ENAMETOOLONG: "the file name is too long",
-    }
-    if error.errno == errno.ENOENT:
-        if directory.is_dir():
-            return f"files cannot be created in {directory}"
-        return f"the directory {directory} does not exist"
-    return reasons.get(error.errno or 0, error.strerror or str(error))
-
-
-def _first_non_directory(directory: Path) -> Path:
-    """The first existing ancestor of ``directory`` (or itself) that is not a directory."""
-    for candidate in (*reversed(directory.parents), directory):
-        if candidate.exists() and not candidate.is_dir():
-            return candidate
-    return directory
-
-
-def check_output_file(path: Path, option: str, suffixes: tuple[str, ...], force: bool) -> str:
-    """Check, before any expensive work, that ``path`` can be written as asked.
-
-    Args:
-        path: the file a command will write.
-        option: the option that named it (for messages), e.g. ``--out``.
-        suffixes: the extensions that can be written, lower case with the dot.
-        force: whether an existing file may be replaced.
-
-    Returns:
-        The file's extension, lower case, one of ``suffixes``.
-
-    Raises:
-        WriteError: the extension is not supported, the path is a directory, the file
-            exists and ``force`` is not set, or no file can be created in its directory
-            (it does not exist, is not a directory, is read-only, ...).
-    """
-    supported = ", ".join(suffixes)
-    suffix = path.suffix.lower()
-    if path.is_dir():
-        raise WriteError(
-            f"{path}: {option} is a directory; give a file name such as {path / ('out' + suffixes[0])}."
-        )
-    if suffix not in suffixes:
-        raise WriteError(
-            f"{path}: {option} cannot write {'files ending in ' + suffix if suffix else 'a file without an extension'}; "
-            f"give a file name ending in one of {supported}."
-        )
-    if path.exists() and not force:
-        raise WriteError(
-            f"{path}: already exists; pass --force to replace it, or choose another name."
-        )
-    probe = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
-    try:
-        with open(probe, "xb"):
-            pass
-    except OSError as error:
-        raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
-    with contextlib.suppress(OSError):
-        probe.unlink()
-    return suffix
-
-
-def remove_stale_temporaries(run_dir: Path) -> None:
-    """Delete temporary files a killed process left behind (never a finished file)."""
-    for temporary in run_dir.glob(".*.tmp"):
-        temporary.unlink(missing_ok=True)
-
-
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write UTF-8 text atomically."""
-    atomic_write_bytes(path, text.encode("utf-8"))
-
-
-def atomic_save_npy(path: Path, array: np.ndarray) -> None:
-    """Save one array as ``.npy`` atomically."""
-    buffer = io.BytesIO()
-    np.save(buffer, array, allow_pickle=False)
-    atomic_write_bytes(path, buffer.getvalue())
 
 
 # -- creating a run directory ---------------------------------------------------------
@@ -239,114 +114,6 @@ def write_config(run_dir: Path, config: Config) -> None:
     atomic_write_text(run_dir / CONFIG_FILE, header + config.to_yaml())
 
 
-# -- checkpoints ----------------------------------------------------------------------
-
-
-def write_checkpoint(run_dir: Path, checkpoint: Any) -> None:
-    """Save a :class:`~cartpole_q.training.Checkpoint` as one atomic ``checkpoint.npz``."""
-    meta = {
-        "engine": checkpoint.engine,
-        "episode": checkpoint.episode,
-        "env_steps": checkpoint.env_steps,
-        "agent_rng_state": checkpoint.agent_rng_state,
-        "env_rng_state": checkpoint.env_rng_state,
-        "solved_episode": checkpoint.solved_episode,
-        "evaluations": checkpoint.evaluations,
-        "train_seconds": checkpoint.train_seconds,
-        "wall_seconds": checkpoint.wall_seconds,
-        "config": None if checkpoint.config is None else checkpoint.config.to_yaml(),
-    }
-    arrays = {
-        "q": checkpoint.q,
-        "visits": checkpoint.visits,
-        "returns": checkpoint.returns,
-        "lengths": checkpoint.lengths,
-        "epsilons": checkpoint.epsilons,
-        "alphas": checkpoint.alphas,
-        "meta": np.array(json.dumps(meta)),
-    }
-    if checkpoint.solved_q is not None:
-        arrays["solved_q"] = checkpoint.solved_q
-    buffer = io.BytesIO()
-    np.savez(buffer, allow_pickle=False, **arrays)
-    atomic_write_bytes(run_dir / CHECKPOINT_FILE, buffer.getvalue())
-
-
-def load_checkpoint(run_dir: Path) -> Any:
-    """Read ``checkpoint.npz`` back as a :class:`~cartpole_q.training.Checkpoint`.
-
-    Raises:
-        RunError: the checkpoint is missing or damaged.
-    """
-    from cartpole_q.training import Checkpoint
-
-    path = run_dir / CHECKPOINT_FILE
-    if not path.is_file():
-        raise RunError(f"{path}: no checkpoint; there is nothing to resume in {run_dir}.")
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            return Checkpoint(
-                engine=meta["engine"],
-                episode=int(meta["episode"]),
-                env_steps=int(meta["env_steps"]),
-                q=data["q"],
-                visits=data["visits"],
-                returns=data["returns"],
-                lengths=data["lengths"],
-                epsilons=data["epsilons"],
-                alphas=data["alphas"],
-                agent_rng_state=meta["agent_rng_state"],
-                env_rng_state=meta["env_rng_state"],
-                solved_episode=meta["solved_episode"],
-                solved_q=data["solved_q"] if "solved_q" in data.files else None,
-                evaluations=meta["evaluations"],
-                train_seconds=float(meta["train_seconds"]),
-                wall_seconds=float(meta["wall_seconds"]),
-                config=_checkpoint_config(meta.get("config")),
-            )
-    except (
-        OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError
-    ) as error:  # fmt: skip
-        raise RunError(
-            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
-        ) from None
-
-
-def _checkpoint_config(text: Any) -> Config | None:
-    """The config a checkpoint recorded (``None`` for checkpoints older than that)."""
-    if text is None:
-        return None
-    data = yaml.safe_load(text)
-    if not isinstance(data, dict):
-        raise ValueError("its recorded config is not a mapping")
-    return load_config(data)
-
-
-def read_checkpoint_meta(run_dir: Path) -> dict[str, Any] | None:
-    """The small part of ``checkpoint.npz`` (episode, engine, ...), without its arrays.
-
-    Returns:
-        ``None`` when there is no checkpoint.
-
-    Raises:
-        RunError: the checkpoint is damaged.
-    """
-    path = run_dir / CHECKPOINT_FILE
-    if not path.is_file():
-        return None
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-        if not isinstance(meta, dict):
-            raise ValueError("its meta is not a JSON object")
-        return meta
-    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as error:
-        raise RunError(
-            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
-        ) from None
-
-
 # -- writing a finished (or interrupted) run ------------------------------------------
 
 
@@ -394,14 +161,12 @@ def summarize(result: Any) -> dict[str, Any]:
     }
 
 
-def metrics_csv(result: Any) -> str:
+def metrics_csv(metrics: EpisodeMetrics) -> str:
     """Per-episode metrics as CSV; floats written with ``repr`` so they round-trip exactly."""
     lines = [",".join(METRICS_HEADER)]
     lines.extend(
         f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r}"
-        for i, (r, n, e, a) in enumerate(
-            zip(result.returns, result.lengths, result.epsilons, result.alphas, strict=True)
-        )
+        for i, (r, n, e, a) in enumerate(zip(*metrics, strict=True))
     )
     return "\n".join(lines) + "\n"
 
@@ -450,10 +215,10 @@ def write_run(
     write_config(run_dir, result.config)
     atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
     atomic_save_npy(run_dir / VISITS_FILE, result.visits)
-    atomic_write_text(run_dir / METRICS_FILE, metrics_csv(result))
+    atomic_write_text(run_dir / METRICS_FILE, metrics_csv(result.metrics))
     atomic_write_text(run_dir / EVALUATIONS_FILE, evaluations_csv(result.evaluations))
     if plot:
-        from cartpole_q.plotting import Curve, figure_png, reward_curve_figure
+        from cartpole_q.figures import Curve, figure_png, reward_curve_figure
 
         curve = Curve(
             run_dir.name, result.returns, result.solved_episode, interrupted=result.interrupted
@@ -470,23 +235,7 @@ def write_run(
     return summary
 
 
-def write_json(path: Path, data: dict[str, Any]) -> None:
-    """Write JSON atomically (indented, ending with a newline)."""
-    atomic_write_text(path, json.dumps(data, indent=2) + "\n")
-
-
 # -- reading a run back ---------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class Metrics:
-    """The columns of ``metrics.csv``."""
-
-    episode: np.ndarray
-    returns: np.ndarray
-    lengths: np.ndarray
-    epsilons: np.ndarray
-    alphas: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -497,7 +246,8 @@ class Run:
     config: Config
     q_table: np.ndarray
     visits: np.ndarray | None
-    metrics: Metrics
+    metrics: EpisodeMetrics
+    """the columns of ``metrics.csv`` (episodes are numbered from 1 in order)"""
     summary: dict[str, Any]
 
     @property
@@ -590,31 +340,7 @@ def load_array(path: Path, dtype: type) -> np.ndarray:
     return array
 
 
-def check_q_table(
-    q_table: np.ndarray, bins: tuple[int, ...], n_actions: int | None, source: str
-) -> None:
-    """Check a Q-table against its config's grid (and the environment's actions).
-
-    Raises:
-        RunError: wrong dtype or shape, or a non-finite value.
-    """
-    if q_table.dtype != np.float64:
-        raise RunError(f"{source}: must hold float64 values, found {q_table.dtype}.")
-    expected = f"(*bins, n_actions) = ({', '.join(map(str, bins))}, {n_actions or 'n_actions'})"
-    if q_table.ndim != len(bins) + 1 or tuple(q_table.shape[:-1]) != tuple(bins):
-        raise RunError(
-            f"{source}: has shape {q_table.shape}, which does not match its config: expected {expected}."
-        )
-    if n_actions is not None and q_table.shape[-1] != n_actions:
-        raise RunError(
-            f"{source}: has {q_table.shape[-1]} actions per state but the environment has "
-            f"{n_actions}: expected {expected}."
-        )
-    if not np.isfinite(q_table).all():
-        raise RunError(f"{source}: holds NaN or infinite values.")
-
-
-def read_metrics(path: Path) -> Metrics:
+def read_metrics(path: Path) -> EpisodeMetrics:
     """Read ``metrics.csv``.
 
     Raises:
@@ -636,8 +362,9 @@ def read_metrics(path: Path) -> Metrics:
     if columns.size and (columns.ndim != 2 or columns.shape[1] != len(METRICS_HEADER)):
         raise RunError(f"{path}: every row must have {len(METRICS_HEADER)} values.")
     columns = columns.reshape(-1, len(METRICS_HEADER))
-    return Metrics(
-        episode=columns[:, 0].astype(np.int64),
+    if not np.array_equal(columns[:, 0], np.arange(1, len(columns) + 1)):
+        raise RunError(f"{path}: its episodes must be numbered 1, 2, 3, ... in order.")
+    return EpisodeMetrics(
         returns=columns[:, 1],
         lengths=columns[:, 2].astype(np.int64),
         epsilons=columns[:, 3],

@@ -1,4 +1,7 @@
-"""Agent functions with hand-computed values: TD targets, schedules, epsilon-greedy draws."""
+"""The compiled RL functions with hand-computed values: schedules, epsilon-greedy, solving.
+
+Each algorithm's update is tested in ``test_algorithms.py``.
+"""
 
 from __future__ import annotations
 
@@ -7,67 +10,23 @@ import math
 import numpy as np
 import pytest
 
-from cartpole_q.agent import (
-    CONSTANT,
-    EXPONENTIAL,
-    LOG,
-    best_action,
-    best_value,
-    epsilon_greedy,
-    learn_step,
-    reaches_threshold,
-    schedule_value,
-    td_update,
-)
-
-
-def table() -> np.ndarray:
-    # state 0: Q = [1, 0]; state 1: Q = [2, 3]
-    return np.array([[1.0, 0.0], [2.0, 3.0]])
-
-
-def test_td_update_ordinary_step_bootstraps_from_the_best_next_action() -> None:
-    q = table()
-    td_update(q, 0, 0, 1.0, 1, False, 0.5, 0.9)
-    # target = 1 + 0.9 * max(2, 3) = 3.7; Q = 1 + 0.5 * (3.7 - 1) = 2.35
-    assert q[0, 0] == pytest.approx(2.35, abs=1e-15)
-    assert q[0, 1] == 0.0 and q[1].tolist() == [2.0, 3.0]
-
-
-def test_td_update_terminated_step_does_not_bootstrap() -> None:
-    q = table()
-    td_update(q, 0, 0, 1.0, 1, True, 0.5, 0.9)
-    # target = r = 1; Q = 1 + 0.5 * (1 - 1) = 1
-    assert q[0, 0] == 1.0
-    q = table()
-    td_update(q, 0, 1, -1.0, 1, True, 0.25, 0.9)
-    # target = -1; Q = 0 + 0.25 * (-1 - 0) = -0.25
-    assert q[0, 1] == -0.25
-
-
-def test_truncated_step_bootstraps_like_an_ordinary_one() -> None:
-    truncated, ordinary = table(), table()
-    visits = np.zeros((2, 2), dtype=np.int64)
-    rng = np.random.default_rng(0)
-    low, high, bins = np.array([0.0]), np.array([2.0]), np.array([2])
-    next_observation = np.array([1.5], dtype=np.float32)  # state 1
-    state, action = learn_step(truncated, visits, 0, 0, 1.0, next_observation, False, True,
-                               low, high, bins, 0.5, 0.9, 0.0, rng)  # fmt: skip
-    assert (state, action) == (1, -1)  # the episode ended: no next action is drawn
-    td_update(ordinary, 0, 0, 1.0, 1, False, 0.5, 0.9)
-    assert truncated[0, 0] == ordinary[0, 0] == pytest.approx(2.35, abs=1e-15)
-    assert visits.tolist() == [[1, 0], [0, 0]]
+from cartpole_q.engines.kernel import reaches_threshold
+from cartpole_q.rl.algorithms import ENDED, q_learning_step
+from cartpole_q.rl.policy import best_action, best_value, epsilon_greedy
+from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG, schedule_value
 
 
 def test_learn_step_picks_the_next_action_from_the_updated_table() -> None:
     q = np.array([[0.0, 0.0], [0.0, 0.1]])
     visits = np.zeros((2, 2), dtype=np.int64)
-    low, high, bins = np.array([0.0]), np.array([2.0]), np.array([2])
-    state, action = learn_step(q, visits, 1, 1, 1.0, np.array([1.5], dtype=np.float32), False, False,
-                               low, high, bins, 1.0, 0.0, 0.0, np.random.default_rng(0))  # fmt: skip
+    action = q_learning_step(q, visits, 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0,
+                             np.random.default_rng(0))  # fmt: skip
     # Q(1, 1) becomes 1.0 before the greedy choice in state 1
-    assert (state, action) == (1, 1)
-    assert q[1, 1] == 1.0
+    assert action == 1 and q[1, 1] == 1.0
+    assert visits.tolist() == [[0, 0], [0, 1]]
+    ended = q_learning_step(q, visits, 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0,
+                            np.random.default_rng(0))  # fmt: skip
+    assert ended == ENDED  # truncated: the episode ended, no next action is drawn
 
 
 @pytest.mark.parametrize(

@@ -1,0 +1,69 @@
+"""The run configuration: its schema, and loading it from YAML, names and overrides.
+
+This package imports neither numpy, numba nor gymnasium, so that the command line starts
+fast.
+
+>>> config = load_config()
+>>> config.env.id, config.discretization.bins
+('CartPole-v1', (1, 1, 2, 10))
+"""
+
+from cartpole_q.config.loading import (
+    NOT_SET,
+    OVERRIDE_SOURCE,
+    check_known_keys,
+    config_differences,
+    default_raw,
+    default_yaml_text,
+    load_config,
+    parse_assignment,
+    parse_seeds,
+    read_yaml_mapping,
+    resolve_config_path,
+    shipped_configs,
+)
+from cartpole_q.config.schema import (
+    ALGORITHMS,
+    ENGINES,
+    MAX_EPISODES,
+    MAX_SEEDS,
+    SCHEDULE_KINDS,
+    AgentConfig,
+    Config,
+    DiscretizationConfig,
+    EnvConfig,
+    EvalConfig,
+    Schedule,
+    TrainConfig,
+    format_seeds,
+)
+from cartpole_q.errors import ConfigError
+
+__all__ = [
+    "ALGORITHMS",
+    "ENGINES",
+    "MAX_EPISODES",
+    "MAX_SEEDS",
+    "NOT_SET",
+    "OVERRIDE_SOURCE",
+    "SCHEDULE_KINDS",
+    "AgentConfig",
+    "Config",
+    "ConfigError",
+    "DiscretizationConfig",
+    "EnvConfig",
+    "EvalConfig",
+    "Schedule",
+    "TrainConfig",
+    "check_known_keys",
+    "config_differences",
+    "default_raw",
+    "default_yaml_text",
+    "format_seeds",
+    "load_config",
+    "parse_assignment",
+    "parse_seeds",
+    "read_yaml_mapping",
+    "resolve_config_path",
+    "shipped_configs",
+]

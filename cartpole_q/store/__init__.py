@@ -1,0 +1,1 @@
+"""What training leaves on disk: atomic files, run directories, checkpoints, videos."""

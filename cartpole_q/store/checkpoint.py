@@ -1,0 +1,124 @@
+"""Checkpoints: everything ``train --resume`` needs, in one atomic ``checkpoint.npz``.
+
+Arrays are stored as arrays (``allow_pickle=False``); the rest (generator states, the
+config the run was trained with, counters) as one JSON string.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import zipfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from cartpole_q.config import Config, ConfigError, load_config
+from cartpole_q.engines.base import EpisodeMetrics, Tables
+from cartpole_q.errors import RunError
+from cartpole_q.store.atomic import atomic_write_bytes
+from cartpole_q.training import Checkpoint
+
+CHECKPOINT_FILE = "checkpoint.npz"
+
+
+def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
+    """Save a :class:`~cartpole_q.training.Checkpoint` as one atomic ``checkpoint.npz``."""
+    meta = {
+        "engine": checkpoint.engine,
+        "episode": checkpoint.episode,
+        "env_steps": checkpoint.env_steps,
+        "agent_rng_state": checkpoint.agent_rng_state,
+        "env_rng_state": checkpoint.env_rng_state,
+        "solved_episode": checkpoint.solved_episode,
+        "evaluations": checkpoint.evaluations,
+        "train_seconds": checkpoint.train_seconds,
+        "wall_seconds": checkpoint.wall_seconds,
+        "config": None if checkpoint.config is None else checkpoint.config.to_yaml(),
+    }
+    arrays = {
+        **checkpoint.tables._asdict(),  # q, q_b (Double Q-learning's B; empty otherwise), visits
+        **checkpoint.metrics._asdict(),  # returns, lengths, epsilons, alphas
+        "meta": np.array(json.dumps(meta)),
+    }
+    if checkpoint.solved_q is not None:
+        arrays["solved_q"] = checkpoint.solved_q
+    buffer = io.BytesIO()
+    np.savez(buffer, allow_pickle=False, **arrays)
+    atomic_write_bytes(run_dir / CHECKPOINT_FILE, buffer.getvalue())
+
+
+def load_checkpoint(run_dir: Path) -> Checkpoint:
+    """Read ``checkpoint.npz`` back as a :class:`~cartpole_q.training.Checkpoint`.
+
+    Raises:
+        RunError: the checkpoint is missing or damaged.
+    """
+    path = run_dir / CHECKPOINT_FILE
+    if not path.is_file():
+        raise RunError(f"{path}: no checkpoint; there is nothing to resume in {run_dir}.")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            return Checkpoint(
+                engine=meta["engine"],
+                episode=int(meta["episode"]),
+                env_steps=int(meta["env_steps"]),
+                tables=Tables(
+                    q=data["q"],
+                    # checkpoints older than Double Q-learning have no second table
+                    q_b=data["q_b"] if "q_b" in data.files else np.zeros((0, data["q"].shape[1])),
+                    visits=data["visits"],
+                ),
+                metrics=EpisodeMetrics(*(data[name] for name in EpisodeMetrics._fields)),
+                agent_rng_state=meta["agent_rng_state"],
+                env_rng_state=meta["env_rng_state"],
+                solved_episode=meta["solved_episode"],
+                solved_q=data["solved_q"] if "solved_q" in data.files else None,
+                evaluations=meta["evaluations"],
+                train_seconds=float(meta["train_seconds"]),
+                wall_seconds=float(meta["wall_seconds"]),
+                config=_checkpoint_config(meta.get("config")),
+            )
+    except (
+        OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError
+    ) as error:  # fmt: skip
+        raise RunError(
+            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
+        ) from None
+
+
+def _checkpoint_config(text: Any) -> Config | None:
+    """The config a checkpoint recorded (``None`` for checkpoints older than that)."""
+    if text is None:
+        return None
+    data = yaml.safe_load(text)
+    if not isinstance(data, dict):
+        raise ValueError("its recorded config is not a mapping")
+    return load_config(data)
+
+
+def read_checkpoint_meta(run_dir: Path) -> dict[str, Any] | None:
+    """The small part of ``checkpoint.npz`` (episode, engine, ...), without its arrays.
+
+    Returns:
+        ``None`` when there is no checkpoint.
+
+    Raises:
+        RunError: the checkpoint is damaged.
+    """
+    path = run_dir / CHECKPOINT_FILE
+    if not path.is_file():
+        return None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+        if not isinstance(meta, dict):
+            raise ValueError("its meta is not a JSON object")
+        return meta
+    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as error:
+        raise RunError(
+            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
+        ) from None
