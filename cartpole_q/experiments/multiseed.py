@@ -9,7 +9,6 @@ one per core; a seed's results do not depend on which worker ran it, or when.
 from __future__ import annotations
 
 import dataclasses
-import json
 import multiprocessing
 import os
 import pickle
@@ -128,8 +127,6 @@ NOT_STARTED: Any = object()
 
 _STOP = "stop"
 _JOIN_SECONDS = 5.0
-_worker_conn: Connection | None = None
-_worker_stopped = False
 
 
 class WorkerError(RuntimeError):
@@ -144,11 +141,11 @@ def run_in_workers(
     reporter: Reporter | None = None,
     should_stop: Callable[[], bool] | None = None,
 ) -> list[Any]:
-    """Call ``function(*job)`` for every job in spawned worker processes.
+    """Call ``function(worker, *job)`` for every job in spawned worker processes.
 
     Args:
-        function: a module-level function; it may poll :func:`worker_should_stop` and
-            report progress through :func:`worker_reporter`.
+        function: a module-level function, called as ``function(worker, *job)`` with the
+            job's :class:`Worker` (to poll ``should_stop`` and report progress).
         jobs: the argument tuples, started in this order.
         workers: at most this many processes (never more than there are jobs).
         reporter: receives the workers' progress.
@@ -324,13 +321,11 @@ _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 def _worker_main(conn: Connection, parent_pid: int) -> None:
     """A worker's life: ignore signals, die with the parent, run jobs until told to end."""
-    global _worker_conn, _worker_stopped
     for signum in _SIGNALS:
         signal.signal(signum, signal.SIG_IGN)  # also discards one that arrived while blocked
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, set(_SIGNALS))
     _die_with_parent(parent_pid)
-    _worker_conn = conn
     while True:
         try:
             message = conn.recv()
@@ -341,9 +336,8 @@ def _worker_main(conn: Connection, parent_pid: int) -> None:
         if message == _STOP:
             continue  # the job it was meant for has already ended
         _, function, args = message
-        _worker_stopped = False
         try:
-            value = function(*args)
+            value = function(Worker(conn), *args)
         except BaseException as error:  # every failure goes to the parent
             text = traceback.format_exc()
             try:
@@ -373,18 +367,27 @@ def _die_with_parent(parent_pid: int) -> None:
         os._exit(1)  # the parent died before the request took effect
 
 
-def worker_should_stop() -> bool:
-    """In a job run by :func:`run_in_workers`: whether the parent asked it to stop."""
-    global _worker_stopped
-    conn = _worker_conn
-    if not _worker_stopped and conn is not None:
-        try:
-            while conn.poll():
-                if conn.recv() in (_STOP, None):
-                    _worker_stopped = True
-        except (EOFError, OSError):
-            _worker_stopped = True  # the parent is gone
-    return _worker_stopped
+class Worker:
+    """A job's link to the parent process: stop requests in, progress out."""
+
+    def __init__(self, conn: Connection) -> None:
+        self._conn = conn
+        self._stopped = False
+
+    def should_stop(self) -> bool:
+        """Whether the parent asked this job to stop (or is gone)."""
+        if not self._stopped:
+            try:
+                while self._conn.poll():
+                    if self._conn.recv() in (_STOP, None):
+                        self._stopped = True
+            except (EOFError, OSError):
+                self._stopped = True  # the parent is gone
+        return self._stopped
+
+    def reporter(self) -> Reporter:
+        """A reporter whose messages reach the parent's."""
+        return _PipeReporter(self._conn)
 
 
 class _PipeReporter:
@@ -420,35 +423,22 @@ class _PipeReporter:
         """Nothing to close."""
 
 
-def worker_reporter() -> Reporter | None:
-    """In a job run by :func:`run_in_workers`: a reporter that reaches the parent's."""
-    return None if _worker_conn is None else _PipeReporter(_worker_conn)
-
-
-def _train_seed(child: str, seed: int, resume: bool) -> bool:
+def _train_seed(worker: Worker, child: str, seed: int, resume: bool) -> bool:
     """Worker job: train one seed into its directory; return whether it was interrupted."""
-    if worker_should_stop():
+    if worker.should_stop():
         return True
     path = Path(child)
     prepared = prepare(load_config(path / rundir.CONFIG_FILE), str(path / rundir.CONFIG_FILE))
     outcome = execute_run(
-        path, prepared, resume=resume, should_stop=worker_should_stop,
-        reporter=worker_reporter(), key=f"worker {os.getpid()}", label=f"seed {seed}",
+        path, prepared, resume=resume, should_stop=worker.should_stop,
+        reporter=worker.reporter(), key=f"worker {os.getpid()}", label=f"seed {seed}",
     )  # fmt: skip
     return outcome.result.interrupted
 
 
 def _finished(child: Path) -> bool:
-    summary = _read_json(child / rundir.SUMMARY_FILE)
+    summary = rundir.read_summary(child)
     return summary is not None and not summary.get("interrupted", True)
-
-
-def _read_json(path: Path) -> dict[str, Any] | None:
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
 
 
 def _spread(values: list[float]) -> dict[str, float] | None:
@@ -473,7 +463,7 @@ def aggregate(
     engine = None
     for seed in seeds:
         child = seed_dir(parent, seed, seeds)
-        summary = _read_json(child / rundir.SUMMARY_FILE)
+        summary = rundir.read_summary(child)
         if summary is None:
             continue
         threshold = summary.get("reward_threshold", threshold)
@@ -597,7 +587,9 @@ def seed_status(parent: Path) -> SeedStatus:
     return status
 
 
-def _evaluate_one(path: str, episodes: int | None, seed: int | None) -> dict[str, Any]:
+def _evaluate_one(
+    worker: Worker | None, path: str, episodes: int | None, seed: int | None
+) -> dict[str, Any]:
     from cartpole_q.evaluation import evaluate
 
     run = rundir.load_run(path)
@@ -634,10 +626,10 @@ def evaluate_seeds(
     workers = workers or default_workers(len(paths))
     jobs = [(path, episodes, seed) for path in paths]
     if workers <= 1:
-        results = [_evaluate_one(*job) for job in jobs]
+        results = [_evaluate_one(None, *job) for job in jobs]
     else:
         results = run_in_workers(_evaluate_one, jobs, workers)
-    threshold = _read_json(Path(paths[0]) / rundir.SUMMARY_FILE) or {}
+    threshold = rundir.read_summary(Path(paths[0])) or {}
     reward_threshold = threshold.get("reward_threshold")
     means = [result["mean"] for result in results]
     return {

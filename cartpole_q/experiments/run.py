@@ -233,7 +233,7 @@ def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
             f"{run_dir}: is a multi-seed run; --episodes extends one run: extend its seeds "
             f"one by one with `cartpole-q train --resume {run_dir}/seed-NNN --episodes N`."
         )
-    summary = _read_summary(run_dir / rundir.SUMMARY_FILE)
+    summary = rundir.read_summary(run_dir)
     if summary is not None and not summary.get("interrupted", True):
         if multi_seed:
             raise RunError(f"{run_dir}: this run already finished; there is nothing to resume.")
@@ -241,19 +241,6 @@ def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
     if multi_seed:
         _check_seed_configs(run_dir, config)
     return prepare(config, str(config_path))
-
-
-def _read_summary(path: Path) -> dict[str, Any] | None:
-    """A run's ``summary.json``, ``None`` if absent; an unreadable one counts as interrupted."""
-    import json
-
-    if not path.is_file():
-        return None
-    try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        summary = None
-    return summary if isinstance(summary, dict) else {"interrupted": True}
 
 
 def _check_extendable(

@@ -284,14 +284,14 @@ def load_run(path: str | Path) -> Run:
         raise RunError(
             f"{path}: is a multi-seed run; its runs are the seed-* directories inside it."
         )
-    if not (path / SUMMARY_FILE).is_file():
+    summary = read_summary(path)
+    if summary is None:
         hint = (
             f"; resume it with `cartpole-q train --resume {path}`"
             if (path / CHECKPOINT_FILE).is_file()
             else ""
         )
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
-    summary = _read_summary(path / SUMMARY_FILE)
     q_table = load_array(path / Q_TABLE_FILE, np.float64)
     check_q_table(q_table, config.discretization.bins, None, str(path / Q_TABLE_FILE))
     visits = None
@@ -372,9 +372,20 @@ def read_metrics(path: Path) -> EpisodeMetrics:
     )
 
 
-def _read_summary(path: Path) -> dict[str, Any]:
+def read_summary(run_dir: Path) -> dict[str, Any] | None:
+    """A run directory's ``summary.json``: the one reader of it.
+
+    Returns:
+        The summary, or ``None`` when there is none (the run has not finished).
+
+    Raises:
+        RunError: the file exists but is not a JSON object.
+    """
+    path = run_dir / SUMMARY_FILE
     try:
         summary = json.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
         raise RunError(f"{path}: is not valid JSON ({error}).") from None
     if not isinstance(summary, dict):
