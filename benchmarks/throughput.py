@@ -8,9 +8,11 @@ Rows:
   gymnasium engine  cartpole-q's Python loop on gymnasium.make, same grid
   numba engine      the compiled twin and agent, same grid (one thread, compile excluded)
   + progress bar    the gymnasium engine with the live rich progress bar drawing
+  algorithms        each agent.algorithm on the numba engine, against Q-learning
+  environments      MountainCar-v0 and Acrobot-v1: their twins against the gymnasium engine
 
-Every figure is the best of --repeats runs; ratios are against the blog loop measured in
-this same run, so they hold across machines even when absolute rates do not.
+Every figure is the median of --repeats runs; ratios are against baselines measured in this
+same run, so they hold across machines even when absolute rates do not.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from __future__ import annotations
 import argparse
 import io
 import math
+import statistics
 import time
 
 import gymnasium as gym
@@ -75,13 +78,16 @@ def blog_loop(episodes: int, seed: int) -> tuple[int, float]:
 
 
 def engine_rate(
-    config_path: str | None, engine: str, episodes: int, seed: int, progress: bool = False
-) -> tuple[int, float]:
+    config_path: str | dict | None, engine: str, episodes: int, seed: int, progress: bool = False,
+    algorithm: str | None = None,
+) -> tuple[int, float]:  # fmt: skip
     """Training env steps and seconds of ``train`` (periodic evaluation off, compile excluded)."""
     overrides = {
         "engine": engine, "seed": seed, "train.episodes": episodes, "train.stop_when_solved": False,
         "train.eval_every": 0, "train.checkpoint_every": 0,
     }  # fmt: skip
+    if algorithm is not None:
+        overrides["agent.algorithm"] = algorithm
     config = load_config(config_path, overrides)
     info = inspect_env(config)
     callback = None
@@ -98,12 +104,29 @@ def engine_rate(
     return result.env_steps, result.train_seconds
 
 
-def best_rate(measure, repeats: int) -> float:  # type: ignore[no-untyped-def]
+def median_rate(measure, repeats: int) -> float:  # type: ignore[no-untyped-def]
+    """The median env steps per second of ``repeats`` measurements (a noisy 2-core machine)."""
     rates = []
     for _ in range(repeats):
         steps, seconds = measure()
         rates.append(steps / seconds)
-    return max(rates)
+    return statistics.median(rates)
+
+
+def env_config(env_id: str, bins: tuple[int, ...], low: tuple[float, ...], high: tuple[float, ...],
+               algorithm: str = "q_learning") -> dict:  # fmt: skip
+    """A config mapping for another environment (a grid over its observation)."""
+    return {
+        "env": {"id": env_id},
+        "discretization": {"bins": list(bins), "low": list(low), "high": list(high)},
+        "agent": {"algorithm": algorithm, "epsilon": 0.1, "q_init": 0.0},
+    }
+
+
+MOUNTAINCAR = env_config("MountainCar-v0", (20, 20), (-1.2, -0.07), (0.6, 0.07))
+ACROBOT = env_config(
+    "Acrobot-v1", (6, 6, 6, 6, 8, 8), (-1, -1, -1, -1, -12.6, -28.3), (1, 1, 1, 1, 12.6, 28.3)
+)
 
 
 def main() -> None:
@@ -124,43 +147,81 @@ def main() -> None:
     engine_rate(None, "numba", 5, 0)
 
     rows = [
-        ("blog loop (baseline)", best_rate(lambda: blog_loop(python_episodes, 0), args.repeats)),
+        ("blog loop (baseline)", median_rate(lambda: blog_loop(python_episodes, 0), args.repeats)),
         (
             "gymnasium engine, blog grid",
-            best_rate(lambda: engine_rate(blog, "gymnasium", python_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(blog, "gymnasium", python_episodes, 0), args.repeats),
         ),
         (
             "numba engine, blog grid",
-            best_rate(lambda: engine_rate(blog, "numba", numba_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(blog, "numba", numba_episodes, 0), args.repeats),
         ),
         (
             "gymnasium engine, default config",
-            best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), args.repeats),
         ),
         (
             "numba engine, default config",
-            best_rate(lambda: engine_rate(None, "numba", numba_episodes // 10, 0), args.repeats),
+            median_rate(lambda: engine_rate(None, "numba", numba_episodes // 10, 0), args.repeats),
         ),
     ]
     baseline = rows[0][1]
-    print(f"{'training loop':40s} {'env steps/s':>14s} {'vs blog loop':>13s}")
+    print(
+        f"{'training loop (median of ' + str(args.repeats) + ')':40s} {'env steps/s':>14s} {'vs blog loop':>13s}"
+    )
     for name, rate in rows:
         print(f"{name:40s} {rate:14,.0f} {rate / baseline:12.1f}x")
     gym_default = rows[3][1]
     print(f"numba / gymnasium engine, default config: {rows[4][1] / gym_default:,.0f}x")
     print(f"numba / gymnasium engine, blog grid:      {rows[2][1] / rows[1][1]:,.0f}x")
 
+    # Each algorithm on the numba engine, default config, against Q-learning in the same run.
+    print()
+    print(
+        f"{'algorithm, numba engine, default config':40s} {'env steps/s':>14s} {'vs q_learning':>13s}"
+    )
+    q_learning = rows[4][1]
+    for algorithm in ("q_learning", "sarsa", "expected_sarsa", "double_q_learning"):
+        engine_rate(None, "numba", 5, 0, algorithm=algorithm)  # compile or load the cache
+        rate = median_rate(
+            lambda a=algorithm: engine_rate(None, "numba", numba_episodes // 10, 0, algorithm=a),
+            args.repeats,
+        )
+        print(f"{algorithm:40s} {rate:14,.0f} {rate / q_learning:12.0%}")
+
+    # The other twins: numba against the gymnasium engine on the same config.
+    print()
+    print(
+        f"{'environment (Q-learning, epsilon 0.1)':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s}"
+    )
+    for name, config in (
+        ("MountainCar-v0, 20x20 grid", MOUNTAINCAR),
+        ("Acrobot-v1, 6^4x8^2 grid", ACROBOT),
+    ):
+        engine_rate(config, "numba", 2, 0)
+        engine_rate(config, "gymnasium", 1, 0)
+        gym_rate = median_rate(
+            lambda c=config: engine_rate(c, "gymnasium", max(2, int(20 * scale)), 0), args.repeats
+        )
+        numba_rate = median_rate(
+            lambda c=config: engine_rate(c, "numba", max(200, int(5000 * scale)), 0), args.repeats
+        )
+        print(f"{name:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x")
+
     # The progress bar's cost, measured as interleaved pairs so machine drift cancels out.
     plain, with_bar = [], []
     for _ in range(max(3, args.repeats)):
-        plain.append(best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), 1))
+        plain.append(median_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), 1))
         with_bar.append(
-            best_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0, progress=True), 1)
+            median_rate(
+                lambda: engine_rate(None, "gymnasium", python_episodes, 0, progress=True), 1
+            )
         )
-    cost = 1.0 - max(with_bar) / max(plain)
+    cost = 1.0 - statistics.median(with_bar) / statistics.median(plain)
     print(
-        f"progress bar on the gymnasium engine: {max(with_bar):,.0f} vs {max(plain):,.0f} env steps/s "
-        f"without, a cost of {100 * cost:.1f}% (best of {len(plain)} interleaved runs each)"
+        f"progress bar on the gymnasium engine: {statistics.median(with_bar):,.0f} vs "
+        f"{statistics.median(plain):,.0f} env steps/s without, a cost of {100 * cost:.1f}% "
+        f"(medians of {len(plain)} interleaved runs each)"
     )
     assert math.isfinite(cost)
 

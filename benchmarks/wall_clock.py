@@ -3,7 +3,8 @@
     python benchmarks/wall_clock.py [--repeats 5] [--seeds 0-99]
 
 Rows: `cartpole-q --help`; `cartpole-q train` on the default config with a cold numba
-cache (compiling) and a warm one (loading it); `cartpole-q train --seeds` on all cores.
+cache (compiling) and a warm one (loading it), beside the floor that imports alone set
+(measured in the same run); `cartpole-q train --seeds` on all cores.
 Each figure is the median of --repeats runs (one run for the cold and many-seed rows).
 """
 
@@ -25,6 +26,17 @@ def wall(args: list[str], env: dict[str, str] | None = None) -> float:
     subprocess.run([sys.executable, "-m", "cartpole_q", *args], check=True, env=env,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
     return time.perf_counter() - started
+
+
+def wall_python(code: str) -> float:
+    """Seconds a fresh `python -c CODE` takes: the floor that imports alone set."""
+    started = time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True)
+    return time.perf_counter() - started
+
+
+IMPORT_FLOOR = "import numpy, numba, gymnasium"
+IMPORT_FLOOR_PLOTTING = IMPORT_FLOOR + "; import matplotlib.figure, matplotlib.backends.backend_agg"
 
 
 def main() -> None:
@@ -49,6 +61,16 @@ def main() -> None:
             wall(["train", "-q", "--out", str(root / f"warm-{i}")]) for i in range(args.repeats)
         ]
         rows.append(("cartpole-q train, warm cache", statistics.median(warm)))
+        rows.append(
+            (
+                "  import floor: numpy + numba + gymnasium",
+                statistics.median(wall_python(IMPORT_FLOOR) for _ in range(args.repeats)),
+            )
+        )
+        rows.append((
+            "  import floor + matplotlib Figure, Agg",
+            statistics.median(wall_python(IMPORT_FLOOR_PLOTTING) for _ in range(args.repeats)),
+        ))  # fmt: skip
         rows.append((f"cartpole-q train --seeds {args.seeds} ({os.cpu_count()} cores)",
                      wall(["train", "-q", "--seeds", args.seeds, "--out", str(root / "seeds")])))  # fmt: skip
     for name, seconds in rows:
