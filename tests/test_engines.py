@@ -93,16 +93,20 @@ def _trained_bytes(
     return result.q_table.tobytes(), metrics_csv(result.metrics)
 
 
+ALGORITHMS = ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
+
+
+@pytest.mark.parametrize("algorithm", ALGORITHMS)
 @pytest.mark.parametrize(
     ("config_name", "episodes"),
-    [("default.yaml", None), ("blog.yaml", None), ("sutton_barto.yaml", 150)],
+    [("default.yaml", None), ("blog.yaml", 300), ("sutton_barto.yaml", 150)],
 )
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_numba_and_gymnasium_engines_give_byte_identical_runs(
-    tmp_path, config_name: str, episodes, seed: int
+    tmp_path, config_name: str, episodes, seed: int, algorithm: str
 ) -> None:  # type: ignore[no-untyped-def]
     path = CONFIGS / config_name
-    overrides = {"seed": seed, "train.checkpoint_every": 0}
+    overrides = {"seed": seed, "train.checkpoint_every": 0, "agent.algorithm": algorithm}
     if episodes is not None:
         overrides["train.episodes"] = episodes
     files = {}
@@ -111,16 +115,48 @@ def test_numba_and_gymnasium_engines_give_byte_identical_runs(
         directory = tmp_path / engine
         directory.mkdir()
         atomic_save_npy(directory / "q_table.npy", result.q_table)
+        atomic_save_npy(directory / "visits.npy", result.visits)
         files[engine] = (
             (directory / "q_table.npy").read_bytes(),
             metrics_csv(result.metrics),
+            (directory / "visits.npy").read_bytes(),
             result.evaluations,
         )
         assert result.env_steps > 0
     assert files["numba"][0] == files["gymnasium"][0]
     assert files["numba"][1] == files["gymnasium"][1]
-    # periodic evaluations ran on the twin for one engine and in Gymnasium for the other
     assert files["numba"][2] == files["gymnasium"][2]
+    # periodic evaluations ran on the twin for one engine and in Gymnasium for the other
+    assert files["numba"][3] == files["gymnasium"][3]
+
+
+def test_algorithms_learn_different_tables() -> None:
+    # the algorithm key reaches the compiled loop: each gives its own table on one seed
+    tables = {
+        train(load_config(overrides={"agent.algorithm": a, "train.episodes": 50}),
+              final_eval=False).q_table.tobytes()
+        for a in ALGORITHMS
+    }  # fmt: skip
+    assert len(tables) == len(ALGORITHMS)
+
+
+def test_double_q_learning_keeps_the_mean_of_its_two_tables(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
+
+    config = load_config(overrides={
+        "agent.algorithm": "double_q_learning", "train.episodes": 40,
+        "train.stop_when_solved": False, "train.checkpoint_every": 40,
+    })  # fmt: skip
+    saved = []
+    result = train(config, on_checkpoint=saved.append, final_eval=False)
+    checkpoint = saved[-1]
+    q_a, q_b = checkpoint.tables.q, checkpoint.tables.q_b
+    assert q_b.shape == q_a.shape and not np.array_equal(q_a, q_b)
+    expected = (0.5 * (q_a + q_b)).reshape(result.q_table.shape)
+    assert result.q_table.tobytes() == expected.tobytes()
+    write_checkpoint(tmp_path, checkpoint)  # both tables travel in the checkpoint
+    loaded = load_checkpoint(tmp_path)
+    assert np.array_equal(loaded.tables.q, q_a) and np.array_equal(loaded.tables.q_b, q_b)
 
 
 def test_twin_evaluation_returns_exactly_what_gymnasium_returns() -> None:

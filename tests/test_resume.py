@@ -59,17 +59,27 @@ def _assert_same_results(run: Path, reference: Path) -> None:
     assert (run / rundir.CHECKPOINT_FILE).exists() == extendable
 
 
-@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+@pytest.mark.parametrize(
+    ("engine", "algorithm"),
+    [
+        ("numba", "q_learning"),
+        ("gymnasium", "q_learning"),
+        ("numba", "sarsa"),
+        ("gymnasium", "expected_sarsa"),
+        ("numba", "double_q_learning"),
+        ("gymnasium", "double_q_learning"),
+    ],
+)
 @pytest.mark.parametrize(
     ("episodes", "stop_after_polls"),
     [(120, 1), (120, 7), (230, 19)],  # the last run solves (about episode 175) before it stops
 )
 def test_interrupted_run_is_complete_and_resumes_byte_identically(
-    tmp_path: Path, engine: str, episodes: int, stop_after_polls: int
+    tmp_path: Path, engine: str, algorithm: str, episodes: int, stop_after_polls: int
 ) -> None:
     overrides = {
         "engine": engine, "seed": 2, "train.episodes": episodes, "train.stop_when_solved": False,
-        "train.checkpoint_every": 25, "train.eval_every": 10,
+        "train.checkpoint_every": 25, "train.eval_every": 10, "agent.algorithm": algorithm,
     }  # fmt: skip
     reference = _reference(tmp_path, overrides)
     prepared = prepare(load_config(overrides=overrides), "test")
@@ -348,17 +358,25 @@ def _reference_of(config: Path, tmp_path: Path) -> Path:
 def test_sigkill_at_random_instants_never_leaves_a_broken_file(tmp_path: Path) -> None:
     config = write_yaml(tmp_path / "slow.yaml", SLOW_TRAINING)
     run = tmp_path / "run"
-    # Start-up takes about 0.3 s; the whole run about 6 s.
-    instants = [random.Random(seed).uniform(0.3, 2.5) for seed in range(6)]
+    # Each process is killed at a random instant after it has written a new checkpoint, so
+    # the kills interrupt training (not only start-up) however fast this machine is.
+    delays = [random.Random(seed).uniform(0.0, 0.4) for seed in range(6)]
     resumed_from_checkpoint = 0
-    for instant in instants:
+    for delay in delays:
         started = (run / rundir.CONFIG_FILE).is_file()
-        resumed_from_checkpoint += (run / rundir.CHECKPOINT_FILE).is_file()
+        checkpoint = run / rundir.CHECKPOINT_FILE
+        resumed_from_checkpoint += checkpoint.is_file()
+        before = checkpoint.stat().st_mtime_ns if checkpoint.is_file() else 0
         args = ("train", "--resume", run) if started else ("train", "-c", config, "--out", run)
         process = subprocess.Popen(
             _command(*args, "-q"), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
         )
-        time.sleep(instant)
+        deadline = time.monotonic() + 120
+        while process.poll() is None and time.monotonic() < deadline:
+            if checkpoint.is_file() and checkpoint.stat().st_mtime_ns > before:
+                break
+            time.sleep(0.01)
+        time.sleep(delay)
         os.kill(process.pid, signal.SIGKILL)
         process.wait()
         if run.exists():
