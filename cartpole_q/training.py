@@ -6,8 +6,9 @@ checkpoints and progress to the caller's callbacks, and honours a stop request. 
 sizes never change results: an engine's state lives entirely in the Q-table, the metrics
 arrays and two random generators.
 
-Randomness: the run seed feeds a ``numpy.random.SeedSequence`` whose two children give the
-agent's Generator and the integer seed of the environment's first reset.
+Randomness: the run seed feeds a ``numpy.random.SeedSequence`` whose three children give the
+agent's Generator, the integer seed of the environment's first reset, and the Generator of
+``env.randomize``'s physics draws.
 """
 
 from __future__ import annotations
@@ -27,16 +28,23 @@ from cartpole_q.evaluation import EvalReport
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
 
-def derive_generators(seed: int) -> tuple[np.random.Generator, int]:
-    """Return the agent's Generator and the environment's first-reset seed for a run seed.
+def derive_generators(seed: int) -> tuple[np.random.Generator, int, np.random.Generator]:
+    """The agent's Generator, the environment's first-reset seed and the physics Generator.
 
-    >>> rng, env_seed = derive_generators(0)
+    ``SeedSequence(seed).spawn(3)``: its first two children are ``spawn(2)``'s, so the
+    physics generator (``env.randomize``'s draws) changes no run that existed before it.
+
+    >>> _, env_seed, _ = derive_generators(0)
     >>> env_seed
     673228719
     """
-    agent_sequence, env_sequence = np.random.SeedSequence(seed).spawn(2)
+    agent_sequence, env_sequence, physics_sequence = np.random.SeedSequence(seed).spawn(3)
     env_seed = int(env_sequence.generate_state(1, dtype=np.uint32)[0])
-    return np.random.Generator(np.random.PCG64(agent_sequence)), env_seed
+    return (
+        np.random.Generator(np.random.PCG64(agent_sequence)),
+        env_seed,
+        np.random.Generator(np.random.PCG64(physics_sequence)),
+    )
 
 
 @dataclass(frozen=True)
@@ -80,6 +88,7 @@ class Checkpoint:
     """the metrics of the finished episodes (views of the live arrays)"""
     agent_rng_state: dict[str, Any]
     env_rng_state: dict[str, Any]
+    physics_rng_state: dict[str, Any] | None
     solved_episode: int | None
     solved_q: np.ndarray | None
     evaluations: list[dict[str, Any]]
@@ -197,8 +206,8 @@ def train(
     """
     env_info = env_info or inspect_env(config)
     engine_name = resume.engine if resume is not None else resolve_engine(config, env_info)
-    agent_rng, env_seed = derive_generators(config.seed)
-    state = TrainingState.fresh(config, env_info, agent_rng)
+    agent_rng, env_seed, physics_rng = derive_generators(config.seed)
+    state = TrainingState.fresh(config, env_info, agent_rng, physics_rng)
     if resume is not None:
         _restore(state, resume)
     engine = make_engine(
@@ -255,6 +264,7 @@ def _run(
             tables=state.tables,
             metrics=EpisodeMetrics(*(column[:episode] for column in state.metrics)),
             agent_rng_state=dict(state.agent_rng.bit_generator.state),
+            physics_rng_state=dict(state.physics_rng.bit_generator.state),
             env_rng_state=engine.env_rng_state(),
             solved_episode=state.solved_episode,
             solved_q=state.solved_q,
@@ -348,6 +358,8 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     for column, saved in zip(state.metrics, checkpoint.metrics, strict=True):
         column[:episode] = saved
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
+    if checkpoint.physics_rng_state is not None:
+        state.physics_rng.bit_generator.state = checkpoint.physics_rng_state
     state.episode = episode
     state.env_steps = checkpoint.env_steps
     state.solved_episode = checkpoint.solved_episode

@@ -195,10 +195,21 @@ def test_chunking_does_not_change_results() -> None:
 
 
 def test_generators_are_derived_from_the_seed() -> None:
-    rng_a, env_a = derive_generators(7)
-    rng_b, env_b = derive_generators(7)
+    rng_a, env_a, physics_a = derive_generators(7)
+    rng_b, env_b, physics_b = derive_generators(7)
     assert env_a == env_b and rng_a.random() == rng_b.random()
+    assert physics_a.random() == physics_b.random()
     assert derive_generators(8)[1] != env_a
+    # the contract, written with NumPy alone: spawn(3)'s first two children are spawn(2)'s
+    agent_seq, env_seq, physics_seq = np.random.SeedSequence(7).spawn(3)
+    assert env_a == int(env_seq.generate_state(1, dtype=np.uint32)[0])
+    assert (
+        derive_generators(7)[0].random() == np.random.Generator(np.random.PCG64(agent_seq)).random()
+    )
+    assert (
+        derive_generators(7)[2].random()
+        == np.random.Generator(np.random.PCG64(physics_seq)).random()
+    )
 
 
 def test_kept_table_is_the_solve_point_when_training_goes_on() -> None:

@@ -33,8 +33,12 @@ import yaml
 from cartpole_q.config.schema import (
     ALGORITHMS,
     ENGINES,
+    INTEGRATORS,
     MAX_EPISODES,
     MAX_SEEDS,
+    PHYSICS_ENV_IDS,
+    PHYSICS_KEYS,
+    RANDOMIZED_KEYS,
     SCHEDULE_KINDS,
     AgentConfig,
     Config,
@@ -185,8 +189,8 @@ def parse_assignment(text: str) -> tuple[str, Any]:
 def shipped_configs() -> dict[str, str]:
     """The example configs shipped with the package: name -> one-line description.
 
-    >>> sorted(shipped_configs())
-    ['blog', 'default', 'sutton_barto']
+    >>> {"blog", "default", "sutton_barto"} <= set(shipped_configs())
+    True
     """
     found: dict[str, str] = {}
     for entry in sorted(_configs_dir().iterdir(), key=lambda item: item.name):
@@ -573,7 +577,7 @@ class _Reader:
             name=name,
             seed=self.integer("seed", minimum=0),
             engine=self.choice("engine", ENGINES),
-            env=EnvConfig(id=self.string("env.id"), kwargs=self.kwargs("env.kwargs")),
+            env=self._env(),
             discretization=discretization,
             agent=AgentConfig(
                 algorithm=self.choice("agent.algorithm", ALGORITHMS),
@@ -601,6 +605,75 @@ class _Reader:
                 seed=self.integer("eval.seed", minimum=0),
             ),
         )
+
+    def _env(self) -> EnvConfig:
+        env_id = self.string("env.id")
+        physics = self._physics(env_id)
+        randomize = self._randomize(env_id)
+        return EnvConfig(
+            id=env_id, kwargs=self.kwargs("env.kwargs"), physics=physics, randomize=randomize
+        )
+
+    def _physics_mapping(self, field: str, env_id: str, keys: tuple[str, ...]) -> dict[str, Any]:
+        value = self._value(field)
+        if value is None or value == {}:
+            return {}
+        if not isinstance(value, dict):
+            raise self.error(field, f"must be a mapping of keys to values, got {_shown(value)}.")
+        if env_id not in PHYSICS_ENV_IDS:
+            raise self.error(
+                field,
+                f"applies to CartPole only ({', '.join(PHYSICS_ENV_IDS)}), but env.id is "
+                f"{env_id!r}.",
+            )
+        for key in value:
+            if key not in keys:
+                raise ConfigError(
+                    f"{self.source_of(field)}: {_unknown_key(key, list(keys), f'{field}.')}"
+                )
+        return value
+
+    def _physics(self, env_id: str) -> Mapping[str, float | str]:
+        value = self._physics_mapping("env.physics", env_id, PHYSICS_KEYS)
+        physics: dict[str, float | str] = {}
+        for key in PHYSICS_KEYS:  # canonical order
+            if key not in value:
+                continue
+            field = f"env.physics.{key}"
+            if key == "kinematics_integrator":
+                physics[key] = self.choice_value(field, value[key], INTEGRATORS)
+            elif key == "gravity":
+                physics[key] = self.number(field, value[key])
+            else:
+                physics[key] = self.number(
+                    field, value[key], low=0.0, low_open=True, interval="(0, inf)"
+                )
+        return MappingProxyType(physics)
+
+    def _randomize(self, env_id: str) -> Mapping[str, tuple[float, float]]:
+        value = self._physics_mapping("env.randomize", env_id, RANDOMIZED_KEYS)
+        ranges: dict[str, tuple[float, float]] = {}
+        for key in RANDOMIZED_KEYS:  # the order of the draws
+            if key not in value:
+                continue
+            field = f"env.randomize.{key}"
+            pair = value[key]
+            if not isinstance(pair, list) or len(pair) != 2:
+                raise self.error(field, f"must be [low, high], got {_shown(pair)}.")
+            bounded = {"low": -math.inf} if key == "gravity" else {
+                "low": 0.0, "low_open": True, "interval": "(0, inf)"
+            }  # fmt: skip
+            low = self.number(f"{field}[0]", pair[0], **bounded)
+            high = self.number(f"{field}[1]", pair[1], **bounded)
+            if low > high:
+                raise self.error(field, f"low ({low}) must not be above high ({high}).")
+            ranges[key] = (low, high)
+        return MappingProxyType(ranges)
+
+    def choice_value(self, field: str, value: Any, choices: tuple[str, ...]) -> str:
+        if value not in choices:
+            raise self.error(field, f"must be one of {', '.join(choices)}; got {_shown(value)}.")
+        return str(value)
 
     def _discretization(self) -> DiscretizationConfig:
         bins = self.bins("discretization.bins")

@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import yaml
@@ -19,6 +20,24 @@ SCHEDULE_KINDS = ("constant", "exponential", "log")
 """schedule ``type`` values, in the order of the codes the compiled schedules take"""
 ALGORITHMS = ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
 """``agent.algorithm`` values, in the order of the codes the compiled algorithms take"""
+PHYSICS_KEYS = (
+    "gravity",
+    "masscart",
+    "masspole",
+    "length",
+    "force_mag",
+    "tau",
+    "kinematics_integrator",
+    "theta_threshold_radians",
+    "x_threshold",
+)
+"""``env.physics`` keys: ``CartPoleEnv`` attributes (``length`` is half the pole)"""
+RANDOMIZED_KEYS = ("gravity", "masscart", "masspole", "length", "force_mag", "tau")
+"""``env.randomize`` keys, in the order of their draws"""
+INTEGRATORS = ("euler", "semi-implicit euler")
+"""``env.physics.kinematics_integrator`` values"""
+PHYSICS_ENV_IDS = ("CartPole-v0", "CartPole-v1")
+"""the environments ``env.physics`` and ``env.randomize`` apply to"""
 MAX_EPISODES = 10_000_000
 """the most episodes a run (or an evaluation) may ask for"""
 MAX_SEEDS = 10_000
@@ -69,6 +88,14 @@ class EnvConfig:
     """the id given to ``gymnasium.make``"""
     kwargs: Mapping[str, Any]
     """keyword arguments forwarded to ``gymnasium.make`` (read-only mapping)"""
+    physics: Mapping[str, float | str] = field(default_factory=lambda: MappingProxyType({}))
+    """CartPole only: attributes of ``CartPoleEnv`` set after ``gymnasium.make`` (see
+    :data:`PHYSICS_KEYS`); derived values are recomputed as ``CartPoleEnv.__init__`` does"""
+    randomize: Mapping[str, tuple[float, float]] = field(
+        default_factory=lambda: MappingProxyType({})
+    )
+    """CartPole only: ``[low, high]`` per key of :data:`RANDOMIZED_KEYS`; one uniform draw
+    per key (in that order) before every training episode's reset"""
 
 
 @dataclass(frozen=True)
@@ -153,7 +180,12 @@ class Config:
             "name": self.name,
             "seed": self.seed,
             "engine": self.engine,
-            "env": {"id": self.env.id, "kwargs": _plain(self.env.kwargs)},
+            "env": {
+                "id": self.env.id,
+                "kwargs": _plain(self.env.kwargs),
+                "physics": _plain(self.env.physics),
+                "randomize": _plain(self.env.randomize),
+            },
             "discretization": {
                 "bins": list(self.discretization.bins),
                 "low": list(self.discretization.low),

@@ -25,7 +25,9 @@ def resolve_engine(config: Config, env_info: EnvInfo, source: str = "config") ->
 
     if config.engine == "gymnasium":
         return "gymnasium"
-    settings = twin_settings(config.env.id, config.env.kwargs, env_info.max_episode_steps)
+    settings = twin_settings(
+        config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
+    )
     if isinstance(settings, TwinSettings):
         return "numba"
     if config.engine == "numba":
@@ -52,9 +54,11 @@ def make_engine(
         from cartpole_q.engines.numba_engine import NumbaEngine
         from cartpole_q.envs.registry import TwinSettings, twin_settings
 
-        settings = twin_settings(config.env.id, config.env.kwargs, env_info.max_episode_steps)
+        settings = twin_settings(
+            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
+        )
         assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
-        return NumbaEngine(settings, params, env_seed, env_rng_state)
+        return NumbaEngine(settings, params, env_seed, env_rng_state, config.env.randomize)
     from cartpole_q.engines.gymnasium_engine import GymnasiumEngine
 
     return GymnasiumEngine(config, params, env_seed, env_rng_state)

@@ -134,6 +134,8 @@ class TrainingState:
     tables: Tables
     agent_rng: np.random.Generator
     metrics: EpisodeMetrics
+    physics_rng: np.random.Generator
+    """draws ``env.randomize``'s physics before every episode (nothing else)"""
     episode: int = 0
     """episodes finished"""
     env_steps: int = 0
@@ -147,7 +149,11 @@ class TrainingState:
 
     @classmethod
     def fresh(
-        cls, config: Config, env_info: EnvInfo, agent_rng: np.random.Generator
+        cls,
+        config: Config,
+        env_info: EnvInfo,
+        agent_rng: np.random.Generator,
+        physics_rng: np.random.Generator | None = None,
     ) -> TrainingState:
         """Allocate the state of a run that has not started."""
         n_states = math.prod(config.discretization.bins)
@@ -161,6 +167,7 @@ class TrainingState:
             ),
             agent_rng=agent_rng,
             metrics=EpisodeMetrics.empty(config.train.episodes),
+            physics_rng=physics_rng if physics_rng is not None else np.random.default_rng(0),
         )
 
     def policy_table(self) -> np.ndarray:

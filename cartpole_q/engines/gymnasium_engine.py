@@ -21,7 +21,7 @@ from cartpole_q.engines.kernel import (
 )
 from cartpole_q.engines.play import play_greedy
 from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
-from cartpole_q.envs.gym import make_env
+from cartpole_q.envs.gym import make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithms import ENDED, first_action, learn_step
 from cartpole_q.rl.policy import state_index
@@ -97,8 +97,15 @@ class GymnasiumEngine:
         grid, agent = self._params.grid, self._params.agent
         env, tables, metrics = self._env, state.tables, state.metrics
         handle = self._rng_handle(state.agent_rng)
+        randomize = self._config.env.randomize
         for episode in range(state.episode, stop):
             epsilon, alpha = episode_rates(agent, episode)
+            if randomize:  # one draw per key, in the config's (canonical) order
+                drawn = {
+                    key: state.physics_rng.uniform(low, high)
+                    for key, (low, high) in randomize.items()
+                }
+                set_physics(env, drawn)
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
             s, a = self._first(handle, tables, grid, observation, epsilon)

@@ -23,7 +23,7 @@ import numpy as np
 from numba import njit
 
 from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid, Tables
-from cartpole_q.envs.registry import twin_reset, twin_step
+from cartpole_q.envs.registry import twin_randomize, twin_reset, twin_step
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithms import ENDED, first_action, learn_step
 from cartpole_q.rl.policy import best_action, state_index
@@ -110,6 +110,7 @@ def training_kernel(algorithm: int, twin: int) -> Any:
         tables: Tables, grid: Grid, agent: AgentRecord, metrics: EpisodeMetrics,
         agent_rng: np.random.Generator, env_rng: np.random.Generator,
         env: tuple[int, int, int, tuple[float, ...]], start: int, stop: int, check_solved: bool,
+        physics_rng: np.random.Generator, randomize: tuple[np.ndarray, np.ndarray, np.ndarray],
     ) -> tuple[int, int, int]:  # fmt: skip
         """Train episodes ``start .. stop - 1`` on the twin.
 
@@ -124,18 +125,24 @@ def training_kernel(algorithm: int, twin: int) -> Any:
             start: the first episode (0-based) to train.
             stop: train up to this episode, excluded.
             check_solved: stop right after the first solving episode.
+            physics_rng: the generator of ``env.randomize``'s draws.
+            randomize: ``(keys, lows, highs)`` of ``env.randomize`` (empty arrays: none).
 
         Returns:
             ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
             right after the solve episode when ``check_solved``.
         """
-        max_steps, state_size, observation_size, params = env
+        max_steps, state_size, observation_size, base_params = env
+        keys, lows, highs = randomize
         env_state = np.empty(state_size, dtype=np.float64)
         observation = np.empty(observation_size, dtype=np.float32)
         gamma = agent.gamma
         env_steps = 0
         for episode in range(start, stop):
             epsilon, alpha = episode_rates(agent, episode)
+            params = base_params
+            if keys.size:
+                params = twin_randomize(twin, base_params, physics_rng, keys, lows, highs)
             twin_reset(twin, env_state, observation, env_rng, params)
             # Greedy episodes (epsilon 0) run a copy of the loop compiled with a constant
             # epsilon, without the generator calls they would skip anyway: a third faster.

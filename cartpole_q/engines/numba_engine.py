@@ -6,11 +6,13 @@ Q-table and metrics are byte-identical to it; about two hundred times faster.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
 
+from cartpole_q.config import RANDOMIZED_KEYS
 from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.registry import TwinSettings
@@ -28,6 +30,7 @@ class NumbaEngine:
         params: AgentParams,
         env_seed: int,
         env_rng_state: dict[str, Any] | None = None,
+        randomize: Mapping[str, tuple[float, float]] | None = None,
     ) -> None:
         self._train_episodes = training_kernel(params.agent.algorithm, settings.code)
         self._greedy_returns = greedy_kernel(settings.code)
@@ -38,6 +41,12 @@ class NumbaEngine:
             settings.params,
         )
         self._params = params
+        ranges = randomize or {}
+        self._randomize = (
+            np.array([RANDOMIZED_KEYS.index(key) for key in ranges], dtype=np.int64),
+            np.array([low for low, _ in ranges.values()], dtype=np.float64),
+            np.array([high for _, high in ranges.values()], dtype=np.float64),
+        )
         # Seeded exactly as Gymnasium seeds env.np_random at reset(seed=env_seed).
         self._env_rng: np.random.Generator = seeding.np_random(env_seed)[0]
         if env_rng_state is not None:
@@ -48,7 +57,7 @@ class NumbaEngine:
         p = self._params
         finished, env_steps, solved = self._train_episodes(
             state.tables, p.grid, p.agent, state.metrics, state.agent_rng, self._env_rng,
-            self._env, state.episode, stop, check_solved,
+            self._env, state.episode, stop, check_solved, state.physics_rng, self._randomize,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps

@@ -11,6 +11,7 @@ import math
 import os
 import sys
 import warnings
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -52,7 +53,7 @@ def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "conf
         with warnings.catch_warnings():
             # Gymnasium warns about out-of-date versions such as CartPole-v0; the user chose it.
             warnings.simplefilter("ignore", category=DeprecationWarning)
-            return gymnasium.make(env.id, **kwargs)
+            made = gymnasium.make(env.id, **kwargs)
     except ImportError as error:
         module = env.id.partition(":")[0] if ":" in env.id else (error.name or "a module")
         detail = str(error).split(". ")[0]
@@ -60,6 +61,23 @@ def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "conf
             f"{source}: env.id: cannot make {env.id!r}: the module {module!r} cannot be "
             f"imported ({detail}); install it, or check the part of env.id before ':'."
         ) from None
+    if env.physics:
+        set_physics(made, env.physics)
+    return made
+
+
+def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
+    """Set CartPole's physics on ``env.unwrapped``, derived values recomputed.
+
+    ``total_mass`` and ``polemass_length`` are recomputed exactly as
+    ``CartPoleEnv.__init__`` computes them; setting the attributes alone would leave them
+    stale (ray #14090).
+    """
+    cartpole = env.unwrapped
+    for key, value in physics.items():
+        setattr(cartpole, key, value)
+    cartpole.total_mass = cartpole.masspole + cartpole.masscart
+    cartpole.polemass_length = cartpole.masspole * cartpole.length
 
 
 def inspect_env(config: Config, source: str = "config") -> EnvInfo:

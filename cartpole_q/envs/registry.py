@@ -47,7 +47,10 @@ def twin_ids() -> tuple[str, ...]:
 
 
 def twin_settings(
-    env_id: str, kwargs: Mapping[str, Any], spec_max_steps: int | None
+    env_id: str,
+    kwargs: Mapping[str, Any],
+    spec_max_steps: int | None,
+    physics: Mapping[str, float | str] | None = None,
 ) -> TwinSettings | str:
     """Return the twin settings for ``gymnasium.make(env_id, **kwargs)``, or why there are none.
 
@@ -55,6 +58,7 @@ def twin_settings(
         env_id: the Gymnasium id.
         kwargs: the ``gymnasium.make`` arguments.
         spec_max_steps: the registered time limit, used when ``kwargs`` gives none.
+        physics: ``env.physics`` (CartPole only; the config refuses it elsewhere).
 
     Returns:
         ``TwinSettings`` when a twin reproduces the environment exactly, else a sentence
@@ -64,7 +68,7 @@ def twin_settings(
     if code is None:
         return f"env.id {env_id!r} has no compiled twin (only {', '.join(twin_ids())} do)"
     twin = TWINS[code]
-    params = twin.twin_params(kwargs)
+    params = twin.twin_params(kwargs, physics) if physics else twin.twin_params(kwargs)
     if isinstance(params, str):
         return params
     max_steps = kwargs.get("max_episode_steps", spec_max_steps)
@@ -112,3 +116,28 @@ def _twin_step(code, state, action, observation, params):
         return step(state, action, observation, params)
 
     return implementation
+
+
+def twin_randomize(code, params, rng, keys, lows, highs):
+    """The twin's ``params`` with ``env.randomize``'s draws (CartPole), else ``params``.
+
+    Compiled code only, with ``code`` a compile-time constant (as :func:`twin_reset`).
+    """
+    raise NotImplementedError("twin_randomize is called from compiled code only")
+
+
+@overload(twin_randomize, inline="always")
+def _twin_randomize(code, params, rng, keys, lows, highs):
+    if not isinstance(code, types.IntegerLiteral):
+        return None
+    if code.literal_value == CARTPOLE:
+
+        def physics(code, params, rng, keys, lows, highs):
+            return cartpole.randomized(params, rng, keys, lows, highs)
+
+        return physics
+
+    def unchanged(code, params, rng, keys, lows, highs):
+        return params
+
+    return unchanged

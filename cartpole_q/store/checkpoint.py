@@ -32,6 +32,7 @@ def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
         "env_steps": checkpoint.env_steps,
         "agent_rng_state": checkpoint.agent_rng_state,
         "env_rng_state": checkpoint.env_rng_state,
+        "physics_rng_state": checkpoint.physics_rng_state,
         "solved_episode": checkpoint.solved_episode,
         "evaluations": checkpoint.evaluations,
         "train_seconds": checkpoint.train_seconds,
@@ -75,6 +76,8 @@ def load_checkpoint(run_dir: Path) -> Checkpoint:
                 metrics=EpisodeMetrics(*(data[name] for name in EpisodeMetrics._fields)),
                 agent_rng_state=meta["agent_rng_state"],
                 env_rng_state=meta["env_rng_state"],
+                # checkpoints older than env.randomize have none (nothing was drawn)
+                physics_rng_state=meta.get("physics_rng_state"),
                 solved_episode=meta["solved_episode"],
                 solved_q=data["solved_q"] if "solved_q" in data.files else None,
                 evaluations=meta["evaluations"],

@@ -29,19 +29,33 @@ ENV_IDS = ("CartPole-v1", "CartPole-v0")
 STATE_SIZE = 4
 OBSERVATION_SIZE = 4
 N_ACTIONS = 2
-PARAM_NAMES = ("sutton_barto_reward",)
-"""the ``gymnasium.make`` arguments in ``params``, in order"""
-SUTTON_BARTO_REWARD = 0
-"""index of ``sutton_barto_reward`` (1.0 or 0.0) in ``params``"""
-SUPPORTED_KWARGS = (*PARAM_NAMES, "max_episode_steps")
+PARAM_NAMES = (
+    "sutton_barto_reward",
+    "gravity",
+    "masscart",
+    "masspole",
+    "total_mass",
+    "length",
+    "polemass_length",
+    "force_mag",
+    "tau",
+    "euler",
+    "theta_threshold_radians",
+    "x_threshold",
+)
+"""what ``params`` holds, in order: the reward flag (1.0 or 0.0), the physics with its derived
+values, and the integrator (1.0: euler, 0.0: semi-implicit euler)"""
+(
+    SUTTON_BARTO_REWARD, GRAVITY_, MASSCART_, MASSPOLE_, TOTAL_MASS_, LENGTH_,
+    POLEMASS_LENGTH_, FORCE_MAG_, TAU_, EULER_, THETA_THRESHOLD_, X_THRESHOLD_,
+) = range(len(PARAM_NAMES))  # fmt: skip
+SUPPORTED_KWARGS = ("sutton_barto_reward", "max_episode_steps")
 
 # The constants of CartPoleEnv.__init__, computed the same way.
 GRAVITY = 9.8
 MASSCART = 1.0
 MASSPOLE = 0.1
-TOTAL_MASS = MASSPOLE + MASSCART
 LENGTH = 0.5  # half the pole's length
-POLEMASS_LENGTH = MASSPOLE * LENGTH
 FORCE_MAG = 10.0
 TAU = 0.02
 THETA_THRESHOLD_RADIANS = 12 * 2 * math.pi / 360
@@ -49,12 +63,18 @@ X_THRESHOLD = 2.4
 RESET_LOW, RESET_HIGH = -0.05, 0.05
 
 
-def twin_params(kwargs: Mapping[str, Any]) -> tuple[float, ...] | str:
-    """Return ``params`` for ``gymnasium.make("CartPole-v1", **kwargs)``, or why not.
+def twin_params(
+    kwargs: Mapping[str, Any], physics: Mapping[str, float | str] | None = None
+) -> tuple[float, ...] | str:
+    """Return ``params`` for ``gymnasium.make("CartPole-v1", **kwargs)`` with ``physics``.
+
+    Args:
+        kwargs: the ``gymnasium.make`` arguments.
+        physics: ``env.physics`` (validated by the config): attributes set after making.
 
     Returns:
-        The tuple ``(sutton_barto_reward,)`` (1.0 or 0.0), or a sentence naming the
-        first key the twin cannot reproduce.
+        The tuple of :data:`PARAM_NAMES`, or a sentence naming the first key the twin
+        cannot reproduce.
     """
     problem = unsupported_key(kwargs, SUPPORTED_KWARGS)
     if problem is not None:
@@ -62,7 +82,61 @@ def twin_params(kwargs: Mapping[str, Any]) -> tuple[float, ...] | str:
     sutton_barto = kwargs.get("sutton_barto_reward", False)
     if not isinstance(sutton_barto, bool):
         return f"env.kwargs key 'sutton_barto_reward' must be true or false, got {sutton_barto!r}"
-    return (1.0 if sutton_barto else 0.0,)
+    values: dict[str, Any] = {
+        "gravity": GRAVITY, "masscart": MASSCART, "masspole": MASSPOLE, "length": LENGTH,
+        "force_mag": FORCE_MAG, "tau": TAU, "kinematics_integrator": "euler",
+        "theta_threshold_radians": THETA_THRESHOLD_RADIANS, "x_threshold": X_THRESHOLD,
+        **(physics or {}),
+    }  # fmt: skip
+    masscart, masspole, length = (float(values[k]) for k in ("masscart", "masspole", "length"))
+    return (
+        1.0 if sutton_barto else 0.0,
+        float(values["gravity"]),
+        masscart,
+        masspole,
+        masspole + masscart,  # total_mass, as CartPoleEnv.__init__ computes it
+        length,
+        masspole * length,  # polemass_length, likewise
+        float(values["force_mag"]),
+        float(values["tau"]),
+        1.0 if values["kinematics_integrator"] == "euler" else 0.0,
+        float(values["theta_threshold_radians"]),
+        float(values["x_threshold"]),
+    )
+
+
+@njit(cache=True, nogil=True, inline="always")
+def with_physics(
+    params: tuple[float, ...], gravity: float, masscart: float, masspole: float, length: float,
+    force_mag: float, tau: float,
+) -> tuple[float, ...]:  # fmt: skip
+    """``params`` with new physics; derived values computed as ``CartPoleEnv.__init__`` does."""
+    total_mass = masspole + masscart
+    polemass_length = masspole * length
+    return (
+        params[SUTTON_BARTO_REWARD], gravity, masscart, masspole, total_mass, length,
+        polemass_length, force_mag, tau, params[EULER_], params[THETA_THRESHOLD_],
+        params[X_THRESHOLD_],
+    )  # fmt: skip
+
+
+@njit(cache=True, nogil=True, inline="always")
+def randomized(
+    params: tuple[float, ...], rng: np.random.Generator, keys: np.ndarray, lows: np.ndarray,
+    highs: np.ndarray,
+) -> tuple[float, ...]:  # fmt: skip
+    """``params`` with one ``rng.uniform(low, high)`` drawn per randomised key, in order.
+
+    ``keys`` index ``env.randomize``'s keys in the order gravity, masscart, masspole,
+    length, force_mag, tau; the other values come from ``params`` (``env.physics``).
+    """
+    values = np.array(
+        [params[GRAVITY_], params[MASSCART_], params[MASSPOLE_], params[LENGTH_],
+         params[FORCE_MAG_], params[TAU_]]
+    )  # fmt: skip
+    for i in range(keys.size):
+        values[keys[i]] = rng.uniform(lows[i], highs[i])
+    return with_physics(params, values[0], values[1], values[2], values[3], values[4], values[5])
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -86,26 +160,32 @@ def step(
         left the track). Truncation is the caller's time limit.
     """
     x, x_dot, theta, theta_dot = state[0], state[1], state[2], state[3]
-    force = FORCE_MAG if action == 1 else -FORCE_MAG
+    total_mass, polemass_length = params[TOTAL_MASS_], params[POLEMASS_LENGTH_]
+    tau = params[TAU_]
+    force = params[FORCE_MAG_] if action == 1 else -params[FORCE_MAG_]
     costheta = np.cos(theta)
     sintheta = np.sin(theta)
-    temp = (force + POLEMASS_LENGTH * (theta_dot * theta_dot) * sintheta) / TOTAL_MASS
-    thetaacc = (GRAVITY * sintheta - costheta * temp) / (
-        LENGTH * (4.0 / 3.0 - MASSPOLE * (costheta * costheta) / TOTAL_MASS)
+    temp = (force + polemass_length * (theta_dot * theta_dot) * sintheta) / total_mass
+    thetaacc = (params[GRAVITY_] * sintheta - costheta * temp) / (
+        params[LENGTH_] * (4.0 / 3.0 - params[MASSPOLE_] * (costheta * costheta) / total_mass)
     )
-    xacc = temp - POLEMASS_LENGTH * thetaacc * costheta / TOTAL_MASS
-    x = x + TAU * x_dot
-    x_dot = x_dot + TAU * xacc
-    theta = theta + TAU * theta_dot
-    theta_dot = theta_dot + TAU * thetaacc
+    xacc = temp - polemass_length * thetaacc * costheta / total_mass
+    if params[EULER_] != 0.0:
+        x = x + tau * x_dot
+        x_dot = x_dot + tau * xacc
+        theta = theta + tau * theta_dot
+        theta_dot = theta_dot + tau * thetaacc
+    else:  # semi-implicit euler
+        x_dot = x_dot + tau * xacc
+        x = x + tau * x_dot
+        theta_dot = theta_dot + tau * thetaacc
+        theta = theta + tau * theta_dot
     state[0], state[1], state[2], state[3] = x, x_dot, theta, theta_dot
     for i in range(4):
         observation[i] = np.float32(state[i])
+    x_threshold, theta_threshold = params[X_THRESHOLD_], params[THETA_THRESHOLD_]
     terminated = (
-        x < -X_THRESHOLD
-        or x > X_THRESHOLD
-        or theta < -THETA_THRESHOLD_RADIANS
-        or theta > THETA_THRESHOLD_RADIANS
+        x < -x_threshold or x > x_threshold or theta < -theta_threshold or theta > theta_threshold
     )
     if params[SUTTON_BARTO_REWARD] != 0.0:
         return (-1.0 if terminated else 0.0), terminated

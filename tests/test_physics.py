@@ -1,0 +1,126 @@
+"""CartPole's physics as config: the twin equals Gymnasium with the same physics, exactly."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from gymnasium.utils import seeding
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.envs.gym import make_env
+from cartpole_q.envs.registry import TwinSettings, twin_settings
+from cartpole_q.envs.twins import cartpole as twin
+from cartpole_q.store.rundir import metrics_csv
+from cartpole_q.training import train
+
+PHYSICS_SETTINGS = [
+    {"kinematics_integrator": "semi-implicit euler"},
+    {"length": 0.75, "masspole": 0.3},
+    {"gravity": 3.7, "force_mag": 5.0},
+    {"masscart": 2.5, "tau": 0.01, "kinematics_integrator": "semi-implicit euler"},
+    {"theta_threshold_radians": 0.3, "x_threshold": 4.0},
+    {"length": 0.05, "masspole": 0.01, "force_mag": 20.0, "x_threshold": 1.0},
+]
+
+
+@pytest.mark.parametrize("physics", PHYSICS_SETTINGS)
+def test_twin_with_physics_follows_gymnasium_exactly(physics: dict) -> None:
+    config = load_config(overrides={"env.physics": physics})
+    env = make_env(config.env)
+    settings = twin_settings("CartPole-v1", {}, 500, config.env.physics)
+    assert isinstance(settings, TwinSettings)
+    unwrapped = env.unwrapped
+    for key, value in physics.items():
+        assert getattr(unwrapped, key) == value
+    assert unwrapped.total_mass == unwrapped.masspole + unwrapped.masscart
+    assert unwrapped.polemass_length == unwrapped.masspole * unwrapped.length
+    seed, steps = 3, 10_000
+    actions = np.random.default_rng(seed).integers(0, 2, size=steps)
+    rng = seeding.np_random(seed)[0]
+    state, observation = np.empty(4), np.empty(4, dtype=np.float32)
+    gym_observation, _ = env.reset(seed=seed)
+    twin.reset(state, observation, rng, settings.params)
+    length, episodes = 0, 0
+    for step in range(steps):
+        assert np.array_equal(state, unwrapped.state), f"state differs at step {step}"
+        assert observation.tobytes() == gym_observation.tobytes(), step
+        action = int(actions[step])
+        gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(action)
+        reward, terminated = twin.step(state, action, observation, settings.params)
+        length += 1
+        assert (reward, terminated, length >= 500) == (gym_reward, gym_terminated, gym_truncated)
+        if terminated or length >= 500:
+            gym_observation, _ = env.reset()
+            twin.reset(state, observation, rng, settings.params)
+            length, episodes = 0, episodes + 1
+    assert episodes > 20  # the comparison crossed many resets and terminations
+
+
+@pytest.mark.parametrize(
+    "env_overrides",
+    [
+        {"env.physics": {"length": 0.75, "kinematics_integrator": "semi-implicit euler"}},
+        {"env.randomize": {"masspole": [0.05, 0.5], "force_mag": [5.0, 15.0]}},
+        {
+            "env.physics": {"gravity": 9.0, "tau": 0.015},
+            "env.randomize": {"gravity": [8.0, 12.0], "length": [0.25, 0.75], "tau": [0.02, 0.02]},
+        },
+    ],
+)
+@pytest.mark.parametrize("algorithm", ["q_learning", "sarsa"])
+def test_engines_agree_with_physics_and_randomisation(env_overrides: dict, algorithm: str) -> None:
+    overrides = {**env_overrides, "agent.algorithm": algorithm, "train.episodes": 150,
+                 "train.stop_when_solved": False}  # fmt: skip
+    results = [
+        train(load_config(overrides={**overrides, "engine": engine}), final_eval=False)
+        for engine in ("numba", "gymnasium")
+    ]
+    assert results[0].engine == "numba" and results[1].engine == "gymnasium"
+    assert results[0].q_table.tobytes() == results[1].q_table.tobytes()
+    assert metrics_csv(results[0].metrics) == metrics_csv(results[1].metrics)
+    assert results[0].evaluations == results[1].evaluations
+
+
+def test_randomisation_draws_from_its_own_generator() -> None:
+    # Adding a physics generator changed no existing run; a zero-width range changes nothing
+    # but the physics generator's stream, so the run equals the plain one.
+    plain = train(load_config(overrides={"train.episodes": 120}), final_eval=False)
+    pinned = train(
+        load_config(overrides={"train.episodes": 120, "env.randomize": {"tau": [0.02, 0.02]}}),
+        final_eval=False,
+    )
+    assert plain.q_table.tobytes() == pinned.q_table.tobytes()
+    varied = train(
+        load_config(overrides={"train.episodes": 120, "env.randomize": {"tau": [0.01, 0.03]}}),
+        final_eval=False,
+    )
+    assert metrics_csv(varied.metrics) != metrics_csv(plain.metrics)
+
+
+@pytest.mark.parametrize(
+    ("overrides", "named"),
+    [
+        ({"env.physics": {"lenght": 0.5}}, "env.physics.lenght"),
+        ({"env.physics": {"masspole": 0}}, "env.physics.masspole"),
+        ({"env.physics": {"length": -0.5}}, "env.physics.length"),
+        ({"env.physics": {"tau": 0.0}}, "env.physics.tau"),
+        ({"env.physics": {"kinematics_integrator": "rk4"}}, "env.physics.kinematics_integrator"),
+        ({"env.randomize": {"masspole": [0.5, 0.05]}}, "env.randomize.masspole"),
+        ({"env.randomize": {"x_threshold": [1, 2]}}, "env.randomize.x_threshold"),
+        ({"env.randomize": {"length": 0.5}}, "env.randomize.length"),
+        ({"env.id": "MountainCar-v0", "env.physics": {"tau": 0.01}}, "env.physics"),
+        ({"env.id": "Acrobot-v1", "env.randomize": {"tau": [0.01, 0.02]}}, "env.randomize"),
+    ],
+)
+def test_bad_physics_is_a_config_error_naming_the_key(overrides: dict, named: str) -> None:
+    with pytest.raises(ConfigError, match=named.replace(".", r"\.")):
+        load_config(overrides=overrides)
+
+
+def test_config_yaml_writes_physics_as_given() -> None:
+    config = load_config(
+        overrides={"env.physics": {"length": 1}, "env.randomize": {"tau": [0.01, 0.02]}}
+    )
+    env = config.to_dict()["env"]
+    assert env["physics"] == {"length": 1.0} and env["randomize"] == {"tau": [0.01, 0.02]}
+    assert load_config().to_dict()["env"]["physics"] == {}  # never filled with defaults
