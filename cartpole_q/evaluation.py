@@ -7,12 +7,13 @@ environment's random stream.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import MAX_EPISODES, Config, ConfigError
+from cartpole_q.config import MAX_EPISODES, Config, ConfigError, load_config
 from cartpole_q.engines.base import AgentParams
 from cartpole_q.engines.play import FrameCallback, play_greedy
 from cartpole_q.envs.gym import inspect_env, make_env
@@ -58,6 +59,24 @@ class EvalReport:
     def from_returns(cls, returns: np.ndarray, seed: int) -> EvalReport:
         """Build a report from an array of returns."""
         return cls(returns=tuple(float(r) for r in returns), seed=seed)
+
+
+def under_conditions(
+    config: Config,
+    physics: Mapping[str, Any] | None = None,
+    max_steps: int | None = None,
+) -> Config:
+    """The config with other physics (merged onto its ``env.physics``) or another horizon.
+
+    Checked like a config: an unknown key, a bad value, or physics on an environment that
+    is not CartPole is a ``ConfigError`` naming it (``eval --physics``, ``--max-steps``).
+    """
+    overrides: dict[str, Any] = {}
+    if physics:
+        overrides["env.physics"] = {**config.env.physics, **physics}
+    if max_steps is not None:
+        overrides["env.kwargs.max_episode_steps"] = max_steps
+    return load_config(config.to_dict(), overrides) if overrides else config
 
 
 def evaluate(

@@ -124,3 +124,39 @@ def test_config_yaml_writes_physics_as_given() -> None:
     env = config.to_dict()["env"]
     assert env["physics"] == {"length": 1.0} and env["randomize"] == {"tau": [0.01, 0.02]}
     assert load_config().to_dict()["env"]["physics"] == {}  # never filled with defaults
+
+
+@pytest.fixture(scope="module")
+def solved_run(tmp_path_factory: pytest.TempPathFactory):  # type: ignore[no-untyped-def]
+    from tests.conftest import invoke
+
+    out = tmp_path_factory.mktemp("runs") / "default"
+    assert invoke("train", "--out", out, "-q").exit_code == 0
+    return out
+
+
+def _eval_json(*args: object) -> dict:
+    import json
+
+    from tests.conftest import invoke
+
+    result = invoke("eval", *args, "--json")
+    assert result.exit_code == 0, result.output
+    return json.loads(result.stdout)
+
+
+def test_eval_plays_under_other_physics_and_horizons(solved_run) -> None:  # type: ignore[no-untyped-def]
+    assert _eval_json(solved_run, "--episodes", "5")["mean"] == 500.0
+    weak = _eval_json(solved_run, "--episodes", "5", "--physics", "force_mag=0.5")
+    assert weak["mean"] < 200  # too weak a push to hold the pole
+    longer = _eval_json(solved_run, "--episodes", "3", "--max-steps", "800")
+    assert 500 < longer["max"] <= 800
+
+
+def test_eval_refuses_bad_physics(solved_run) -> None:  # type: ignore[no-untyped-def]
+    from tests.conftest import invoke
+    from tests.test_cli import assert_refused
+
+    assert_refused(invoke("eval", solved_run, "--physics", "lenght=1"), "env.physics.lenght")
+    assert_refused(invoke("eval", solved_run, "--physics", "masspole=-1"), "env.physics.masspole")
+    assert_refused(invoke("eval", solved_run, "--physics", "masspole"), "masspole")

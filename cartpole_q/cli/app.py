@@ -9,6 +9,7 @@ Heavy modules (numpy, numba, gymnasium, matplotlib) are imported inside the comm
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -385,21 +386,45 @@ def eval_command(
             show_default="one per core",
         ),
     ] = None,
+    physics: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--physics",
+            metavar="KEY=VALUE",
+            help="Play under other CartPole physics, e.g. --physics length=0.75 (repeatable; "
+            "keys of env.physics).",
+        ),
+    ] = None,
+    max_steps: Annotated[
+        int | None,
+        typer.Option(
+            metavar="N", min=1, help="Play with another time limit (env max_episode_steps)."
+        ),
+    ] = None,
 ) -> None:
     """Play a run's greedy policy in gymnasium.make and report its returns."""
     with _exit_codes():
         from cartpole_q.cli.report import eval_line
+        from cartpole_q.config import parse_assignment
         from cartpole_q.store import rundir
 
+        changed = {key: value for key, value in map(parse_assignment, physics or [])}
         if rundir.is_multi_seed(run_dir):
             if video is not None or render:
                 raise UserError(
                     f"{run_dir}: is a multi-seed run; --video and --render take one seed's "
                     "run directory (one of its seed-* subdirectories)."
                 )
-            _eval_seeds(run_dir, episodes, seed, json_output, workers)
+            _eval_seeds(run_dir, episodes, seed, json_output, workers, changed, max_steps)
             return
         run = rundir.load_run(run_dir)
+        threshold = run.summary.get("reward_threshold")
+        if changed or max_steps is not None:
+            from cartpole_q.envs.gym import inspect_env
+            from cartpole_q.evaluation import under_conditions
+
+            run = dataclasses.replace(run, config=under_conditions(run.config, changed, max_steps))
+            threshold = inspect_env(run.config).reward_threshold
         if render and video is not None:
             raise UserError("--render and --video cannot be combined: choose one.")
         if render:
@@ -415,7 +440,7 @@ def eval_command(
         if json_output:
             typer.echo(json.dumps(report.to_dict()))
         else:
-            typer.echo(eval_line(run_dir, report.to_dict(), run.summary.get("reward_threshold")))
+            typer.echo(eval_line(run_dir, report.to_dict(), threshold))
             if video is not None:
                 typer.echo(f"video: {video}")
 
@@ -450,12 +475,20 @@ def _evaluate_run(
 
 
 def _eval_seeds(
-    parent: Path, episodes: int | None, seed: int | None, json_output: bool, workers: int | None
+    parent: Path,
+    episodes: int | None,
+    seed: int | None,
+    json_output: bool,
+    workers: int | None,
+    physics: dict[str, Any] | None = None,
+    max_steps: int | None = None,
 ) -> None:
     from cartpole_q.cli.report import eval_seeds_text
     from cartpole_q.experiments.multiseed import evaluate_seeds
 
-    result = evaluate_seeds(parent, episodes=episodes, seed=seed, workers=workers)
+    result = evaluate_seeds(
+        parent, episodes=episodes, seed=seed, workers=workers, physics=physics, max_steps=max_steps
+    )
     if json_output:
         typer.echo(json.dumps(result))
         if result["note"]:

@@ -588,12 +588,18 @@ def seed_status(parent: Path) -> SeedStatus:
 
 
 def _evaluate_one(
-    worker: Worker | None, path: str, episodes: int | None, seed: int | None
+    worker: Worker | None,
+    path: str,
+    episodes: int | None,
+    seed: int | None,
+    physics: dict[str, Any] | None = None,
+    max_steps: int | None = None,
 ) -> dict[str, Any]:
-    from cartpole_q.evaluation import evaluate
+    from cartpole_q.evaluation import evaluate, under_conditions
 
     run = rundir.load_run(path)
-    report = evaluate(run.q_table, run.config, episodes=episodes, seed=seed)
+    config = under_conditions(run.config, physics, max_steps)
+    report = evaluate(run.q_table, config, episodes=episodes, seed=seed)
     return {"run_seed": run.config.seed, "path": run.path.name, **report.to_dict()}
 
 
@@ -603,8 +609,12 @@ def evaluate_seeds(
     episodes: int | None = None,
     seed: int | None = None,
     workers: int | None = None,
+    physics: dict[str, Any] | None = None,
+    max_steps: int | None = None,
 ) -> dict[str, Any]:
     """Evaluate every finished seed of a multi-seed run in ``gymnasium.make``, in parallel.
+
+    ``physics`` and ``max_steps`` play under other conditions (see ``under_conditions``).
 
     Returns:
         ``runs`` (one ``eval --json`` object per finished seed, with ``run_seed`` and
@@ -624,13 +634,19 @@ def evaluate_seeds(
     for path in paths:
         rundir.load_run(path)
     workers = workers or default_workers(len(paths))
-    jobs = [(path, episodes, seed) for path in paths]
+    jobs = [(path, episodes, seed, physics, max_steps) for path in paths]
     if workers <= 1:
         results = [_evaluate_one(None, *job) for job in jobs]
     else:
         results = run_in_workers(_evaluate_one, jobs, workers)
-    threshold = rundir.read_summary(Path(paths[0])) or {}
-    reward_threshold = threshold.get("reward_threshold")
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.evaluation import under_conditions
+
+    first = rundir.load_run(paths[0])
+    reward_threshold = first.summary.get("reward_threshold")
+    if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
+        conditions = under_conditions(first.config, physics, max_steps)
+        reward_threshold = inspect_env(conditions).reward_threshold
     means = [result["mean"] for result in results]
     return {
         "runs": results,
