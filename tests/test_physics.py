@@ -160,3 +160,50 @@ def test_eval_refuses_bad_physics(solved_run) -> None:  # type: ignore[no-untype
     assert_refused(invoke("eval", solved_run, "--physics", "lenght=1"), "env.physics.lenght")
     assert_refused(invoke("eval", solved_run, "--physics", "masspole=-1"), "env.physics.masspole")
     assert_refused(invoke("eval", solved_run, "--physics", "masspole"), "masspole")
+
+
+def test_robustness_grid_equals_eval_under_the_same_physics(solved_run, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    import csv
+
+    from tests.conftest import invoke
+
+    out = tmp_path / "robust.png"
+    result = invoke(
+        "robustness", solved_run, "--vary", "force_mag=0.5:10.5:3", "--episodes", "4",
+        "--seed", "7", "--out", out,
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert out.is_file() and out.read_bytes()[:4] == b"\x89PNG"
+    rows = list(csv.DictReader(out.with_suffix(".csv").open()))
+    assert [float(row["force_mag"]) for row in rows] == [0.5, 5.5, 10.5]
+    # the grid plays on the twin; eval --physics plays in gymnasium.make: the same returns
+    for row in rows:
+        played = _eval_json(
+            solved_run,
+            "--episodes",
+            "4",
+            "--seed",
+            "7",
+            "--physics",
+            f"force_mag={row['force_mag']}",
+        )
+        assert float(row["mean"]) == played["mean"]
+    assert float(rows[0]["mean"]) < 200 <= float(rows[2]["mean"])
+
+
+@pytest.mark.parametrize(
+    ("args", "named"),
+    [
+        (("--vary", "length=0.1:1"), "KEY=START:STOP:N"),
+        (("--vary", "x_threshold=1:2:3"), "cannot vary"),
+        (("--vary", "length=a:1:3"), "numbers"),
+        (("--vary", "length=0.1:1:3", "--vary", "length=0.1:1:3"), "two different keys"),
+        (("--preset", "nope"), "unknown"),
+        ((), "--vary"),
+    ],
+)
+def test_robustness_refuses_bad_axes(solved_run, tmp_path, args, named: str) -> None:  # type: ignore[no-untyped-def]
+    from tests.conftest import invoke
+    from tests.test_cli import assert_refused
+
+    assert_refused(invoke("robustness", solved_run, *args, "--out", tmp_path / "r.png"), named)

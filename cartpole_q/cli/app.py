@@ -551,6 +551,62 @@ def plot(
         typer.echo(str(path))
 
 
+@app.command("robustness", cls=_Command)
+def robustness_command(
+    run_dir: Annotated[
+        Path,
+        typer.Argument(metavar="RUN_DIR", help="A CartPole run directory (single or multi-seed)."),
+    ],
+    vary: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--vary",
+            metavar="KEY=START:STOP:N",
+            help="A physics key and N values from START to STOP, e.g. length=0.25:0.75:11; "
+            "once for a curve, twice for a heatmap.",
+        ),
+    ] = None,
+    preset: Annotated[
+        str | None,
+        typer.Option(
+            metavar="NAME",
+            help="Instead of --vary: rl-generalization (force_mag 5-15 x length 0.25-0.75) "
+            "or rl-generalization-extreme (1-20 x 0.05-1.0).",
+        ),
+    ] = None,
+    points: Annotated[
+        int, typer.Option(metavar="N", min=1, max=100, help="Values per key of a --preset.")
+    ] = 11,
+    episodes: Annotated[
+        int, typer.Option(metavar="N", min=1, help="Greedy episodes per grid point.")
+    ] = 20,
+    seed: Annotated[
+        int, typer.Option(metavar="N", min=0, help="Seed of each grid point's first reset.")
+    ] = 1000000,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="FILE",
+            help="The figure (.png, .svg, .pdf); the table goes beside it as .csv.",
+            show_default="RUN_DIR/robustness.png",
+        ),
+    ] = None,
+    force: Annotated[bool, typer.Option("--force", help="Replace existing files.")] = False,
+) -> None:
+    """The greedy policy's mean return as CartPole's physics vary: a CSV and a plot."""
+    with _exit_codes():
+        from cartpole_q.experiments.robustness import parse_vary, preset_axes, robustness
+
+        if (preset is None) == (not vary):
+            raise UserError("give --vary KEY=START:STOP:N (once or twice) or --preset NAME.")
+        axes = preset_axes(preset, points) if preset else [parse_vary(text) for text in vary or []]
+        figure, table = robustness(
+            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force
+        )
+        typer.echo(str(table))
+        typer.echo(str(figure))
+
+
 def main() -> None:
     """Entry point of the ``cartpole-q`` console script."""
     app()
