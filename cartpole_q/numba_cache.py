@@ -1,7 +1,7 @@
 """Where numba keeps compiled code: a private cache directory keyed by the compiled source.
 
 numba invalidates a cached function only when the function's own file changes, not when
-a function it inlines from another file does (the engines inline ``agent.py``). A stale
+a function it inlines from another file does (the engines inline ``rl/``, ``envs/``). A stale
 cache would silently run old code, and the two engines would no longer agree. So every
 version of the compiled modules gets its own directory,
 ``$XDG_CACHE_HOME/cartpole-q/numba-<hash of the compiled modules>`` (``~/.cache`` by
