@@ -607,6 +607,29 @@ def robustness_command(
         typer.echo(str(figure))
 
 
+@app.command("compare", cls=_Command)
+def compare_command(
+    dir_a: Annotated[Path, typer.Argument(metavar="DIR_A", help="A run or multi-seed run.")],
+    dir_b: Annotated[Path, typer.Argument(metavar="DIR_B", help="Another one.")],
+    metric: Annotated[
+        str,
+        typer.Option(
+            metavar="NAME",
+            help="eval_mean (higher is better) or solved_episode (lower is better).",
+        ),
+    ] = "eval_mean",
+    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """The probability that a seed of DIR_A beats a seed of DIR_B, with a 95% interval."""
+    with _exit_codes():
+        from cartpole_q.experiments.compare import compare, summary_text
+
+        result = compare(dir_a, dir_b, metric)
+        typer.echo(
+            json.dumps(result.to_dict()) if json_output else summary_text(dir_a, dir_b, result)
+        )
+
+
 def main() -> None:
     """Entry point of the ``cartpole-q`` console script."""
     app()
