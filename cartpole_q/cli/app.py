@@ -592,6 +592,12 @@ def robustness_command(
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace existing files.")] = False,
+    max_steps: Annotated[
+        int | None,
+        typer.Option(
+            metavar="N", min=1, help="Play with this time limit instead of the run's own."
+        ),
+    ] = None,
 ) -> None:
     """The greedy policy's mean return as CartPole's physics vary: a CSV and a plot."""
     with _exit_codes():
@@ -601,7 +607,7 @@ def robustness_command(
             raise UserError("give --vary KEY=START:STOP:N (once or twice) or --preset NAME.")
         axes = preset_axes(preset, points) if preset else [parse_vary(text) for text in vary or []]
         figure, table = robustness(
-            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force
+            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force, max_steps
         )
         typer.echo(str(table))
         typer.echo(str(figure))

@@ -89,13 +89,13 @@ def preset_axes(name: str, points: int) -> list[Axis]:
 
 
 def measure(
-    run_dir: Path, axes: list[Axis], episodes: int, seed: int
+    run_dir: Path, axes: list[Axis], episodes: int, seed: int, max_steps: int | None = None
 ) -> tuple[np.ndarray, list[float], float | None]:
     """Each seed's greedy mean return at each grid point.
 
     Returns:
         ``(means, trained, threshold)``: means of shape ``(seeds, *grid)``; each key's
-        training value; the run's threshold.
+        training value; the threshold at the horizon played (``max_steps``, else the run's).
     """
     runs = load_seed_runs(run_dir) if rundir.is_multi_seed(run_dir) else [rundir.load_run(run_dir)]
     config = runs[0].config
@@ -110,17 +110,26 @@ def measure(
     engines = []
     for point in grid:
         physics = {axis.key: float(value) for axis, value in zip(axes, point, strict=True)}
-        engines.append(make_engine("numba", under_conditions(config, physics), info, env_seed=0))
+        engines.append(
+            make_engine("numba", under_conditions(config, physics, max_steps), info, env_seed=0)
+        )
     for r, run in enumerate(runs):
         table = run.q_table.reshape(-1, info.n_actions)
         for p, engine in enumerate(engines):
             means[r, p] = float(np.mean(engine.evaluate(table, episodes, seed)))
     trained = [float(config.env.physics.get(axis.key, DEFAULTS[axis.key])) for axis in axes]
-    return means.reshape(shape), trained, runs[0].summary.get("reward_threshold")
+    threshold = inspect_env(under_conditions(config, None, max_steps)).reward_threshold
+    return means.reshape(shape), trained, threshold
 
 
 def robustness(
-    run_dir: Path, axes: list[Axis], episodes: int, seed: int, out: Path, force: bool = False
+    run_dir: Path,
+    axes: list[Axis],
+    episodes: int,
+    seed: int,
+    out: Path,
+    force: bool = False,
+    max_steps: int | None = None,
 ) -> tuple[Path, Path]:
     """Measure, then write the figure ``out`` and ``out`` with ``.csv``; return both paths.
 
@@ -133,9 +142,10 @@ def robustness(
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     table_path = out.with_suffix(".csv")
     check_output_file(table_path, "--out (its .csv)", (".csv",), force)
-    means, trained, threshold = measure(run_dir, axes, episodes, seed)
+    means, trained, threshold = measure(run_dir, axes, episodes, seed, max_steps)
     atomic_write_text(table_path, _csv(axes, means))
-    title = f"Robustness of {run_dir.name}: greedy mean over {episodes} episodes"
+    horizon = "" if max_steps is None else f" of {max_steps} steps"
+    title = f"Robustness of {run_dir.name}: greedy mean over {episodes} episodes{horizon}"
     figure = robustness_figure([(a.key, a.values) for a in axes], means, trained, threshold, title)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out, table_path
