@@ -7,6 +7,7 @@ environment's random stream.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -17,6 +18,7 @@ from cartpole_q.config import MAX_EPISODES, Config, ConfigError, load_config
 from cartpole_q.engines.base import AgentParams
 from cartpole_q.engines.play import FrameCallback, play_greedy
 from cartpole_q.envs.gym import inspect_env, make_env
+from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.errors import RunError
 
 
@@ -108,29 +110,43 @@ def evaluate(
             f"--episodes: must be between 1 and {MAX_EPISODES:,} greedy episodes, got {episodes:,}."
         )
     env_info = inspect_env(config)
-    check_q_table(q_table, config.discretization.bins, env_info.n_actions, "the Q-table")
+    check_q_table(q_table, env_info.state_shape, env_info.n_actions, "the Q-table")
     params = AgentParams.from_config(config, env_info)
     seed = config.eval.seed if seed is None else seed
     env = make_env(config.env, render_mode=render_mode)
+    step_cap = None if env_info.max_episode_steps else GREEDY_STEP_CAP
     try:
         returns = play_greedy(
-            env, q_table.reshape(-1, env_info.n_actions), params.grid, episodes, seed, on_frame
-        )
+            env, q_table.reshape(-1, env_info.n_actions), params.grid, episodes, seed, on_frame,
+            step_cap,
+        )  # fmt: skip
     finally:
         env.close()
     return EvalReport.from_returns(returns, seed)
 
 
 def check_q_table(
-    q_table: np.ndarray, bins: tuple[int, ...], n_actions: int | None, source: str
+    q_table: np.ndarray, bins: tuple[int, ...] | None, n_actions: int | None, source: str
 ) -> None:
     """Check a Q-table against its config's grid (and the environment's actions).
+
+    Args:
+        q_table: the table.
+        bins: its shape without the action axis (the grid's bins, or a Discrete
+            observation's sizes); ``None``: unknown here (no grid), checked against the
+            environment later.
+        n_actions: the environment's actions, if known.
+        source: the file or object named in errors.
 
     Raises:
         RunError: wrong dtype or shape, or a non-finite value.
     """
     if q_table.dtype != np.float64:
         raise RunError(f"{source}: must hold float64 values, found {q_table.dtype}.")
+    if bins is None:
+        if q_table.ndim < 2:
+            raise RunError(f"{source}: has shape {q_table.shape}; expected (*states, n_actions).")
+        bins = tuple(q_table.shape[:-1])
     expected = f"(*bins, n_actions) = ({', '.join(map(str, bins))}, {n_actions or 'n_actions'})"
     if q_table.ndim != len(bins) + 1 or tuple(q_table.shape[:-1]) != tuple(bins):
         raise RunError(
@@ -143,3 +159,118 @@ def check_q_table(
         )
     if not np.isfinite(q_table).all():
         raise RunError(f"{source}: holds NaN or infinite values.")
+
+
+@dataclass(frozen=True)
+class ExactReport:
+    """A greedy policy's exact expected return beside the optimum, from the environment's model.
+
+    ``return``: undiscounted, within the episode's step limit (the time limit, or the
+    greedy cap where there is none), from the start distribution: what ``eval``'s mean
+    estimates (for FrozenLake the success probability). The optimum here is the best of
+    all policies, also those that change with the steps left (backward induction).
+    ``discounted``: infinite-horizon, with the run's ``agent.gamma`` (what the agent
+    optimises; left out when ``gamma`` is 1). ``gap`` = optimum - greedy.
+    """
+
+    note: str
+    """what ``return`` measures, in a few words"""
+    horizon: int
+    gamma: float
+    optimum: float
+    greedy: float | None
+    optimum_discounted: float | None
+    greedy_discounted: float | None
+    optimal_policy: tuple[int, ...] = ()
+    """the best first action per Q-table row (undiscounted, all steps left), lowest on ties"""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The figures as ``eval --json`` adds them (``greedy`` and ``gap`` only with a table)."""
+        optimum: dict[str, Any] = {"return": self.optimum, "horizon": self.horizon}
+        if self.optimum_discounted is not None:
+            optimum.update(discounted=self.optimum_discounted, gamma=self.gamma)
+        result: dict[str, Any] = {"optimum": optimum, "note": self.note}
+        if self.greedy is not None:
+            greedy: dict[str, Any] = {"return": self.greedy}
+            gap: dict[str, Any] = {"return": self.optimum - self.greedy}
+            if self.greedy_discounted is not None and self.optimum_discounted is not None:
+                greedy["discounted"] = self.greedy_discounted
+                gap["discounted"] = self.optimum_discounted - self.greedy_discounted
+            result.update(greedy=greedy, gap=gap)
+        return result
+
+
+def exact_report(
+    config: Config, q_table: np.ndarray | None = None, gamma: float | None = None
+) -> ExactReport | str:
+    """The optimum (and ``q_table``'s greedy policy) computed exactly, or why it cannot be.
+
+    Args:
+        config: the environment (``env``) and, unless ``gamma`` is given, the discount.
+        q_table: a learned table, shape ``(*states, n_actions)``; ``None``: the optimum alone.
+        gamma: the discount of the discounted figures (default ``config.agent.gamma``).
+
+    Returns:
+        The report, or a sentence saying why the environment has no exact model.
+    """
+    from cartpole_q.rl.value_iteration import policy_horizon_values, policy_values
+
+    gamma = config.agent.gamma if gamma is None else gamma
+    found = _model(config.env.id, _frozen(config.env.kwargs))
+    if isinstance(found, str):
+        return found
+    env_model, note = found
+    optimum, optimum_discounted, best = _optimum(config.env.id, _frozen(config.env.kwargs), gamma)
+    greedy = greedy_discounted = None
+    if q_table is not None:
+        rows = q_table.reshape(-1, q_table.shape[-1])
+        if rows.shape[0] <= int(env_model.row_of_state.max()):
+            raise RunError(
+                f"the Q-table has {rows.shape[0]} states, fewer than the environment's model."
+            )
+        policy = np.argmax(rows[env_model.row_of_state], axis=1)
+        greedy = policy_horizon_values(env_model.model, policy, env_model.horizon).start_value
+        if gamma < 1.0:
+            greedy_discounted = policy_values(env_model.model, policy, gamma).start_value
+    return ExactReport(
+        note, env_model.horizon, gamma, optimum, greedy, optimum_discounted, greedy_discounted,
+        best,
+    )  # fmt: skip
+
+
+def _frozen(kwargs: Mapping[str, Any]) -> str:
+    import json
+
+    return json.dumps(dict(kwargs), sort_keys=True, default=str)
+
+
+@functools.cache
+def _model(env_id: str, kwargs_json: str) -> tuple[Any, str] | str:
+    """The environment's exact model (built once per process) and what its values mean."""
+    import json
+
+    from cartpole_q.config import EnvConfig
+    from cartpole_q.envs.models import env_model, optimum_note
+
+    found = env_model(EnvConfig(id=env_id, kwargs=json.loads(kwargs_json)))
+    if isinstance(found, str):
+        return found
+    return found, optimum_note(found)
+
+
+@functools.cache
+def _optimum(
+    env_id: str, kwargs_json: str, gamma: float
+) -> tuple[float, float | None, tuple[int, ...]]:
+    from cartpole_q.rl.value_iteration import finite_horizon, value_iteration
+
+    found = _model(env_id, kwargs_json)
+    assert not isinstance(found, str)
+    env_model = found[0]
+    within = finite_horizon(env_model.model, env_model.horizon)
+    discounted = value_iteration(env_model.model, gamma).start_value if gamma < 1.0 else None
+    n_rows = int(env_model.row_of_state.max()) + 1
+    best = np.zeros(n_rows, dtype=np.int64)
+    best[env_model.row_of_state] = within.policy  # a natural's row is its observation's
+    best[env_model.row_of_state[:n_rows]] = within.policy[:n_rows]
+    return within.start_value, discounted, tuple(int(a) for a in best)

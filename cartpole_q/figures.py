@@ -10,8 +10,10 @@ from __future__ import annotations
 import io
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
@@ -109,7 +111,13 @@ def bootstrap_band(
     n_seeds = curves.shape[0]
     mean = np.nanmean(curves, axis=0)
     picks = rng.integers(0, n_seeds, size=(resamples, n_seeds))
-    resampled = np.nanmean(curves[picks], axis=1)
+    # A resample's mean is (how often each seed was picked) @ (the seeds' values): one
+    # matrix product instead of a (resamples, seeds, episodes) array.
+    counts = np.zeros((resamples, n_seeds))
+    np.add.at(counts, (np.arange(resamples)[:, None], picks), 1.0)
+    present = ~np.isnan(curves)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        resampled = (counts @ np.where(present, curves, 0.0)) / (counts @ present)
     low, high = np.nanpercentile(resampled, [2.5, 97.5], axis=0)
     return mean, low, high
 
@@ -126,7 +134,13 @@ def reward_curve_figure(
     its legend entry.
     """
     figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
-    axes = figure.add_subplot()
+    _draw_reward_curves(figure.add_subplot(), curves, threshold, title)
+    return figure
+
+
+def _draw_reward_curves(
+    axes: Axes, curves: Sequence[Curve | SeedBand], threshold: float | None, title: str
+) -> None:
     colours = _colours(len(curves))
     for item, colour in zip(curves, colours, strict=True):
         if isinstance(item, SeedBand):
@@ -157,7 +171,6 @@ def reward_curve_figure(
     axes.set_title(title)
     axes.grid(alpha=0.3)
     axes.legend(loc="best", fontsize="small")
-    return figure
 
 
 def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
@@ -348,6 +361,160 @@ def action_names(env_id: str, n_actions: int) -> list[str] | None:
     return list(names) if names is not None and len(names) == n_actions else None
 
 
+@dataclass(frozen=True)
+class GridMap:
+    """A grid world's map, as the figures take it (see ``cartpole_q.envs.models.GridLayout``)."""
+
+    rows: int
+    columns: int
+    cells: Sequence[str]
+    """per state ``row * columns + column``: ``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal"""
+    moves: Sequence[tuple[int, int]]
+    """per action: ``(row step, column step)``"""
+
+
+_CELL_COLOURS = {"H": "#30405a", "C": "#3a3a3a", "G": "#3c9a4a"}
+_CELL_NAMES = {"H": "hole", "C": "cliff", "G": "goal", "S": "start"}
+
+
+def _draw_grid(axes: Axes, grid: GridMap, values: np.ndarray | None = None) -> None:
+    """Cells (holes, cliff and goal coloured and named; others by ``values`` if given)."""
+    shape = (grid.rows, grid.columns)
+    special = np.array([cell in _CELL_COLOURS for cell in grid.cells]).reshape(shape)
+    if values is not None:
+        shown = np.ma.masked_where(special | np.isnan(values.reshape(shape)), values.reshape(shape))
+        image = axes.imshow(shown, cmap="viridis", origin="upper", interpolation="nearest")
+        figure: Any = axes.figure
+        figure.colorbar(image, ax=axes, shrink=0.8, label="state value max_a Q")
+    for state, cell in enumerate(grid.cells):
+        row, column = divmod(state, grid.columns)
+        if cell in _CELL_COLOURS:
+            axes.add_patch(_square(row, column, _CELL_COLOURS[cell]))
+        if cell in _CELL_NAMES:
+            colour = "white" if cell in _CELL_COLOURS else "black"
+            axes.text(column, row + 0.3, _CELL_NAMES[cell], ha="center", va="center",
+                      fontsize=7, color=colour)  # fmt: skip
+    axes.set_xlim(-0.5, grid.columns - 0.5)
+    axes.set_ylim(grid.rows - 0.5, -0.5)
+    axes.set_xticks(np.arange(-0.5, grid.columns, 1.0), minor=True)
+    axes.set_yticks(np.arange(-0.5, grid.rows, 1.0), minor=True)
+    axes.grid(which="minor", color="white", linewidth=1.0)
+    axes.tick_params(which="both", length=0)
+    axes.set_xticks(range(grid.columns))
+    axes.set_yticks(range(grid.rows))
+    axes.set_aspect("equal")
+
+
+def _square(row: int, column: int, colour: str) -> Any:
+    from matplotlib.patches import Rectangle
+
+    return Rectangle((column - 0.5, row - 0.5), 1.0, 1.0, color=colour, zorder=2)
+
+
+def grid_policy_figure(
+    q_table: np.ndarray, visits: np.ndarray | None, grid: GridMap, title: str
+) -> Figure:
+    """A grid world's greedy policy: an arrow per cell over the state value ``max_a Q``.
+
+    Holes, cliff and goal are coloured and named; cells training never visited get no
+    arrow and no colour.
+    """
+    q = q_table.reshape(grid.rows * grid.columns, -1)
+    visited = (
+        np.ones(len(q), dtype=bool) if visits is None else visits.reshape(len(q), -1).sum(1) > 0
+    )
+    values = np.where(visited, q.max(axis=1), np.nan)
+    width = min(14.0, 1.0 + 0.75 * grid.columns + 1.5)
+    figure = Figure(figsize=(width, 1.0 + 0.75 * grid.rows), dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    _draw_grid(axes, grid, values)
+    for state in range(len(q)):
+        if not visited[state] or grid.cells[state] in _CELL_COLOURS:
+            continue
+        row, column = divmod(state, grid.columns)
+        d_row, d_col = grid.moves[int(np.argmax(q[state]))]
+        axes.annotate("", xy=(column + 0.32 * d_col, row + 0.32 * d_row),
+                      xytext=(column - 0.32 * d_col, row - 0.32 * d_row),
+                      arrowprops={"arrowstyle": "->", "color": "white", "linewidth": 1.8},
+                      zorder=3)  # fmt: skip
+    axes.set_xlabel("column")
+    axes.set_ylabel("row")
+    axes.set_title(f"{title}\ngreedy action per cell (blank: never visited in training)")
+    return figure
+
+
+def draw_paths(axes: Axes, grid: GridMap, paths: Sequence[tuple[str, Sequence[int], bool]]) -> None:
+    """Draw greedy paths (lists of states) on a grid; a path that never ends is dashed."""
+    _draw_grid(axes, grid)
+    colours = _colours(len(paths))
+    for index, ((label, states, ends), colour) in enumerate(zip(paths, colours, strict=True)):
+        offset = 0.12 * (index - (len(paths) - 1) / 2)
+        rows = [divmod(state, grid.columns)[0] + offset for state in states]
+        columns = [divmod(state, grid.columns)[1] + offset for state in states]
+        steps = len(states) - 1
+        text = f"{label}: {steps} steps" if ends else f"{label}: never reaches the goal"
+        axes.plot(columns, rows, color=colour, linewidth=2.5, linestyle="-" if ends else "--",
+                  marker="o", markersize=3, label=text, zorder=4)  # fmt: skip
+    axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), fontsize="small", ncol=2)
+
+
+def reward_and_paths_figure(
+    curves: Sequence[Curve | SeedBand],
+    threshold: float | None,
+    title: str,
+    grid: GridMap,
+    paths: Sequence[tuple[str, Sequence[int], bool]],
+) -> Figure:
+    """Reward curves (as :func:`reward_curve_figure`) above each run's greedy path on the grid."""
+    figure = Figure(figsize=(9.0, 8.0), dpi=DPI, layout="constrained")
+    top, bottom = figure.subplots(2, 1, height_ratios=[1.4, 1.0])
+    _draw_reward_curves(top, curves, threshold, title)
+    # The first episodes of a grid world can cost thousands; show the learning after them.
+    settled = []
+    for item in curves:
+        runs = item.returns if isinstance(item, SeedBand) else [item.returns]
+        for returns in runs:
+            averages = moving_average(np.asarray(returns, dtype=float))
+            settled.append(averages[len(averages) // 10 :])
+    values = np.concatenate(settled) if settled else np.zeros(1)
+    if values.size:
+        low, high = float(np.percentile(values, 1)), float(np.max(values))
+        top.set_ylim(low - 0.1 * (high - low + 1.0), high + 0.1 * (high - low + 1.0))
+    draw_paths(bottom, grid, paths)
+    bottom.set_title("greedy path from the start (a multi-seed run's first seed)")
+    return figure
+
+
+def blackjack_policy_figure(q_table: np.ndarray, visits: np.ndarray | None, title: str) -> Figure:
+    """Blackjack's greedy policy as Sutton & Barto draw it: usable ace or not, hit or stick.
+
+    ``q_table`` has shape ``(32, 11, 2, 2)``: player sum, dealer's card, usable ace,
+    action (0 stick, 1 hit). Player sums 12-21 (below 12 a hit cannot bust); cells never
+    visited in training are blank.
+    """
+    sums, dealer = np.arange(12, 22), np.arange(1, 11)
+    figure = Figure(figsize=(10.0, 4.6), dpi=DPI, layout="constrained")
+    panels = figure.subplots(1, 2)
+    colours = ListedColormap(["#d9e6f2", "#c0392b"])
+    for axes, usable in zip(panels, (1, 0), strict=True):
+        actions = np.argmax(q_table[12:22, 1:11, usable], axis=-1).astype(float)
+        if visits is not None:
+            actions = np.ma.masked_where(visits[12:22, 1:11, usable].sum(-1) == 0, actions)
+        axes.imshow(actions, origin="lower", cmap=colours, vmin=0, vmax=1, aspect="auto",
+                    extent=(0.5, 10.5, 11.5, 21.5), interpolation="nearest")  # fmt: skip
+        axes.set_xticks(dealer, ["A", *map(str, range(2, 11))])
+        axes.set_yticks(sums)
+        axes.set_xlabel("dealer showing")
+        axes.set_ylabel("player sum")
+        axes.set_title("usable ace" if usable else "no usable ace")
+    from matplotlib.patches import Patch
+
+    figure.legend(handles=[Patch(color="#c0392b", label="hit"), Patch(color="#d9e6f2", label="stick")],
+                  loc="outside right center")  # fmt: skip
+    figure.suptitle(title)
+    return figure
+
+
 def robustness_figure(
     axes_values: Sequence[tuple[str, np.ndarray]],
     means: np.ndarray,
@@ -410,3 +577,163 @@ def _edges(values: np.ndarray) -> np.ndarray:
         return np.array([values[0] - 0.5, values[0] + 0.5])
     middle = (values[:-1] + values[1:]) / 2
     return np.concatenate([[2 * values[0] - middle[0]], middle, [2 * values[-1] - middle[-1]]])
+
+
+# -- sweeps ------------------------------------------------------------------------------
+
+SWEEP_PANEL_SIZE = (5.0, 4.2)
+"""inches per panel of ``sweep.png``"""
+PROFILE_MAX_POINTS = 10
+"""the performance profile draws at most this many points (the best by IQM)"""
+
+
+@dataclass(frozen=True)
+class SweepAxis:
+    """One axis of a sweep as drawn: its name and its values as ``results.csv`` cells."""
+
+    name: str
+    values: list[str]
+
+
+def sweep_figure(
+    title: str,
+    axes: Sequence[SweepAxis],
+    point_ids: Sequence[str],
+    statistics: Sequence[dict[str, float | int | None]],
+    eval_means: Sequence[np.ndarray],
+    threshold: float | None,
+) -> Figure:
+    """``sweep.png``: success rate and median solve episode against the axes, and profiles.
+
+    One axis: both statistics against it, with their 95% intervals as error bars. Two
+    axes: a heatmap of each. More: both against the point id. A last panel draws the
+    performance profiles (fraction of seeds whose greedy eval mean reaches each return) of
+    up to :data:`PROFILE_MAX_POINTS` points, the best by IQM.
+
+    Args:
+        title: the sweep's name.
+        axes: the axes, in point order (last fastest); the zip group counts as one.
+        point_ids: the points' ids.
+        statistics: each point's ``points.csv`` statistics (``None`` = missing).
+        eval_means: each point's seeds' eval means.
+        threshold: the reward threshold (marked on the profile), if any.
+    """
+    figure = Figure(figsize=(SWEEP_PANEL_SIZE[0] * 3, SWEEP_PANEL_SIZE[1]), dpi=DPI,
+                    layout="constrained")  # fmt: skip
+    rate_axes, solve_axes, profile_axes = figure.subplots(1, 3)
+    rate = _column(statistics, "success_rate")
+    solve = _column(statistics, "median_solved_episode")
+    if len(axes) == 2:
+        shape = (len(axes[0].values), len(axes[1].values))
+        _sweep_heatmap(figure, rate_axes, axes, rate.reshape(shape), "success rate", (0.0, 1.0))
+        _sweep_heatmap(figure, solve_axes, axes, solve.reshape(shape), "median solve episode", None)
+    else:
+        if len(axes) == 1:
+            labels, name = axes[0].values, axes[0].name
+        else:
+            labels, name = list(point_ids), "point"
+        _sweep_errorbars(rate_axes, labels, name, statistics, "success_rate", "success rate")
+        rate_axes.set_ylim(-0.02, 1.02)
+        _sweep_errorbars(solve_axes, labels, name, statistics, "median_solved_episode",
+                         "median solve episode (solved seeds)")  # fmt: skip
+    iqm = _column(statistics, "iqm_eval_return")
+    order = [i for i in np.argsort(-np.nan_to_num(iqm, nan=-np.inf), kind="stable")
+             if eval_means[i].size][:PROFILE_MAX_POINTS]  # fmt: skip
+    if order:
+        every = np.concatenate([eval_means[i] for i in order])
+        taus = np.linspace(float(every.min()), float(every.max()), 200)
+        colours = _colours(len(order))
+        for colour, i in zip(colours, order, strict=True):
+            fraction = (eval_means[i][:, None] >= taus[None, :]).mean(axis=0)
+            profile_axes.step(taus, fraction, where="post", color=colour,
+                              label=f"point {point_ids[i]}")  # fmt: skip
+    if threshold is not None:
+        profile_axes.axvline(
+            threshold, color="grey", linestyle="--", label=f"threshold {threshold:g}"
+        )
+    profile_axes.set_ylim(-0.02, 1.02)
+    profile_axes.set_xlabel("greedy eval mean return τ")
+    profile_axes.set_ylabel("fraction of seeds ≥ τ")
+    profile_axes.set_title(
+        "performance profiles" + (" (best by IQM)" if len(point_ids) > len(order) else "")
+    )
+    profile_axes.legend(loc="lower left", fontsize="x-small")
+    profile_axes.grid(alpha=0.3)
+    figure.suptitle(f"Sweep {title}: 95% intervals (Wilson; bootstrap over seeds)")
+    return figure
+
+
+def _column(statistics: Sequence[dict[str, float | int | None]], name: str) -> np.ndarray:
+    values = [row[name] for row in statistics]
+    return np.array([np.nan if value is None else float(value) for value in values])
+
+
+def _numeric(labels: Sequence[str]) -> np.ndarray | None:
+    """The labels as numbers, when every one is a number."""
+    try:
+        return np.array([float(label) for label in labels])
+    except ValueError:
+        return None
+
+
+def _sweep_errorbars(
+    axes: Axes,
+    labels: Sequence[str],
+    name: str,
+    statistics: Sequence[dict[str, float | int | None]],
+    column: str,
+    ylabel: str,
+) -> None:
+    values = _column(statistics, column)
+    low = _column(statistics, f"{column}_low")
+    high = _column(statistics, f"{column}_high")
+    numbers = _numeric(labels)
+    positions = numbers if numbers is not None else np.arange(len(labels), dtype=float)
+    errors = np.vstack([np.clip(values - low, 0, None), np.clip(high - values, 0, None)])
+    axes.errorbar(positions, values, yerr=np.nan_to_num(errors), marker="o", capsize=4)
+    if numbers is None:
+        axes.set_xticks(positions, labels, rotation=30, ha="right", fontsize="small")
+    elif np.all(numbers > 0) and numbers.max() / numbers.min() >= 100:
+        axes.set_xscale("log")
+    axes.set_xlabel(name)
+    axes.set_ylabel(ylabel)
+    axes.grid(alpha=0.3)
+
+
+def _sweep_heatmap(
+    figure: Figure,
+    axes: Axes,
+    sweep_axes: Sequence[SweepAxis],
+    values: np.ndarray,
+    label: str,
+    limits: tuple[float, float] | None,
+) -> None:
+    """A heatmap of one statistic: first axis down, second across, each cell annotated."""
+    masked = np.ma.masked_invalid(values)
+    cmap = "viridis" if limits is not None else "viridis_r"
+    vmin, vmax = limits if limits is not None else (None, None)
+    image = axes.imshow(masked, cmap=cmap, vmin=vmin, vmax=vmax, aspect="auto")
+    figure.colorbar(image, ax=axes, label=label)
+    rows, columns = values.shape
+    for i in range(rows):
+        for j in range(columns):
+            text = (
+                "—"
+                if np.isnan(values[i, j])
+                else f"{values[i, j]:.2f}"
+                if limits
+                else f"{values[i, j]:.0f}"
+            )
+            axes.text(j, i, text, ha="center", va="center", fontsize="small", color="white",
+                      path_effects=_outline())  # fmt: skip
+    axes.set_xticks(range(columns), sweep_axes[1].values, rotation=30, ha="right", fontsize="small")
+    axes.set_yticks(range(rows), sweep_axes[0].values, fontsize="small")
+    axes.set_xlabel(sweep_axes[1].name)
+    axes.set_ylabel(sweep_axes[0].name)
+    axes.set_title(label)
+
+
+def _outline() -> list[object]:
+    from matplotlib import patheffects
+
+    return [patheffects.withStroke(linewidth=2, foreground="black")]

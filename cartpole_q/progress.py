@@ -1,7 +1,9 @@
 """Progress output while training: a live bar on a terminal, plain lines otherwise.
 
 Reporters are cheap to call after every chunk of episodes: the live bar redraws at most
-ten times a second from its own thread, and plain lines are printed every tenth of the run.
+ten times a second, from the caller's thread (no refresh thread, so that worker processes
+can be forked safely), and plain lines are printed every tenth of the run. A sweep has
+one bar for all its runs.
 """
 
 from __future__ import annotations
@@ -143,7 +145,9 @@ class RichReporter:
             TextColumn("eta"),
             TimeRemainingColumn(),
             console=self._console,
-            refresh_per_second=10,
+            # Redrawn by update() itself (throttled): no refresh thread, so that worker
+            # processes can be forked safely (see experiments.multiseed).
+            auto_refresh=False,
             expand=True,
         )
         self._tasks: dict[Any, Any] = {}
@@ -176,6 +180,7 @@ class RichReporter:
             f"eps {progress.epsilon:.2f} {compact_rate(progress.train_steps_per_second):>7}"
         )
         self._progress.update(self._tasks[key], completed=progress.episode, stats=stats)
+        self._progress.refresh()
 
     def finish(self, key: Any, line: str) -> None:
         """Print how the run ended above the bars, and complete its bar at the real count.
@@ -192,6 +197,7 @@ class RichReporter:
             self._draw(key, latest)
         completed = self._progress.tasks[task].completed or 1
         self._progress.update(task, total=completed, stats="done")
+        self._progress.refresh()
 
     def close(self) -> None:
         """Stop the live display, leaving the final bars on screen."""
@@ -206,3 +212,140 @@ def make_reporter(quiet: bool, stream: IO[str] | None = None) -> Reporter:
     if stream.isatty():
         return RichReporter()
     return PlainReporter(stream)
+
+
+# -- sweeps: one bar for the whole sweep ---------------------------------------------------
+
+
+class SweepProgress(Protocol):
+    """Receives a sweep's progress: runs (point x seed) finished, points complete."""
+
+    def start(self, total_runs: int, done_runs: int, total_points: int, done_points: int) -> None:
+        """The sweep starts; ``done_runs`` were finished before (``--resume``)."""
+        ...
+
+    def advance(self, done_runs: int, done_points: int) -> None:
+        """More runs finished."""
+        ...
+
+    def close(self) -> None:
+        """The sweep ended."""
+        ...
+
+
+class NullSweepProgress:
+    """Prints nothing (``--quiet``)."""
+
+    def start(self, total_runs: int, done_runs: int, total_points: int, done_points: int) -> None:
+        """Ignore."""
+
+    def advance(self, done_runs: int, done_points: int) -> None:
+        """Ignore."""
+
+    def close(self) -> None:
+        """Ignore."""
+
+
+def sweep_line(done_runs: int, total_runs: int, done_points: int, total_points: int,
+               rate: float, eta: float | None) -> str:  # fmt: skip
+    """One plain line of sweep progress.
+
+    >>> sweep_line(1000, 10000, 10, 100, 171.4, 52.5)
+    'sweep: 1,000/10,000 runs, 10/100 points, 171 runs/s, eta 52 s'
+    """
+    tail = "" if eta is None else f", eta {eta:.0f} s"
+    return (
+        f"sweep: {done_runs:,}/{total_runs:,} runs, {done_points}/{total_points} points, "
+        f"{rate:,.0f} runs/s{tail}"
+    )
+
+
+class PlainSweepProgress:
+    """A plain line every tenth of the sweep (for logs, pipes and CI)."""
+
+    def __init__(self, stream: IO[str] | None = None) -> None:
+        self._stream = stream or sys.stdout
+        self._total = self._points = self._first = 0
+        self._next = 0
+        self._started = 0.0
+
+    def start(self, total_runs: int, done_runs: int, total_points: int, done_points: int) -> None:
+        """Remember the totals."""
+        self._total, self._points, self._first = total_runs, total_points, done_runs
+        self._next = done_runs + max(1, total_runs // 10)
+        self._started = time.monotonic()
+
+    def advance(self, done_runs: int, done_points: int) -> None:
+        """Print a line when the sweep crosses the next tenth."""
+        if done_runs < self._next and done_runs < self._total:
+            return
+        self._next = done_runs + max(1, self._total // 10)
+        rate, eta = _rate_and_eta(self._started, done_runs - self._first, self._total - done_runs)
+        line = sweep_line(done_runs, self._total, done_points, self._points, rate, eta)
+        print(line, file=self._stream, flush=True)
+
+    def close(self) -> None:
+        """Nothing to close."""
+
+
+def _rate_and_eta(started: float, runs: int, left: int) -> tuple[float, float | None]:
+    elapsed = time.monotonic() - started
+    rate = runs / elapsed if elapsed > 0 else 0.0
+    return rate, (left / rate if rate > 0 else None)
+
+
+class RichSweepProgress:
+    """A live bar: runs done of all, points complete, runs per second, time left."""
+
+    def __init__(self, console: Any | None = None) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeRemainingColumn
+        from rich.progress import Progress as RichProgress
+
+        self._progress = RichProgress(
+            TextColumn("[bold]sweep"),
+            BarColumn(bar_width=None),
+            MofNCompleteColumn(),
+            TextColumn("runs  {task.fields[points]}  {task.fields[rate]}"),
+            TextColumn("eta"),
+            TimeRemainingColumn(),
+            console=console or Console(),
+            auto_refresh=False,  # no refresh thread: workers can be forked safely
+            expand=True,
+        )
+        self._task: Any = None
+        self._points = self._first = 0
+        self._started = 0.0
+
+    def start(self, total_runs: int, done_runs: int, total_points: int, done_points: int) -> None:
+        """Show the bar."""
+        self._points, self._first, self._started = total_points, done_runs, time.monotonic()
+        self._task = self._progress.add_task(
+            "sweep", total=total_runs, completed=done_runs,
+            points=f"{done_points}/{total_points} points", rate="",
+        )  # fmt: skip
+        self._progress.start()
+        self._progress.refresh()
+
+    def advance(self, done_runs: int, done_points: int) -> None:
+        """Move the bar."""
+        rate, _ = _rate_and_eta(self._started, done_runs - self._first, 0)
+        self._progress.update(
+            self._task, completed=done_runs, points=f"{done_points}/{self._points} points",
+            rate=f"{rate:,.0f} runs/s",
+        )  # fmt: skip
+        self._progress.refresh()
+
+    def close(self) -> None:
+        """Stop the live display, leaving the final bar on screen."""
+        self._progress.stop()
+
+
+def make_sweep_progress(quiet: bool, stream: IO[str] | None = None) -> SweepProgress:
+    """The sweep's progress display: none when quiet, a bar on a terminal, else lines."""
+    stream = stream or sys.stdout
+    if quiet:
+        return NullSweepProgress()
+    if stream.isatty():
+        return RichSweepProgress()
+    return PlainSweepProgress(stream)

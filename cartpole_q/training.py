@@ -106,7 +106,8 @@ class TrainResult:
     engine: str
     """the engine that ran"""
     q_table: np.ndarray
-    """the kept table, shape ``(*bins, n_actions)``: from the solve point if the run solved"""
+    """the kept table, shape ``(*bins, n_actions)`` (``(n, n_actions)`` for ``Discrete(n)``,
+    ``(a, b, ..., n_actions)`` for a Tuple of Discrete): from the solve point if it solved"""
     kept_episode: int
     """the episode after which the kept table was taken"""
     visits: np.ndarray
@@ -248,7 +249,7 @@ def _run(
         hooks.on_checkpoint,
     )
     snapshot_every, on_snapshot = hooks.snapshot_every, hooks.on_snapshot
-    table_shape = (*config.discretization.bins, env_info.n_actions)
+    table_shape = (*env_info.state_shape, env_info.n_actions)
     total = settings.episodes
     train_seconds = 0.0 if resume is None else resume.train_seconds
     wall_before = 0.0 if resume is None else resume.wall_seconds

@@ -208,7 +208,10 @@ def test_training_another_environment_picks_its_engine(
             "env:\n  id: Pendulum-v1\ndiscretization:\n  bins: [2, 2, 2]\n  low: [-1, -1, -8]\n  high: [1, 1, 8]\n",
             ("env.id", "Discrete actions"),
         ),
-        ("env:\n  id: FrozenLake-v1\n", ("env.id", "1-D Box")),
+        (
+            "env:\n  id: FrozenLake-v1\ndiscretization:\n  bins: [4]\n  low: [0]\n  high: [16]\n",
+            ("discretization", "Discrete(16)", "leave discretization out"),
+        ),
         ("env:\n  kwargs: {no_such_argument: 1}\n", "env.kwargs"),
         (
             "discretization:\n  bins: [100, 100, 100, 100]\n",
@@ -255,7 +258,7 @@ def test_environment_errors_explain_themselves(in_tmp: Path, content: str, named
 
 def test_missing_config_file(in_tmp: Path) -> None:
     assert_refused(invoke("train", "-c", in_tmp / "missing.yaml"), "missing.yaml", "not found")
-    assert_refused(invoke("train", "-c", "blgo"), "blgo", "blog, default, double_q_learning")
+    assert_refused(invoke("train", "-c", "blgo"), "blgo", "blog, ", "default, ", "sarsa")
     assert not (in_tmp / "runs").exists()
 
 

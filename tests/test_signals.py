@@ -131,8 +131,13 @@ SIGNALS = [
 
 def _workers_running(process: subprocess.Popen[bytes]) -> Callable[[], bool]:
     def running() -> bool:
-        session = _session(process.pid).values()
-        return sum("spawn_main" in cmdline for cmdline in session) >= 2
+        # Workers are forked (same command line as the parent) or spawned (spawn_main).
+        session = _session(process.pid)
+        workers = [
+            cmdline for pid, cmdline in session.items()
+            if pid != process.pid and "resource_tracker" not in cmdline
+        ]  # fmt: skip
+        return len(workers) >= 2
 
     return running
 

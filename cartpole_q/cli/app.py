@@ -106,6 +106,7 @@ def _exit_codes() -> Iterator[None]:
 
     main = threading.current_thread() is threading.main_thread()
     previous = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    interrupted = False
     if main:
         signal.signal(signal.SIGTERM, interrupt)
     try:
@@ -114,13 +115,18 @@ def _exit_codes() -> Iterator[None]:
         typer.echo(f"error: {error}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
     except KeyboardInterrupt:
+        interrupted = True
         if main:
             for signum in previous:
                 signal.signal(signum, signal.SIG_IGN)
         typer.echo("interrupted", err=True)
         raise typer.Exit(EXIT_INTERRUPTED) from None
+    except typer.Exit as exit_:
+        interrupted = exit_.exit_code == EXIT_INTERRUPTED
+        raise
     finally:
-        if main:
+        # After an interruption, signals stay ignored until the process has exited.
+        if main and not interrupted:
             for signum, handler in previous.items():
                 if handler is not None:  # None: installed outside Python, cannot be restored
                     signal.signal(signum, handler)
@@ -216,6 +222,14 @@ def train(
             "the run directory (one run only). 0: never.",
         ),
     ] = 0,
+    seed_plots: Annotated[
+        bool,
+        typer.Option(
+            "--seed-plots",
+            help="With several seeds, draw reward_curve.png for each seed and for all of "
+            "them together (slower; `cartpole-q plot DIR` draws it later).",
+        ),
+    ] = False,
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with _exit_codes():
@@ -253,7 +267,9 @@ def train(
             source = str(resolve_config_path(config)) if config else "default config"
             prepared = runner.prepare(loaded, source)
             run_dir = runner.start_run(prepared, out)
-        _train_into(run_dir, prepared, resume is not None, workers, quiet, watch, video_every)
+        _train_into(
+            run_dir, prepared, resume is not None, workers, quiet, watch, video_every, seed_plots
+        )
 
 
 def _check_viewing(seeds: Any, watch: int, video_every: int) -> None:
@@ -279,6 +295,7 @@ def _train_into(
     quiet: bool,
     watch: int = 0,
     video_every: int = 0,
+    seed_plots: bool = False,
 ) -> None:
     from cartpole_q.cli.report import print_multi_summary, print_single_summary
     from cartpole_q.experiments import run as runner
@@ -302,6 +319,7 @@ def _train_into(
                 summary = run_seeds(
                     prepared, run_dir, workers=workers or default_workers(len(seeds)),
                     reporter=reporter, should_stop=stop.is_set, resume=resume,
+                    seed_plots=seed_plots,
                 )  # fmt: skip
         except KeyboardInterrupt:
             stopped_at_once = True  # a second signal: workers killed, checkpoints kept
@@ -437,10 +455,17 @@ def eval_command(
                     "record the episodes with --video FILE.gif instead."
                 )
         report = _evaluate_run(run, episodes, seed, video, video_episodes, render, force)
+        from cartpole_q.cli.exact_text import exact_lines
+        from cartpole_q.evaluation import exact_report
+
+        exact = exact_report(run.config, run.q_table)  # a sentence when there is no model
+        extra = {} if isinstance(exact, str) else {"exact": exact.to_dict()}
         if json_output:
-            typer.echo(json.dumps(report.to_dict()))
+            typer.echo(json.dumps({**report.to_dict(), **extra}))
         else:
             typer.echo(eval_line(run_dir, report.to_dict(), threshold))
+            for line in exact_lines(extra["exact"]) if extra else []:
+                typer.echo(line)
             if video is not None:
                 typer.echo(f"video: {video}")
 
@@ -495,6 +520,10 @@ def _eval_seeds(
             typer.echo(f"warning: {result['note']}", err=True)
     else:
         typer.echo(eval_seeds_text(parent, result))
+        if "exact" in result:
+            from cartpole_q.cli.exact_text import exact_seeds_line
+
+            typer.echo(exact_seeds_line(result["exact"]))
 
 
 @app.command(cls=_Command)
@@ -634,6 +663,318 @@ def compare_command(
         typer.echo(
             json.dumps(result.to_dict()) if json_output else summary_text(dir_a, dir_b, result)
         )
+
+
+class BackendChoice(StrEnum):
+    """The ``sweep --backend`` values."""
+
+    local = "local"
+    ray = "ray"
+
+
+@app.command("sweep", cls=_Command)
+def sweep_command(
+    sweep_file: Annotated[
+        Path | None,
+        typer.Argument(
+            metavar="SWEEP.yaml",
+            help="The sweep file: base config, seeds, grid and zip axes over dotted config keys.",
+            show_default=False,
+        ),
+    ] = None,
+    resume: Annotated[
+        Path | None,
+        typer.Option(metavar="DIR", help="Finish an interrupted sweep directory."),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="DIR",
+            help="Sweep directory to create; it must not exist or be empty.",
+            show_default="sweeps/<name>-<YYYYmmdd-HHMMSS>",
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            metavar="N",
+            min=1,
+            help="Worker processes (with Ray: a local cluster's CPUs).",
+            show_default="one per core",
+        ),
+    ] = None,
+    backend: Annotated[
+        BackendChoice,
+        typer.Option(
+            help="Run on local processes, or as Ray tasks (`pip install 'cartpole-q[ray]'`)."
+        ),
+    ] = BackendChoice.local,
+    address: Annotated[
+        str | None,
+        typer.Option(
+            metavar="ADDR",
+            help="With --backend ray: a running cluster (`auto`, or HOST:PORT of its head).",
+            show_default="start a local cluster",
+        ),
+    ] = None,
+    max_runs: Annotated[
+        int,
+        typer.Option(
+            metavar="N",
+            min=1,
+            help="Refuse sweeps of more runs (points x seeds) than this, unless --yes.",
+        ),
+    ] = 20_000,
+    yes: Annotated[
+        bool, typer.Option("--yes", "-y", help="Run however many runs the sweep has.")
+    ] = False,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="Print nothing but the sweep directory.")
+    ] = False,
+) -> None:
+    """Train and evaluate every point of a sweep on every seed; the last line printed is its directory."""
+    with _exit_codes():
+        import os
+
+        from cartpole_q.experiments import sweep as sweeping
+        from cartpole_q.experiments.run import StopRequest
+        from cartpole_q.progress import make_sweep_progress
+
+        if resume is not None:
+            if sweep_file is not None or out is not None:
+                raise UserError(
+                    "--resume finishes a sweep exactly as it was started, so it takes neither "
+                    "a SWEEP.yaml nor --out."
+                )
+            spec = sweeping.load_sweep_dir(resume)
+            directory = resume
+        else:
+            if sweep_file is None:
+                raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
+            spec = sweeping.prepare_sweep(sweep_file)
+            if spec.runs > max_runs and not yes:
+                raise UserError(
+                    f"{sweep_file}: {len(spec.points)} points x {len(spec.seeds)} seeds = "
+                    f"{spec.runs:,} runs, more than --max-runs {max_runs:,}; pass --yes to run "
+                    "them all (or raise --max-runs)."
+                )
+            directory = sweeping.start_sweep(spec, out)
+        if address is not None and backend is not BackendChoice.ray:
+            raise UserError("--address is for --backend ray.")
+        workers = workers or max(1, min(os.cpu_count() or 1, spec.runs))
+        progress = make_sweep_progress(quiet)
+        hint = f"finish it with `cartpole-q sweep --resume {directory}`"
+        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+            try:
+                outcome = sweeping.run_sweep(
+                    spec, directory, workers=workers, backend=backend.value, address=address,
+                    progress=progress, should_stop=stop.is_set,
+                )  # fmt: skip
+            except KeyboardInterrupt:
+                typer.echo(f"interrupted at once: the finished runs are saved; {hint}", err=True)
+                raise typer.Exit(EXIT_INTERRUPTED) from None
+        if not quiet and outcome.complete:
+            from cartpole_q.cli.report import print_sweep_summary
+
+            print_sweep_summary(outcome)
+        typer.echo(str(directory))
+        if not outcome.complete:
+            typer.echo(
+                f"interrupted: {outcome.done_runs:,} of {outcome.total_runs:,} runs done; {hint}",
+                err=True,
+            )
+            raise typer.Exit(EXIT_INTERRUPTED)
+
+
+@app.command("optimum", cls=_Command)
+def optimum_command(
+    env_id: Annotated[
+        str,
+        typer.Argument(
+            metavar="ENV_ID",
+            help="A Gymnasium id with a transition table (FrozenLake-v1, FrozenLake8x8-v1, "
+            "Taxi-v4, CliffWalking-v1) or Blackjack-v1.",
+        ),
+    ],
+    set_values: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--set",
+            metavar="KEY=VALUE",
+            help="Set an env key, e.g. --set env.kwargs.is_slippery=false or "
+            "--set env.kwargs.map_name=8x8. Repeatable.",
+        ),
+    ] = None,
+    gamma: Annotated[
+        float | None,
+        typer.Option(
+            metavar="G",
+            min=0.0,
+            max=1.0,
+            help="Also give the optimal discounted return with this discount (no time limit).",
+        ),
+    ] = None,
+    json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
+) -> None:
+    """The best expected return from the start, by value iteration on the environment's model."""
+    with _exit_codes():
+        from cartpole_q.cli.exact_text import exact_lines, policy_grid
+        from cartpole_q.config import load_config, parse_assignment
+        from cartpole_q.envs.gym import inspect_env
+        from cartpole_q.envs.models import grid_layout
+        from cartpole_q.evaluation import exact_report
+
+        overrides: dict[str, Any] = {"env.id": env_id}
+        for key, value in map(parse_assignment, set_values or []):
+            if key != "env" and not key.startswith("env."):
+                raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
+            overrides[key] = value
+        config = load_config(overrides=overrides)
+        inspect_env(config)  # an unknown id or argument: a config error naming it
+        exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
+        if isinstance(exact, str):
+            raise UserError(
+                f"{env_id}: no exact optimum: {exact}. It needs a transition table "
+                "(env.unwrapped.P: FrozenLake, Taxi, CliffWalking) or Blackjack's rules."
+            )
+        result = {"env_id": env_id, "kwargs": dict(config.env.kwargs), **exact.to_dict()}
+        layout = grid_layout(config.env)
+        if json_output:
+            typer.echo(json.dumps({**result, "policy": list(exact.optimal_policy)}))
+            return
+        typer.echo(f"{env_id} {json.dumps(result['kwargs'])}")
+        for line in exact_lines(result):
+            typer.echo(line)
+        if layout is not None:
+            marks = {state: cell for state, cell in enumerate(layout.cells) if cell in "HCG"}
+            typer.echo("optimal first actions (S start, H hole, C cliff, G goal):")
+            policy = list(exact.optimal_policy)
+            typer.echo(policy_grid(policy, layout.rows, layout.columns, layout.arrows(), marks))
+
+
+@app.command("tune", cls=_Command)
+def tune_command(
+    tune_file: Annotated[
+        Path | None,
+        typer.Argument(
+            metavar="TUNE.yaml",
+            help="The tune file: base config, seeds, trials, objective and search space.",
+            show_default=False,
+        ),
+    ] = None,
+    resume: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="DIR",
+            help="Go on with a tune directory's study: finish it after a kill, raise its "
+            "total with --trials, or join it from another process.",
+        ),
+    ] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="DIR",
+            help="Tune directory to create; it must not exist or be empty.",
+            show_default="tunes/<name>-<YYYYmmdd-HHMMSS>",
+        ),
+    ] = None,
+    trials: Annotated[
+        int | None,
+        typer.Option(metavar="N", min=1, help="Trials in all (overrides `trials`)."),
+    ] = None,
+    storage: Annotated[
+        str | None,
+        typer.Option(
+            metavar="URL",
+            help="An Optuna storage URL (sqlite:///study.db, postgresql://...).",
+            show_default="the journal file DIR/study.journal",
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            metavar="N",
+            min=1,
+            help="Worker processes for each trial's seeds.",
+            show_default="one per core",
+        ),
+    ] = None,
+    backend: Annotated[
+        BackendChoice,
+        typer.Option(help="Run each trial's seeds on local processes, or as Ray tasks."),
+    ] = BackendChoice.local,
+    address: Annotated[
+        str | None,
+        typer.Option(metavar="ADDR", help="With --backend ray: a running cluster's address."),
+    ] = None,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="Print nothing but the tune directory.")
+    ] = False,
+) -> None:
+    """Search config values with Optuna, each trial scored on every seed; the last line is its directory."""
+    with _exit_codes():
+        import os
+
+        from cartpole_q.experiments import tune as tuning
+        from cartpole_q.experiments.run import StopRequest
+        from cartpole_q.experiments.tune_spec import load_tune
+
+        if resume is not None:
+            if tune_file is not None or out is not None or storage is not None:
+                raise UserError(
+                    "--resume goes on with the study as it was started, so it takes neither a "
+                    "TUNE.yaml, --out nor --storage (only --trials, to raise the total)."
+                )
+            spec, storage_url = tuning.load_tune_dir(resume)
+            directory = resume
+        else:
+            if tune_file is None:
+                raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
+            spec = load_tune(tune_file)
+            storage_url = storage
+            tuning.optuna_module()
+            if storage_url is not None:
+                tuning.storage_for(Path(), storage_url)
+            directory = tuning.start_tune(spec, out, storage_url)
+        if address is not None and backend is not BackendChoice.ray:
+            raise UserError("--address is for --backend ray.")
+        workers = workers or max(1, min(os.cpu_count() or 1, len(spec.seeds)))
+
+        def report(trial: dict[str, Any]) -> None:
+            if not quiet:
+                shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
+                rate = trial.get("success_rate")
+                rate_text = "" if rate is None else f"success {rate:.2f}, "
+                typer.echo(
+                    f"trial {trial['number']}: {rate_text}IQM {trial.get('iqm_eval_return', float('nan')):.1f}"
+                    f" ({shown})"
+                )
+
+        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+            try:
+                outcome = tuning.run_tune(
+                    spec, directory, storage_url, trials=trials, workers=workers,
+                    backend=backend.value, address=address, should_stop=stop.is_set,
+                    on_trial=report,
+                )  # fmt: skip
+            except KeyboardInterrupt:
+                typer.echo(
+                    f"interrupted at once; go on with `cartpole-q tune --resume {directory}`",
+                    err=True,
+                )
+                raise typer.Exit(EXIT_INTERRUPTED) from None
+        if not quiet and outcome.best is not None:
+            best = outcome.best
+            typer.echo(
+                f"best: trial {best['number']} of {outcome.finished_trials} finished, "
+                f"objective {best['objective']:.6g}: "
+                + ", ".join(f"{k}={v}" for k, v in best["values"].items())
+            )
+            typer.echo(f"trials.csv, best.yaml, history.png and importance.png in {directory}")
+        typer.echo(str(directory))
+        if stop.is_set():
+            typer.echo(f"interrupted: go on with `cartpole-q tune --resume {directory}`", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def main() -> None:

@@ -163,12 +163,76 @@ def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
         for run in result["runs"]
     ]
     note = result.get("note")
+    threshold = result["reward_threshold"]
+    reached = (
+        f"{result['successes']}/{len(result['runs'])} {'finished ' if note else ''}"
+        f"seeds with greedy mean >= {threshold:g}"
+        if threshold is not None
+        else f"{len(result['runs'])} {'finished ' if note else ''}seeds (no reward threshold)"
+    )
     lines.append(
-        f"{parent}: {result['successes']}/{len(result['runs'])} {'finished ' if note else ''}"
-        "seeds with greedy mean >= "
-        f"{result['reward_threshold']:g} over {result['episodes']} episodes each in gymnasium.make; "
+        f"{parent}: {reached} over {result['episodes']} episodes each in gymnasium.make; "
         f"mean of means {result['mean']:.2f}, lowest {result['min']:.2f}"
     )
     if note:
         lines.append(note)
     return "\n".join(lines)
+
+
+SWEEP_TABLE_ROWS = 15
+"""``sweep`` prints at most this many points, the best first"""
+
+
+def _interval(row: dict[str, str], column: str, digits: int) -> str:
+    value = row[column]
+    if not value:
+        return "-"
+    low, high = row[f"{column}_low"], row[f"{column}_high"]
+    return f"{float(value):.{digits}f} [{float(low):.{digits}f}, {float(high):.{digits}f}]"
+
+
+def sweep_table(
+    axes: list[str], point_rows: list[dict[str, str]], limit: int = SWEEP_TABLE_ROWS
+) -> list[str]:
+    """The points as text lines, best first (success rate, then IQM eval return).
+
+    >>> row = {"point": "000", "agent.alpha": "0.1", "seeds": "2", "success_rate": "1.0",
+    ...        "success_rate_low": "0.34", "success_rate_high": "1.0", "iqm_eval_return": "500.0",
+    ...        "iqm_eval_return_low": "500.0", "iqm_eval_return_high": "500.0",
+    ...        "median_solved_episode": "175.0", "median_solved_episode_low": "170.0",
+    ...        "median_solved_episode_high": "180.0"}
+    >>> for line in sweep_table(["agent.alpha"], [row]): print(line)
+    point  agent.alpha  seeds  success rate [95%]  IQM eval return [95%]  median solve episode [95%]
+    000    0.1          2      1.00 [0.34, 1.00]   500.0 [500.0, 500.0]   175 [170, 180]
+    """
+
+    def rank(row: dict[str, str]) -> tuple[float, float]:
+        return (-float(row["success_rate"] or -1), -float(row["iqm_eval_return"] or "-inf"))
+
+    ordered = sorted(point_rows, key=rank)[:limit]
+    header = ["point", *axes, "seeds", "success rate [95%]", "IQM eval return [95%]",
+              "median solve episode [95%]"]  # fmt: skip
+    table = [header]
+    for row in ordered:
+        table.append([
+            row["point"], *(row[axis] for axis in axes), row["seeds"],
+            _interval(row, "success_rate", 2), _interval(row, "iqm_eval_return", 1),
+            _interval(row, "median_solved_episode", 0),
+        ])  # fmt: skip
+    widths = [max(len(line[i]) for line in table) for i in range(len(header))]
+    return ["  ".join(text.ljust(width) for text, width in zip(line, widths, strict=True)).rstrip()
+            for line in table]  # fmt: skip
+
+
+def print_sweep_summary(outcome: Any) -> None:
+    """Print a finished sweep's points (the best first) and where its files are."""
+    spec, directory = outcome.spec, outcome.directory
+    rows = outcome.points
+    shown = min(len(rows), SWEEP_TABLE_ROWS)
+    title = f"{len(rows)} points x {len(spec.seeds)} seeds"
+    if shown < len(rows):
+        title += f" (the best {shown} shown; all in points.csv)"
+    print(title)
+    for line in sweep_table(spec.axes, rows):
+        print(line)
+    print(f"points.csv, results.csv and sweep.png in {directory}")

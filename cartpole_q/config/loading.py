@@ -19,6 +19,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import difflib
+import functools
 import math
 import os
 import re
@@ -80,7 +81,11 @@ ConfigSource = str | os.PathLike[str] | Mapping[str, Any]
 
 
 def load_config(
-    path: ConfigSource | None = None, overrides: Mapping[str, Any] | None = None
+    path: ConfigSource | None = None,
+    overrides: Mapping[str, Any] | None = None,
+    *,
+    source: str | None = None,
+    override_source: str | None = None,
 ) -> Config:
     """Load, complete and validate a config.
 
@@ -101,6 +106,9 @@ def load_config(
         overrides: dotted keys (``"train.episodes"``, ``"env.kwargs.max_episode_steps"``)
             or section names with mappings, and the values that replace the file's, as
             given on the command line; applied in order.
+        source: how errors name ``path`` (default: the file, or "config mapping").
+        override_source: how errors name the overrides (default: "command line"; a
+            sweep names its file and point).
 
     Returns:
         The validated, frozen config.
@@ -109,37 +117,59 @@ def load_config(
         ConfigError: the file cannot be read or parsed, or a key or value is invalid.
     """
     raw = default_raw()
-    source = "default config"
+    named = "default config"
     if isinstance(path, Mapping):
-        source = "config mapping"
+        named = "config mapping"
         user: Mapping[Any, Any] = path
     elif path is not None:
         file = resolve_config_path(path)
-        source = str(path) if file == Path(path) else str(file)
+        named = str(path) if file == Path(path) else str(file)
         user = read_yaml_mapping(file)
     else:
         user = {}
-    check_known_keys(user, source)
+    named = source or named
+    override_source = override_source or OVERRIDE_SOURCE
+    check_known_keys(user, named)
     raw = _merge(raw, user)
     overridden: list[str] = []
     for dotted, value in (overrides or {}).items():
-        nested = _nest(dotted, value)
-        check_known_keys(nested, OVERRIDE_SOURCE)
+        nested = _nest(dotted, value, override_source)
+        check_known_keys(nested, override_source)
         raw = _merge(raw, nested)
         overridden.extend(_leaf_paths(nested))
-    return _Reader(raw, source, overridden).config()
+    raw = _without_default_grid(raw, user, overridden)
+    return _Reader(raw, named, overridden, override_source).config()
 
 
 OVERRIDE_SOURCE = "command line"
 """how errors name the source of an override (``--set``, ``--seed`` and the like)"""
 
 
-def _nest(dotted: Any, value: Any) -> dict[str, Any]:
+def _without_default_grid(
+    raw: dict[str, Any], user: Mapping[Any, Any], overridden: list[str]
+) -> dict[str, Any]:
+    """Drop the embedded default's grid for an environment other than CartPole.
+
+    The default's ``discretization`` describes CartPole's four dimensions. A config that
+    gives no ``discretization`` (neither the file nor an override) takes it only on
+    CartPole; elsewhere it has none, which Discrete and Tuple-of-Discrete observations
+    need (a Box observation then asks for one, see ``inspect_env``).
+    """
+    given = "discretization" in user or any(
+        path == "discretization" or path.startswith("discretization.") for path in overridden
+    )
+    env = raw.get("env")
+    if given or not isinstance(env, dict) or env.get("id") in PHYSICS_ENV_IDS:
+        return raw
+    return {**raw, "discretization": None}
+
+
+def _nest(dotted: Any, value: Any, source: str = OVERRIDE_SOURCE) -> dict[str, Any]:
     """Turn ``("agent.epsilon.k", 5)`` into ``{"agent": {"epsilon": {"k": 5}}}``."""
     parts = dotted.split(".") if isinstance(dotted, str) else []
     if not parts or not all(parts):
         raise ConfigError(
-            f"{OVERRIDE_SOURCE}: {_shown(dotted)} is not a config key; give a dotted path "
+            f"{source}: {_shown(dotted)} is not a config key; give a dotted path "
             "such as 'agent.alpha' or 'env.kwargs.max_episode_steps'."
         )
     nested: dict[str, Any] = {parts[-1]: copy.deepcopy(value)}
@@ -239,12 +269,22 @@ def default_yaml_text() -> str:
 
 def default_raw() -> dict[str, Any]:
     """Return the embedded default config as plain data (a fresh copy)."""
-    data = yaml.safe_load(default_yaml_text())
+    return copy.deepcopy(_parsed_default())
+
+
+@functools.cache
+def _parsed_default() -> dict[str, Any]:
+    # Parsed once per process: a sweep or a multi-seed run loads many configs.
+    data = yaml.load(default_yaml_text(), Loader=_UniqueKeyLoader)
     assert isinstance(data, dict)  # the packaged file is ours; tests check it loads
     return data
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
+# libyaml's parser when PyYAML has it (ten times faster), the same safe constructors.
+_SafeLoader: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class _UniqueKeyLoader(_SafeLoader):  # type: ignore[misc]
     """A safe loader that refuses duplicate mapping keys instead of keeping the last."""
 
 
@@ -364,7 +404,8 @@ def _merge(
 ) -> dict[Any, Any]:
     """Overlay ``user`` on ``base``: mappings merge key by key, other values replace.
 
-    A section left empty (``agent:``) changes nothing. A schedule mapping merges into
+    A section left empty (``agent:``) changes nothing, except ``discretization:``, which
+    means no grid (Discrete observations). A schedule mapping merges into
     the base schedule when it keeps its ``type`` (or gives none), and replaces it when
     it names another type; a number replaces a schedule and vice versa.
     """
@@ -372,8 +413,8 @@ def _merge(
     for key, value in user.items():
         here = (*path, key)
         old = merged.get(key)
-        if not path and key in _SECTIONS and value is None:
-            continue
+        if not path and key in _SECTIONS and value is None and key != "discretization":
+            continue  # (an explicit `discretization: null` means no grid)
         if isinstance(value, Mapping) and isinstance(old, Mapping) and _merges(here, old, value):
             merged[key] = _merge(old, value, here)
         else:
@@ -390,10 +431,17 @@ def _merges(path: tuple[Any, ...], old: Mapping[Any, Any], new: Mapping[Any, Any
 class _Reader:
     """Typed, range-checked access to the merged raw mapping, with precise error messages."""
 
-    def __init__(self, raw: dict[str, Any], source: str, overridden: list[str]) -> None:
+    def __init__(
+        self,
+        raw: dict[str, Any],
+        source: str,
+        overridden: list[str],
+        override_source: str = OVERRIDE_SOURCE,
+    ) -> None:
         self._raw = raw
         self._source = source
         self._overridden = overridden
+        self._override_source = override_source
 
     def source_of(self, field: str) -> str:
         """The command line if an override set ``field`` (or a part of it), else the file."""
@@ -403,7 +451,7 @@ class _Reader:
                 or field.startswith((f"{path}.", f"{path}["))
                 or path.startswith(f"{field}.")
             ):
-                return OVERRIDE_SOURCE
+                return self._override_source
         return self._source
 
     def error(self, field: str, problem: str) -> ConfigError:
@@ -563,6 +611,8 @@ class _Reader:
     def config(self) -> Config:
         raw = self._raw
         for section in _SECTIONS:
+            if section == "discretization" and raw.get(section) is None:
+                continue  # no grid: Discrete observations (checked against the env later)
             if not isinstance(raw.get(section), dict):
                 raise self.error(section, "must be a mapping of keys to values.")
         name = self.string("name")
@@ -675,7 +725,9 @@ class _Reader:
             raise self.error(field, f"must be one of {', '.join(choices)}; got {_shown(value)}.")
         return str(value)
 
-    def _discretization(self) -> DiscretizationConfig:
+    def _discretization(self) -> DiscretizationConfig | None:
+        if self._raw["discretization"] is None:
+            return None
         bins = self.bins("discretization.bins")
         low = self.number_list("discretization.low")
         high = self.number_list("discretization.high")

@@ -100,7 +100,11 @@ class EnvConfig:
 
 @dataclass(frozen=True)
 class DiscretizationConfig:
-    """The grid that turns a continuous observation into a Q-table row."""
+    """The grid that turns a continuous (Box) observation into a Q-table row.
+
+    Discrete and Tuple-of-Discrete observations need none: they are the row index already
+    (``Config.discretization`` is then ``None``).
+    """
 
     bins: tuple[int, ...]
     """bins per observation dimension; a dimension with 1 bin is ignored"""
@@ -169,7 +173,10 @@ class Config:
     engine: str
     """``auto``, ``numba`` or ``gymnasium``"""
     env: EnvConfig
-    discretization: DiscretizationConfig
+    discretization: DiscretizationConfig | None
+    """the binning grid of a Box observation; ``None`` for Discrete and Tuple-of-Discrete
+    observations, which index the Q-table directly (when a config gives no grid, CartPole
+    takes the embedded default's and every other environment none)"""
     agent: AgentConfig
     train: TrainConfig
     eval: EvalConfig
@@ -186,7 +193,9 @@ class Config:
                 "physics": _plain(self.env.physics),
                 "randomize": _plain(self.env.randomize),
             },
-            "discretization": {
+            "discretization": None
+            if self.discretization is None
+            else {
                 "bins": list(self.discretization.bins),
                 "low": list(self.discretization.low),
                 "high": list(self.discretization.high),
@@ -213,7 +222,9 @@ class Config:
 
     def to_yaml(self) -> str:
         """Return the resolved config as YAML; loading it gives back an equal config."""
-        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None)
+        # libyaml's emitter when PyYAML has it: the same text, many times faster.
+        dumper = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+        return yaml.dump(self.to_dict(), Dumper=dumper, sort_keys=False, default_flow_style=None)
 
     def for_seed(self, seed: int) -> Config:
         """Return this config as the single run of ``seed`` (no ``train.seeds``)."""

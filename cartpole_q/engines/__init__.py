@@ -60,5 +60,7 @@ def make_engine(
         assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
         return NumbaEngine(settings, params, env_seed, env_rng_state, config.env.randomize)
     from cartpole_q.engines.gymnasium_engine import GymnasiumEngine
+    from cartpole_q.envs.models import GREEDY_STEP_CAP
 
-    return GymnasiumEngine(config, params, env_seed, env_rng_state)
+    step_cap = None if env_info.max_episode_steps else GREEDY_STEP_CAP
+    return GymnasiumEngine(config, params, env_seed, env_rng_state, step_cap)

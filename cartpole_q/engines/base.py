@@ -44,11 +44,42 @@ class AgentRecord(NamedTuple):
 
 
 class Grid(NamedTuple):
-    """The binning grid: float64 edges and int64 bins per observation dimension."""
+    """How an observation becomes a Q-table row, as compiled code takes it.
+
+    Binned (Box) observations: float64 edges and int64 bins per dimension, ``starts``
+    empty. Indexed (Discrete, Tuple of Discrete) observations: ``bins`` holds each
+    component's size and ``starts`` its ``start`` (int64), ``low`` and ``high`` empty; the
+    row is ``obs - start`` (components in C order). ``starts.size > 0`` is the index mode.
+    """
 
     low: np.ndarray
     high: np.ndarray
     bins: np.ndarray
+    starts: np.ndarray
+
+    @property
+    def indexed(self) -> bool:
+        """Whether observations are the row index (Discrete) rather than binned (Box)."""
+        return bool(self.starts.size)
+
+    @classmethod
+    def of(cls, config: Config, env_info: EnvInfo) -> Grid:
+        """The grid of a validated config on its (inspected) environment."""
+        if env_info.index_starts is not None:
+            return cls(
+                np.zeros(0, dtype=np.float64),
+                np.zeros(0, dtype=np.float64),
+                np.array(env_info.state_shape, dtype=np.int64),
+                np.array(env_info.index_starts, dtype=np.int64),
+            )
+        d = config.discretization
+        assert d is not None  # inspect_env refuses a Box observation without a grid
+        return cls(
+            np.array(d.low, dtype=np.float64),
+            np.array(d.high, dtype=np.float64),
+            np.array(d.bins, dtype=np.int64),
+            np.zeros(0, dtype=np.int64),
+        )
 
 
 class Tables(NamedTuple):
@@ -104,14 +135,9 @@ class AgentParams:
     @classmethod
     def from_config(cls, config: Config, env_info: EnvInfo) -> AgentParams:
         """Build the parameters of a validated config on its environment."""
-        d = config.discretization
         threshold = env_info.reward_threshold
         return cls(
-            grid=Grid(
-                np.array(d.low, dtype=np.float64),
-                np.array(d.high, dtype=np.float64),
-                np.array(d.bins, dtype=np.int64),
-            ),
+            grid=Grid.of(config, env_info),
             agent=AgentRecord(
                 algorithm=ALGORITHMS.index(config.agent.algorithm),
                 gamma=config.agent.gamma,
@@ -156,7 +182,7 @@ class TrainingState:
         physics_rng: np.random.Generator | None = None,
     ) -> TrainingState:
         """Allocate the state of a run that has not started."""
-        n_states = math.prod(config.discretization.bins)
+        n_states = math.prod(env_info.state_shape)
         shape = (n_states, env_info.n_actions)
         double = config.agent.algorithm == "double_q_learning"
         return cls(

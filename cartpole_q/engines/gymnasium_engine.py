@@ -10,6 +10,7 @@ import functools
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, Tables, TrainingState
@@ -24,7 +25,7 @@ from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
 from cartpole_q.envs.gym import make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithms import ENDED, first_action, learn_step
-from cartpole_q.rl.policy import state_index
+from cartpole_q.rl.policy import observation_row
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -40,12 +41,12 @@ def step_functions(algorithm: int) -> tuple[Any, Any]:
     """
 
     def first(handle, tables, grid, observation, epsilon):
-        state = state_index(observation, grid.low, grid.high, grid.bins)
+        state = observation_row(observation, grid)
         return state, first_action(algorithm, tables.q, tables.q_b, state, epsilon, handle.rng)
 
     def following(handle, tables, grid, gamma, state, action, reward, observation,
                   terminated, truncated, alpha, epsilon):  # fmt: skip
-        next_state = state_index(observation, grid.low, grid.high, grid.bins)
+        next_state = observation_row(observation, grid)
         next_action = learn_step(
             algorithm, tables.q, tables.q_b, tables.visits, state, action, reward, next_state,
             terminated, truncated, alpha, gamma, epsilon, handle.rng,
@@ -56,10 +57,11 @@ def step_functions(algorithm: int) -> tuple[Any, Any]:
 
 
 class GymnasiumEngine:
-    """Trains in ``gymnasium.make(env.id, **env.kwargs)``; works for any Box/Discrete env.
+    """Trains in ``gymnasium.make(env.id, **env.kwargs)``; works for any env ``inspect_env`` accepts.
 
     The environment is seeded once, at its first reset, with ``env_seed``; a resumed run
-    instead restores the environment generator's saved state.
+    instead restores the environment generator's saved state. Observations go to compiled
+    code as they come: an array (Box), an integer (Discrete) or a tuple of integers.
     """
 
     name = "gymnasium"
@@ -71,6 +73,7 @@ class GymnasiumEngine:
         params: AgentParams,
         env_seed: int,
         env_rng_state: dict[str, Any] | None = None,
+        step_cap: int | None = None,
     ) -> None:
         self._config = config
         self._params = params
@@ -82,6 +85,9 @@ class GymnasiumEngine:
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
         self._first, self._next = step_functions(params.agent.algorithm)
+        # Tuple observations as plain integers: one compiled specialisation for any env.
+        self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
+        self._step_cap = step_cap
         self._handle: GeneratorHandle | None = None
         self._handle_rng: np.random.Generator | None = None
 
@@ -108,10 +114,14 @@ class GymnasiumEngine:
                 set_physics(env, drawn)
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
+            if self._as_ints:
+                observation = tuple(map(int, observation))
             s, a = self._first(handle, tables, grid, observation, epsilon)
             episode_return, length = 0.0, 0
             while a != ENDED:
                 observation, reward, terminated, truncated, _ = env.step(a)
+                if self._as_ints:
+                    observation = tuple(map(int, observation))
                 length += 1
                 episode_return += reward
                 s, a = self._next(handle, tables, grid, agent.gamma, s, a, float(reward),
@@ -126,13 +136,17 @@ class GymnasiumEngine:
     def warm_up(self, state: TrainingState) -> None:
         """Compile the per-step functions on a one-row scratch table.
 
-        The observation sits on every lower grid edge, so it maps to row 0; epsilon 0 and a
-        terminated step draw nothing from the agent's generator, except Double
-        Q-learning's coin, which is drawn from a scratch generator here.
+        The observation sits on every lower grid edge (or is every component's ``start``),
+        so it maps to row 0; epsilon 0 and a terminated step draw nothing from the agent's
+        generator, except Double Q-learning's coin, which is drawn from a scratch generator
+        here.
         """
         grid, agent = self._params.grid, self._params.agent
         space = self._env.observation_space
-        observation = grid.low.astype(space.dtype)
+        observation: Any = grid.low.astype(space.dtype)
+        if grid.indexed:
+            starts = tuple(int(start) for start in grid.starts)
+            observation = starts if isinstance(space, spaces.Tuple) else starts[0]
         n_actions = state.tables.q.shape[1]
         scratch = Tables(
             np.zeros((1, n_actions)),
@@ -148,7 +162,7 @@ class GymnasiumEngine:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
         env = make_env(self._config.env)
         try:
-            return play_greedy(env, q, self._params.grid, episodes, seed)
+            return play_greedy(env, q, self._params.grid, episodes, seed, step_cap=self._step_cap)
         finally:
             env.close()
 

@@ -80,7 +80,7 @@ def _twin_episode(
     loop would cost two atomic reference-count updates per step.
     """
     q, q_b, visits = tables
-    low, high, bins = grid
+    low, high, bins, _ = grid  # twins have Box observations: binned, never indexed
     state = state_index(observation, low, high, bins)
     action = first_action(algorithm, q, q_b, state, epsilon, rng)
     episode_return, length = 0.0, 0

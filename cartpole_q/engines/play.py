@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.engines.base import Grid
-from cartpole_q.rl.binning import state_index
+from cartpole_q.rl.binning import discrete_index, state_index
 
 FrameCallback = Callable[[Any, int, int], None]
 """called with ``(env, episode, step)`` after every reset and step, e.g. to render"""
@@ -25,6 +25,7 @@ def play_greedy(
     episodes: int,
     seed: int,
     on_frame: FrameCallback | None = None,
+    step_cap: int | None = None,
 ) -> np.ndarray:
     """Play the greedy policy of a 2-D ``(n_states, n_actions)`` Q-table.
 
@@ -35,12 +36,15 @@ def play_greedy(
         episodes: how many episodes to play.
         seed: the seed of the first reset.
         on_frame: called after every reset and step, e.g. to record video frames.
+        step_cap: end an episode after this many steps (for environments without a time
+            limit, see :data:`GREEDY_STEP_CAP`); ``None``: only the environment ends it.
 
     Returns:
         The return of each episode.
     """
     # Plain Python lists make the uncompiled binning rule about twice as fast per step.
     low, high, bins = grid.low.tolist(), grid.high.tolist(), grid.bins.tolist()
+    starts = grid.starts.tolist()
     returns = np.zeros(episodes, dtype=np.float64)
     for episode in range(episodes):
         observation, _ = env.reset(seed=seed if episode == 0 else None)
@@ -48,12 +52,16 @@ def play_greedy(
             on_frame(env, episode, 0)
         step = 0
         while True:
-            action = int(np.argmax(q[state_index(observation, low, high, bins)]))
+            if starts:
+                row = discrete_index(observation, starts, bins)
+            else:
+                row = state_index(observation, low, high, bins)
+            action = int(np.argmax(q[row]))
             observation, reward, terminated, truncated, _ = env.step(action)
             step += 1
             returns[episode] += reward
             if on_frame is not None:
                 on_frame(env, episode, step)
-            if terminated or truncated:
+            if terminated or truncated or (step_cap is not None and step >= step_cap):
                 break
     return returns

@@ -28,13 +28,24 @@ class EnvInfo:
     id: str
     """the Gymnasium id"""
     observation_dim: int
-    """length of the 1-D Box observation"""
+    """length of the 1-D Box observation (components of a Tuple, 1 for a Discrete)"""
     n_actions: int
     """size of the Discrete action space"""
     reward_threshold: float | None
     """return that counts as solved (config's ``train.reward_threshold`` or the env's)"""
     max_episode_steps: int | None
     """the time limit after which an episode is truncated"""
+    state_shape: tuple[int, ...] = ()
+    """the Q-table's shape without the action axis: the bins of a Box observation, ``(n,)``
+    for ``Discrete(n)``, ``(a, b, ...)`` for a Tuple of Discrete spaces"""
+    index_starts: tuple[int, ...] | None = None
+    """each Discrete component's ``start`` when the observation is the row index itself
+    (row ``obs - start``; a Tuple's components in C order); ``None`` when it is binned"""
+
+    @property
+    def indexed(self) -> bool:
+        """Whether observations index the Q-table directly (Discrete or Tuple of Discrete)."""
+        return self.index_starts is not None
 
 
 def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "config") -> Any:
@@ -88,10 +99,11 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
         source: the config's file (or another label) for error messages.
 
     Raises:
-        ConfigError: naming ``env.id``, ``env.kwargs``, ``discretization.bins`` or
-            ``agent.max_q_table_bytes``, when the environment cannot be made, its spaces
-            are not a 1-D Box and a Discrete, the grid's dimension differs from the
-            observation's, or the Q-table would exceed the size limit.
+        ConfigError: naming ``env.id``, ``env.kwargs``, ``discretization`` or
+            ``agent.max_q_table_bytes``, when the environment cannot be made, its actions
+            are not a Discrete from 0, its observations not a 1-D Box, a Discrete or a Tuple
+            of Discrete spaces, a Box has no grid or one of another dimension, a Discrete
+            observation is given a grid, or the Q-table would exceed the size limit.
     """
     import gymnasium
     from gymnasium import spaces
@@ -120,27 +132,54 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
             f"{source}: env.id: {env_id!r} has action space {action_space}; tabular "
             "Q-learning here needs Discrete actions numbered from 0."
         )
-    if not isinstance(observation_space, spaces.Box) or len(observation_space.shape) != 1:
-        raise ConfigError(
-            f"{source}: env.id: {env_id!r} has observation space {observation_space}; the "
-            "discretiser needs a 1-D Box."
+    index_starts = _index_starts(observation_space)
+    if index_starts is not None:
+        components = (
+            observation_space.spaces
+            if isinstance(observation_space, spaces.Tuple)
+            else (observation_space,)
         )
-    observation_dim = int(observation_space.shape[0])
-    bins = config.discretization.bins
-    if len(bins) != observation_dim:
+        state_shape = tuple(int(getattr(space, "n", 0)) for space in components)
+        observation_dim = len(state_shape)
+        if config.discretization is not None:
+            raise ConfigError(
+                f"{source}: discretization: {env_id!r} has observation space "
+                f"{observation_space}, whose observations index the Q-table directly (shape "
+                f"{(*state_shape, int(action_space.n))}); a grid bins only Box observations, "
+                "so leave discretization out (or set it to null)."
+            )
+        field = "env.id"
+    elif isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 1:
+        observation_dim = int(observation_space.shape[0])
+        if config.discretization is None:
+            raise ConfigError(
+                f"{source}: discretization: {env_id!r} has observation space "
+                f"{observation_space}, which needs a grid: give discretization.bins, low "
+                f"and high, one entry per dimension ({observation_dim})."
+            )
+        state_shape = config.discretization.bins
+        if len(state_shape) != observation_dim:
+            raise ConfigError(
+                f"{source}: discretization.bins: has {len(state_shape)} entries but "
+                f"{env_id!r} observations have {observation_dim} dimensions; give bins, low "
+                "and high one entry per dimension."
+            )
+        field = "discretization.bins"
+    else:
         raise ConfigError(
-            f"{source}: discretization.bins: has {len(bins)} entries but {env_id!r} "
-            f"observations have {observation_dim} dimensions; give bins, low and high "
-            "one entry per dimension."
+            f"{source}: env.id: {env_id!r} has observation space {observation_space}; "
+            "tabular learning here needs a 1-D Box (binned by discretization), a Discrete, "
+            "or a Tuple of Discrete spaces."
         )
     n_actions = int(action_space.n)
-    table_bytes = q_table_bytes(bins, n_actions)
+    table_bytes = q_table_bytes(state_shape, n_actions)
     limit = config.agent.max_q_table_bytes
     if table_bytes > limit:
+        fewer = "use fewer bins" if index_starts is None else "use a smaller environment"
         raise ConfigError(
-            f"{source}: discretization.bins: the Q-table would hold {math.prod(bins):,} "
+            f"{source}: {field}: the Q-table would hold {math.prod(state_shape):,} "
             f"states x {n_actions} actions = {_size(table_bytes)}, above the limit of "
-            f"{_size(limit)} (agent.max_q_table_bytes); use fewer bins or raise the limit."
+            f"{_size(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
         )
     max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
     threshold = config.train.reward_threshold
@@ -152,7 +191,24 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
         n_actions=n_actions,
         reward_threshold=threshold,
         max_episode_steps=max_steps,
+        state_shape=tuple(state_shape),
+        index_starts=index_starts,
     )
+
+
+def _index_starts(space: Any) -> tuple[int, ...] | None:
+    """The ``start`` of each Discrete component, or ``None`` if not Discrete / Tuple of them."""
+    from gymnasium import spaces
+
+    if isinstance(space, spaces.Discrete):
+        return (int(space.start),)
+    if (
+        isinstance(space, spaces.Tuple)
+        and space.spaces
+        and all(isinstance(component, spaces.Discrete) for component in space.spaces)
+    ):
+        return tuple(int(getattr(component, "start", 0)) for component in space.spaces)
+    return None
 
 
 def _default_threshold(

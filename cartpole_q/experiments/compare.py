@@ -2,7 +2,8 @@
 
 The probability of improvement (rliable): how likely a random seed of A beats a random seed
 of B on a metric, with a 95% stratified-bootstrap interval (seeds resampled within each
-run). A single run counts as one seed.
+run). A single run counts as one seed; a sweep point (``<sweep>/points/<p>``) has the seeds
+of its ``results.csv`` rows.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import Any
 from cartpole_q.errors import UserError
 from cartpole_q.experiments.multiseed import load_seed_runs
 from cartpole_q.experiments.statistics import iqm, median, probability_of_improvement
-from cartpole_q.store import rundir
+from cartpole_q.store import rundir, sweepdir
 
 METRICS = {
     "eval_mean": ("greedy eval mean", True),
@@ -47,7 +48,11 @@ class Comparison:
 
 
 def seed_values(path: Path, metric: str) -> list[float]:
-    """One value per finished seed of a run (a single run is one seed)."""
+    """One value per finished seed of a run (a single run is one seed) or sweep point."""
+    point_rows = sweepdir.point_results(path)
+    if point_rows is not None:
+        cells = [row[metric] for row in point_rows]
+        return [float(cell) if cell else float("inf") for cell in cells]
     runs = load_seed_runs(path) if rundir.is_multi_seed(path) else [rundir.load_run(path)]
     values = []
     for run in runs:

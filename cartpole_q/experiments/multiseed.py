@@ -9,6 +9,7 @@ one per core; a seed's results do not depend on which worker ran it, or when.
 from __future__ import annotations
 
 import dataclasses
+import math
 import multiprocessing
 import os
 import pickle
@@ -55,6 +56,7 @@ def run_seeds(
     reporter: Reporter | None = None,
     should_stop: Callable[[], bool] | None = None,
     resume: bool = False,
+    seed_plots: bool = False,
 ) -> dict[str, Any]:
     """Train every seed of ``prepared.config`` under ``parent`` and write the aggregate.
 
@@ -66,6 +68,9 @@ def run_seeds(
         should_stop: polled while waiting; when true, workers stop at the end of their
             current episode and unstarted seeds are left for ``--resume``.
         resume: keep finished seeds, resume interrupted ones, start the rest.
+        seed_plots: draw each seed's ``reward_curve.png`` (about 0.15 s per seed) and the
+            parent's, which shows every seed with a band. Without it no figure is drawn,
+            so that many seeds train in seconds (``cartpole-q plot DIR`` draws it later).
 
     Returns:
         The aggregate summary (also written as ``parent/summary.json``).
@@ -98,19 +103,36 @@ def run_seeds(
             outcome = execute_run(
                 child, prepare(config.for_seed(seed), str(child / rundir.CONFIG_FILE)),
                 resume=child_resume, should_stop=should_stop, reporter=reporter,
-                key="run", label=f"seed {seed}",
+                key="run", label=f"seed {seed}", plot=seed_plots,
             )  # fmt: skip
             interrupted = interrupted or outcome.result.interrupted
     else:
+        # Several seeds per job: a worker loads the config and the compiled loop once per
+        # job, not once per seed; four jobs per worker keep the workers busy to the end.
+        size = max(1, math.ceil(len(jobs) / (4 * workers)))
+        items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
+        chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
         results = run_in_workers(
-            _train_seed, [(str(child), seed, child_resume) for seed, child, child_resume in jobs],
-            workers, reporter=reporter, should_stop=should_stop,
-        )  # fmt: skip
-        interrupted = any(result is not False for result in results)
+            _train_seeds, chunks, workers, reporter=reporter, should_stop=should_stop
+        )
+        interrupted = any(
+            result is NOT_STARTED or len(result) < len(chunk[0]) or any(result)
+            for result, chunk in zip(results, chunks, strict=True)
+        )
 
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
+    if seed_plots:
+        _plot_seeds(parent)
     write_json(parent / rundir.SUMMARY_FILE, summary)
     return summary
+
+
+def _plot_seeds(parent: Path) -> None:
+    """Draw the parent's ``reward_curve.png``: every finished seed's returns, with a band."""
+    from cartpole_q.experiments.plots import plot_rewards
+
+    with suppress(RunError):  # no seed has finished: there is nothing to draw
+        plot_rewards([parent], parent / rundir.CURVE_FILE, force=True)
 
 
 # -- worker processes: one helper for training and evaluating seeds ---------------------
@@ -140,6 +162,7 @@ def run_in_workers(
     *,
     reporter: Reporter | None = None,
     should_stop: Callable[[], bool] | None = None,
+    on_result: Callable[[int, Any], None] | None = None,
 ) -> list[Any]:
     """Call ``function(worker, *job)`` for every job in spawned worker processes.
 
@@ -151,6 +174,8 @@ def run_in_workers(
         reporter: receives the workers' progress.
         should_stop: polled about ten times a second; once true, no job starts any more
             and the running ones are asked to stop (their results are still awaited).
+        on_result: called in this process with each job's index and result as it
+            arrives (e.g. to save finished work while the rest runs).
 
     Returns:
         The results in job order; :data:`NOT_STARTED` for the jobs a stop left out.
@@ -164,7 +189,7 @@ def run_in_workers(
     results: list[Any] = [NOT_STARTED] * len(jobs)
     if not jobs:
         return results
-    context = multiprocessing.get_context("spawn")
+    context: Any = multiprocessing.get_context(_start_method())
     if os.name == "posix":
         # Started lazily by the first worker, multiprocessing's resource tracker unblocks
         # SIGINT and SIGTERM once it runs; start it first so the block below holds.
@@ -185,12 +210,26 @@ def run_in_workers(
                 conns.append(parent_end)
                 process.start()
                 child_end.close()
-        _dispatch(function, jobs, conns, processes, results, reporter, should_stop)
+        _dispatch(function, jobs, conns, processes, results, reporter, should_stop, on_result)
     except BaseException:
         _end_workers(processes, conns, kill=True)
         raise
     _end_workers(processes, conns, kill=False)
     return results
+
+
+def _start_method() -> str:
+    """``fork`` where it is safe and cheap, else ``spawn``.
+
+    A forked worker starts in milliseconds with everything this process has imported and
+    compiled; a spawned one imports numpy, numba and gymnasium and loads the compiled
+    loop again (about 1.5 s), which would dominate a quick multi-seed run. Forking is
+    safe on Linux while this process has no other thread (a live progress bar has one;
+    a thread holding a lock at the fork would leave that lock held in the child).
+    """
+    if sys.platform.startswith("linux") and threading.active_count() == 1:
+        return "fork"
+    return "spawn"
 
 
 def _dispatch(
@@ -201,6 +240,7 @@ def _dispatch(
     results: list[Any],
     reporter: Reporter,
     should_stop: Callable[[], bool] | None,
+    on_result: Callable[[int, Any], None] | None = None,
 ) -> None:
     """Hand out the jobs to idle workers and collect their messages until none is busy."""
     idle = list(range(len(conns)))
@@ -232,8 +272,11 @@ def _dispatch(
                         f"{processes[worker].exitcode}) while it ran {jobs[busy[worker]]!r}."
                     ) from None
                 if kind == "result":
-                    results[busy.pop(worker)] = payload[0]
+                    job = busy.pop(worker)
+                    results[job] = payload[0]
                     idle.append(worker)
+                    if on_result is not None:
+                        on_result(job, payload[0])
                 elif kind == "error":
                     raise _worker_exception(*payload)
                 elif kind == "start":
@@ -423,17 +466,34 @@ class _PipeReporter:
         """Nothing to close."""
 
 
-def _train_seed(worker: Worker, child: str, seed: int, resume: bool) -> bool:
-    """Worker job: train one seed into its directory; return whether it was interrupted."""
-    if worker.should_stop():
-        return True
-    path = Path(child)
-    prepared = prepare(load_config(path / rundir.CONFIG_FILE), str(path / rundir.CONFIG_FILE))
-    outcome = execute_run(
-        path, prepared, resume=resume, should_stop=worker.should_stop,
-        reporter=worker.reporter(), key=f"worker {os.getpid()}", label=f"seed {seed}",
-    )  # fmt: skip
-    return outcome.result.interrupted
+def _train_seeds(worker: Worker, items: Sequence[tuple[str, int, bool]], plot: bool) -> list[bool]:
+    """Worker job: train seeds into their directories, one after another.
+
+    Each item is (seed directory, seed, resume). The seeds share one config but their
+    seed, so it is checked against its environment once.
+
+    Returns:
+        Whether each started seed was interrupted; seeds a stop left out have no entry.
+    """
+    interrupted: list[bool] = []
+    env_info = None
+    reporter = worker.reporter()
+    for child, seed, resume in items:
+        if worker.should_stop():
+            break
+        path = Path(child)
+        config = load_config(path / rundir.CONFIG_FILE)
+        if env_info is None:
+            prepared = prepare(config, str(path / rundir.CONFIG_FILE))
+            env_info = prepared.env_info
+        else:
+            prepared = dataclasses.replace(prepared, config=config)
+        outcome = execute_run(
+            path, prepared, resume=resume, should_stop=worker.should_stop, reporter=reporter,
+            key=f"worker {os.getpid()}", label=f"seed {seed}", plot=plot,
+        )  # fmt: skip
+        interrupted.append(outcome.result.interrupted)
+    return interrupted
 
 
 def _finished(child: Path) -> bool:
@@ -595,12 +655,42 @@ def _evaluate_one(
     physics: dict[str, Any] | None = None,
     max_steps: int | None = None,
 ) -> dict[str, Any]:
-    from cartpole_q.evaluation import evaluate, under_conditions
+    from cartpole_q.evaluation import evaluate, exact_report, under_conditions
 
     run = rundir.load_run(path)
     config = under_conditions(run.config, physics, max_steps)
     report = evaluate(run.q_table, config, episodes=episodes, seed=seed)
-    return {"run_seed": run.config.seed, "path": run.path.name, **report.to_dict()}
+    result = {"run_seed": run.config.seed, "path": run.path.name, **report.to_dict()}
+    exact = exact_report(config, run.q_table)
+    if not isinstance(exact, str):
+        result["exact"] = exact.to_dict()
+    return result
+
+
+def exact_summary(results: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The seeds' exact greedy returns against the optimum (``None`` without a model).
+
+    ``within_0.01`` counts the seeds whose gap is at most 0.01, ``within_1%`` those within
+    1% of the optimum's magnitude (both as the issue's acceptance states them).
+    """
+    exact = [result["exact"] for result in results if "exact" in result]
+    if not exact:
+        return None
+    optimum = exact[0]["optimum"]["return"]
+    greedy = np.array([item["greedy"]["return"] for item in exact])
+    gaps = optimum - greedy
+    tolerance = 1e-9 * max(1.0, abs(optimum))  # the same value, up to rounding
+    return {
+        "note": exact[0]["note"],
+        "optimum": optimum,
+        "greedy_median": float(np.median(greedy)),
+        "greedy_min": float(np.min(greedy)),
+        "gap_max": float(np.max(gaps)),
+        "within_0.01": int(np.sum(gaps <= 0.01 + tolerance)),
+        "within_1%": int(np.sum(gaps <= 0.01 * abs(optimum) + tolerance)),
+        "optimal": int(np.sum(gaps <= tolerance)),
+        "seeds": len(exact),
+    }
 
 
 def evaluate_seeds(
@@ -648,7 +738,9 @@ def evaluate_seeds(
         conditions = under_conditions(first.config, physics, max_steps)
         reward_threshold = inspect_env(conditions).reward_threshold
     means = [result["mean"] for result in results]
+    exact = exact_summary(results)
     return {
+        **({"exact": exact} if exact else {}),
         "runs": results,
         "successes": sum(
             1 for m in means if reward_threshold is not None and m >= reward_threshold

@@ -7,18 +7,25 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from cartpole_q.errors import UserError
 from cartpole_q.experiments.multiseed import load_seed_runs
 from cartpole_q.figures import (
     FIGURE_FORMATS,
     Curve,
+    GridMap,
     SeedBand,
     action_names,
+    blackjack_policy_figure,
     default_dims,
     dimension_names,
     figure_bytes,
+    grid_policy_figure,
     policy_figure,
+    reward_and_paths_figure,
     reward_curve_figure,
 )
 from cartpole_q.store import rundir
@@ -38,9 +45,11 @@ def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Pa
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     items: list[Curve | SeedBand] = []
+    first_runs: list[rundir.Run] = []
     for path in run_dirs:
         if rundir.is_multi_seed(path):
             runs = load_seed_runs(path)
+            first_runs.append(runs[0])
             thresholds = {run.summary.get("reward_threshold") for run in runs}
             items.append(SeedBand(
                 path.name, [run.metrics.returns for run in runs],
@@ -50,6 +59,7 @@ def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Pa
             ))  # fmt: skip
         else:
             run = rundir.load_run(path)
+            first_runs.append(run)
             items.append(Curve(
                 path.name, run.metrics.returns, run.summary.get("solved_episode"),
                 threshold=run.summary.get("reward_threshold"),
@@ -59,9 +69,58 @@ def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Pa
     title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
     if len(items) == 1 and isinstance(items[0], Curve) and items[0].interrupted:
         title += " (interrupted)"
-    figure = reward_curve_figure(items, None, title)
+    grid, paths = _greedy_paths(run_dirs, first_runs)
+    if grid is not None:
+        figure = reward_and_paths_figure(items, None, title, grid, paths)
+    else:
+        figure = reward_curve_figure(items, None, title)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
+
+
+def _greedy_paths(
+    run_dirs: Sequence[Path], runs: Sequence[rundir.Run]
+) -> tuple[GridMap | None, list[tuple[str, list[int], bool]]]:
+    """Each run's greedy path, when all runs are on one deterministic grid world."""
+    envs = {(run.config.env.id, repr(sorted(run.config.env.kwargs.items()))) for run in runs}
+    if len(envs) != 1 or runs[0].config.discretization is not None:
+        return None, []
+    from cartpole_q.envs.models import EnvModel, env_model, grid_layout
+
+    env = runs[0].config.env
+    layout = grid_layout(env)
+    found = env_model(env) if layout is not None else None
+    if layout is None or not isinstance(found, EnvModel):
+        return None, []
+    model = found.model
+    if not np.all(model.probability == 1.0) or np.count_nonzero(model.initial) != 1:
+        return None, []  # paths of a slippery world are not one line
+    grid = GridMap(layout.rows, layout.columns, layout.cells, layout.moves)
+    paths = []
+    for path, run in zip(run_dirs, runs, strict=True):
+        policy = np.argmax(run.q_table.reshape(model.n_states, -1), axis=1)
+        paths.append((path.name, *follow(model, policy)))
+    return grid, paths
+
+
+def follow(model: Any, policy: np.ndarray, limit: int = 1000) -> tuple[list[int], bool]:
+    """The states a deterministic model visits under ``policy`` from its start.
+
+    Returns the states (the terminal one included) and whether the episode ends; it does
+    not when the path comes back to a state it has visited (it would loop forever).
+    """
+    state = int(np.argmax(model.initial))
+    states, seen = [state], {state}
+    for _ in range(limit):
+        chosen = np.flatnonzero((model.state == state) & (model.action == policy[state]))[0]
+        state = int(model.next_state[chosen])
+        states.append(state)
+        if model.terminated[chosen]:
+            return states, True
+        if state in seen:
+            return states, False
+        seen.add(state)
+    return states, False
 
 
 def plot_policy(run_dir: Path, out: Path, dims_text: str | None, force: bool = False) -> Path:
@@ -73,18 +132,70 @@ def plot_policy(run_dir: Path, out: Path, dims_text: str | None, force: bool = F
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     run = rundir.load_run(run_dir)
-    bins = run.config.discretization.bins
-    dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     env_id = run.config.env.id
     title = f"Policy of {run_dir.name}"
     if run.summary.get("interrupted"):
         title += f" (training interrupted at episode {run.summary.get('episodes')})"
+    grid = run.config.discretization
+    if grid is None:
+        if dims_text is not None:
+            raise UserError(
+                "--dims: this run's observations are Discrete: there are no binned dimensions to pick."
+            )
+        return _plot_discrete_policy(run, out, title, force)
+    bins = grid.bins
+    dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
+    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     figure = policy_figure(
-        run.q_table, run.visits, dims, run.config.discretization.low,
-        run.config.discretization.high, dimension_names(env_id, len(bins)), title,
+        run.q_table, run.visits, dims, grid.low, grid.high,
+        dimension_names(env_id, len(bins)), title,
         action_names=action_names(env_id, run.q_table.shape[-1]),
     )  # fmt: skip
+    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
+    return out
+
+
+TAXI_SHAPE = (5, 5, 5, 4)
+"""Taxi's state ``((taxi row * 5 + taxi column) * 5 + passenger location) * 4 + destination``"""
+TAXI_ACTIONS = ("south", "north", "east", "west", "pickup", "drop off")
+
+
+def _plot_discrete_policy(run: rundir.Run, out: Path, title: str, force: bool) -> Path:
+    """Grid worlds as grids, Blackjack as two panels, Taxi over the taxi's position."""
+    from cartpole_q.envs.models import grid_layout
+
+    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    q, visits = run.q_table, run.visits
+    layout = grid_layout(run.config.env)
+    if layout is not None:
+        grid = GridMap(layout.rows, layout.columns, layout.cells, layout.moves)
+        figure = grid_policy_figure(q, visits, grid, title)
+    elif q.shape == (32, 11, 2, 2):
+        figure = blackjack_policy_figure(q, visits, title)
+    else:
+        if q.shape[:-1] == (500,) and q.shape[-1] == len(TAXI_ACTIONS):
+            shape, names, actions = (
+                TAXI_SHAPE,
+                ["taxi row", "taxi column", "passenger", "destination"],
+                list(TAXI_ACTIONS),
+            )
+        elif q.ndim >= 3:
+            shape, names, actions = (
+                q.shape[:-1],
+                [f"component {k}" for k in range(q.ndim - 1)],
+                None,
+            )
+        else:
+            raise UserError(
+                f"--policy: no map for {run.config.env.id!r}: its observation is one Discrete "
+                "of unknown layout (maps exist for FrozenLake, CliffWalking, Taxi, Blackjack "
+                "and Tuple observations)."
+            )
+        table = q.reshape(*shape, q.shape[-1])
+        counts = None if visits is None else visits.reshape(*shape, q.shape[-1])
+        low = [-0.5] * len(shape)
+        high = [size - 0.5 for size in shape]
+        figure = policy_figure(table, counts, (0, 1), low, high, names, title, action_names=actions)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 

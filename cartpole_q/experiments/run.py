@@ -91,7 +91,9 @@ class StopRequest:
 
     def __exit__(self, *exc_info: object) -> None:
         for signum, handler in self._previous.items():
-            signal.signal(signum, handler)
+            # Once stopping, the command is on its way out: a further signal must not
+            # turn its clean exit (files complete, exit code 130) into a crash.
+            signal.signal(signum, signal.SIG_IGN if self._event.is_set() else handler)
         self._previous.clear()
 
 
@@ -129,6 +131,7 @@ def execute_run(
     label: str | None = None,
     watch_every: int = 0,
     video_every: int = 0,
+    plot: bool = True,
 ) -> Outcome:
     """Train ``prepared.config`` into ``run_dir`` (which holds its ``config.yaml``).
 
@@ -145,6 +148,8 @@ def execute_run(
             window (``train --watch``; 0: never).
         video_every: every this many episodes, record one greedy episode as
             ``videos/episode-NNNNNN.gif`` in the run directory (``train --video-every``).
+        plot: draw ``reward_curve.png`` (a multi-seed run draws one for all its seeds
+            instead, unless ``train --seed-plots``).
 
     Raises:
         RunError: ``resume`` and the checkpoint is missing or damaged.
@@ -173,7 +178,7 @@ def execute_run(
         snapshot_every=math.gcd(watch_every, video_every),
         on_snapshot=_greedy_viewer(run_dir, config, watch_every, video_every),
     )
-    summary = rundir.write_run(run_dir, result, overwrite=True)
+    summary = rundir.write_run(run_dir, result, overwrite=True, plot=plot)
     reporter.finish(key, outcome_line(label or run_dir.name, summary))
     return Outcome(run_dir, result, summary)
 
@@ -287,7 +292,8 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
     """
     where = run_dir / rundir.CONFIG_FILE
     trained: Config | None = checkpoint.config
-    if trained is None:  # a checkpoint from before configs were recorded in it
+    if trained is None and config.discretization is not None:
+        # a checkpoint from before configs were recorded in it (CartPole grids only)
         states = math.prod(config.discretization.bins)
         if checkpoint.tables.q.shape[0] != states:
             raise RunError(
@@ -295,6 +301,8 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
                 f"{states} states, but the checkpoint's Q-table has {checkpoint.tables.q.shape[0]}; "
                 "--resume continues a run exactly as it was trained."
             )
+        return
+    if trained is None:
         return
     for key, old, new in config_differences(trained, config):
         if key == "train.episodes":

@@ -18,6 +18,14 @@ one directly, so ``cartpole-q eval`` never imports numba. A NaN coordinate falls
 (2, 0)
 >>> state_index([0.0, 5.0], low, high, bins), state_index([9.0, 0.0], low, high, bins)
 (2, 3)
+
+Discrete observations need no binning: ``Discrete(n, start)`` gives row ``obs - start``, a
+``Tuple(Discrete(n_0, start_0), Discrete(n_1, start_1), ...)`` the C-order row of
+``i_k = obs[k] - start_k`` (:func:`discrete_index`, compiled as
+:func:`cartpole_q.rl.policy.observation_row`).
+
+>>> discrete_index(7, [3], [10]), discrete_index((2, 1), [0, 1], [4, 3])
+(4, 6)
 """
 
 from __future__ import annotations
@@ -59,3 +67,18 @@ def bin_indices(
         state_index([x], [lo], [hi], [n]) if n > 1 else 0
         for x, lo, hi, n in zip(observation, low, high, bins, strict=True)
     )
+
+
+def discrete_index(observation: Any, starts: Any, sizes: Any) -> int:
+    """The flat (C-order) Q-table row of a Discrete or Tuple-of-Discrete observation.
+
+    Args:
+        observation: an integer (``Discrete``) or a tuple of integers (``Tuple``).
+        starts: each component's ``start``.
+        sizes: each component's ``n``.
+    """
+    components = observation if isinstance(observation, tuple | list) else (observation,)
+    index = 0
+    for k in range(len(sizes)):
+        index = index * sizes[k] + (int(components[k]) - starts[k])
+    return index

@@ -21,7 +21,8 @@ decides, then ``rng.integers(0, n_actions)`` when exploring.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl import binning
@@ -30,6 +31,44 @@ configure_numba_cache()  # before any cache=True function is defined
 
 state_index = njit(cache=True, nogil=True, inline="always")(binning.state_index)
 """the binning rule of :mod:`cartpole_q.rl.binning`, compiled (the same source)"""
+
+
+def observation_row(observation, grid):
+    """The Q-table row of an observation: binned (an array) or indexed (Discrete, Tuple).
+
+    Compiled code only: numba picks the rule by the observation's type. An array follows
+    the binning rule on ``grid``'s edges; an integer (``Discrete``) gives
+    ``obs - grid.starts[0]``; a tuple of integers (``Tuple`` of ``Discrete``) the C-order
+    row of ``obs[k] - grid.starts[k]`` over ``grid.bins`` (the components' sizes), as
+    :func:`cartpole_q.rl.binning.discrete_index`.
+    """
+    raise NotImplementedError("observation_row is called from compiled code only")
+
+
+@overload(observation_row, inline="always")
+def _observation_row(observation, grid):
+    if isinstance(observation, types.Array):
+
+        def binned(observation, grid):
+            return state_index(observation, grid.low, grid.high, grid.bins)
+
+        return binned
+    if isinstance(observation, types.Integer):
+
+        def single(observation, grid):
+            return observation - grid.starts[0]
+
+        return single
+    if isinstance(observation, types.UniTuple) and isinstance(observation.dtype, types.Integer):
+
+        def components(observation, grid):
+            index = 0
+            for k in range(len(observation)):
+                index = index * grid.bins[k] + (observation[k] - grid.starts[k])
+            return index
+
+        return components
+    return None
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -19,6 +19,7 @@ Arrays are read with ``allow_pickle=False`` only.
 from __future__ import annotations
 
 import csv
+import functools
 import io
 import json
 import platform
@@ -119,6 +120,12 @@ def write_config(run_dir: Path, config: Config) -> None:
 
 def versions() -> dict[str, str]:
     """The versions of Python and the packages that produce a run."""
+    return dict(_versions())
+
+
+@functools.cache
+def _versions() -> dict[str, str]:
+    # Read once per process: importlib.metadata parses each package's METADATA file.
     found = {"python": platform.python_version()}
     for package in ("numpy", "gymnasium", "numba", "cartpole-q"):
         try:
@@ -293,7 +300,8 @@ def load_run(path: str | Path) -> Run:
         )
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
     q_table = load_array(path / Q_TABLE_FILE, np.float64)
-    check_q_table(q_table, config.discretization.bins, None, str(path / Q_TABLE_FILE))
+    grid = config.discretization
+    check_q_table(q_table, None if grid is None else grid.bins, None, str(path / Q_TABLE_FILE))
     visits = None
     if (path / VISITS_FILE).is_file():
         visits = load_array(path / VISITS_FILE, np.int64)

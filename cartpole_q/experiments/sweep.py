@@ -1,0 +1,394 @@
+"""Running a sweep: every (point, seed) trained and evaluated, saved in batches, resumable.
+
+Each (point, seed) is exactly ``cartpole-q train --config points/<p>/config.yaml --seed S``
+(the same kept table, byte for byte), but a sweep does the per-process work once: a
+worker loads the compiled kernels once, runs many seeds per task, draws no per-run
+figure and writes nothing itself; the parent saves finished runs in few atomic writes.
+Nothing in ``results.csv`` but ``train_seconds`` depends on the backend, the number of
+workers or an interruption.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.errors import RunError
+from cartpole_q.experiments.backends import execute
+from cartpole_q.experiments.statistics import PointStatistics, summarize_point
+from cartpole_q.experiments.sweep_spec import SweepSpec, axis_cell, load_sweep
+from cartpole_q.progress import NullSweepProgress, SweepProgress
+from cartpole_q.store import sweepdir
+from cartpole_q.store.sweepdir import RESULT_COLUMNS, cell
+
+MAX_RUNS_PER_TASK = 100
+"""a task is at most this many runs (about a second for the default config)"""
+TASKS_PER_WORKER = 4
+"""split the work into at least this many tasks per worker, so that all finish together"""
+FLUSH_SECONDS = 1.0
+"""save finished runs at most this often (a kill loses at most this much work)"""
+
+
+@dataclass
+class SweepOutcome:
+    """How a sweep call ended."""
+
+    directory: Path
+    spec: SweepSpec
+    total_runs: int
+    done_runs: int
+    complete: bool
+    points: list[dict[str, str]] = field(default_factory=list)
+    """the ``points.csv`` rows (only when complete)"""
+
+
+# -- the worker side ---------------------------------------------------------------------
+
+
+def run_task(worker: Any, task: Sequence[tuple[int, dict[str, Any], Sequence[int]]]) -> list[Any]:
+    """Train and evaluate each (point, seed) of a task, as ``cartpole-q train`` would.
+
+    Args:
+        worker: its ``should_stop()`` ends the task early, after the current run.
+        task: (point index, the point's config as a mapping, its seeds) groups.
+
+    Returns:
+        ``(point, seed, cells, q_table)`` per finished run, ``cells`` keyed by
+        :data:`~cartpole_q.store.sweepdir.RESULT_COLUMNS`.
+    """
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.training import train
+
+    finished: list[Any] = []
+    for point, mapping, seeds in task:
+        config = load_config(mapping)
+        env_info = inspect_env(config)
+        for seed in seeds:
+            if worker.should_stop():
+                return finished
+            result = train(config.for_seed(seed), env_info=env_info)
+            finished.append((point, seed, result_cells(result, seed), result.q_table))
+    return finished
+
+
+def result_cells(result: Any, seed: int) -> dict[str, str]:
+    """A :class:`~cartpole_q.training.TrainResult` as its ``results.csv`` cells."""
+    solved = result.solved_episode
+    threshold = result.reward_threshold
+    eval_mean = None if result.eval is None else float(result.eval.mean)
+    greedy = result.first_greedy_success()
+    values = {
+        "seed": seed,
+        "solved_episode": solved,
+        "env_steps_to_solve": None if solved is None else int(result.lengths[:solved].sum()),
+        "first_greedy_success_env_steps": None if greedy is None else greedy["env_steps"],
+        "eval_mean": eval_mean,
+        "success": None if threshold is None or eval_mean is None else eval_mean >= threshold,
+        "episodes": result.episodes,
+        "env_steps": result.env_steps,
+        "train_seconds": round(result.train_seconds, 6),
+    }
+    return {column: cell(values[column]) for column in RESULT_COLUMNS}
+
+
+# -- the parent side ---------------------------------------------------------------------
+
+
+def prepare_sweep(source: Path) -> SweepSpec:
+    """Load a sweep file and check every point's config against its environment.
+
+    Raises:
+        ConfigError: naming the file, the point and the key.
+    """
+    spec = load_sweep(source)
+    check_points(spec, str(source))
+    return spec
+
+
+def check_points(spec: SweepSpec, where: str) -> None:
+    """Check each point's config against its environment (engine, bins, physics).
+
+    Raises:
+        ConfigError: naming the point.
+    """
+    from cartpole_q.experiments.run import prepare
+
+    checked: dict[str, None] = {}
+    for point in spec.points:
+        env_part = repr(
+            (point.config.env, point.config.discretization, point.config.engine, point.config.agent)
+        )
+        if env_part in checked:
+            continue  # the same environment, bins and engine: checked already
+        prepare(point.config, f"{where}: point {spec.point_id(point.index)}")
+        checked[env_part] = None
+
+
+def start_sweep(spec: SweepSpec, out: Path | None) -> Path:
+    """Create the sweep directory and write ``sweep.yaml`` and the points' configs."""
+    directory = sweepdir.create_sweep_dir(spec.name, out)
+    configs = [(spec.point_id(point.index), point.config) for point in spec.points]
+    sweepdir.write_sweep(directory, spec.to_dict(), configs)
+    return directory
+
+
+def load_sweep_dir(directory: Path) -> SweepSpec:
+    """The sweep of an existing sweep directory, for ``--resume``.
+
+    Raises:
+        RunError: ``directory`` is not a sweep directory.
+        ConfigError: its ``sweep.yaml`` is invalid.
+    """
+    path = sweepdir.sweep_file(directory)
+    spec = load_sweep(path)
+    check_points(spec, str(path))
+    return spec
+
+
+def run_sweep(
+    spec: SweepSpec,
+    directory: Path,
+    *,
+    workers: int = 1,
+    backend: str = "local",
+    address: str | None = None,
+    progress: SweepProgress | None = None,
+    should_stop: Callable[[], bool] | None = None,
+) -> SweepOutcome:
+    """Run whatever ``results.csv`` of ``directory`` does not have yet, then summarise.
+
+    Args:
+        spec: the sweep (as written in ``directory``).
+        directory: the sweep directory.
+        workers: worker processes (or a local Ray cluster's CPUs).
+        backend: ``local`` or ``ray``.
+        address: a running Ray cluster's address.
+        progress: receives the count of finished runs.
+        should_stop: polled between runs; when true, the finished runs are saved and
+            the sweep ends, to be finished with ``--resume``.
+
+    Returns:
+        How far it got; when complete, ``points.csv`` and ``sweep.png`` are written.
+
+    Raises:
+        RunError: ``results.csv`` has rows that are not of this sweep.
+    """
+    progress = progress or NullSweepProgress()
+    book = _Book(spec, directory)
+    missing = [
+        (point.index, seed)
+        for point in spec.points
+        for seed in spec.seeds
+        if (point.index, seed) not in book.rows
+    ]
+    progress.start(spec.runs, len(book.rows), len(spec.points), book.points_done())
+    tasks = plan_tasks(spec, missing, workers)
+
+    def on_result(index: int, finished: list[Any]) -> None:
+        book.add(finished)
+        progress.advance(len(book.rows), book.points_done())
+
+    try:
+        execute(
+            run_task, [(task,) for task in tasks], on_result,
+            backend=backend, workers=workers, address=address, should_stop=should_stop,
+        )  # fmt: skip
+    finally:
+        book.flush(force=True)
+        progress.close()
+    outcome = SweepOutcome(directory, spec, spec.runs, len(book.rows), len(book.rows) == spec.runs)
+    if outcome.complete:
+        outcome.points = summarize_sweep(spec, directory, book.sorted_rows())
+    return outcome
+
+
+def plan_tasks(
+    spec: SweepSpec, missing: Sequence[tuple[int, int]], workers: int
+) -> list[list[tuple[int, dict[str, Any], tuple[int, ...]]]]:
+    """Cut the missing (point, seed) runs, in order, into tasks of consecutive runs.
+
+    A task holds up to :data:`MAX_RUNS_PER_TASK` runs, fewer when that leaves fewer than
+    :data:`TASKS_PER_WORKER` tasks per worker; consecutive seeds of a point stay together.
+    """
+    if not missing:
+        return []
+    size = max(1, min(MAX_RUNS_PER_TASK, math.ceil(len(missing) / (TASKS_PER_WORKER * workers))))
+    mappings: dict[int, dict[str, Any]] = {}
+    tasks = []
+    for start in range(0, len(missing), size):
+        groups: list[tuple[int, dict[str, Any], tuple[int, ...]]] = []
+        for point, seed in missing[start : start + size]:
+            if groups and groups[-1][0] == point:
+                groups[-1] = (point, groups[-1][1], (*groups[-1][2], seed))
+                continue
+            if point not in mappings:
+                mappings[point] = spec.points[point].config.to_dict()
+            groups.append((point, mappings[point], (seed,)))
+        tasks.append(groups)
+    return tasks
+
+
+class _Book:
+    """The finished rows and the tables of unfinished points, saved in batches."""
+
+    def __init__(self, spec: SweepSpec, directory: Path) -> None:
+        self._spec = spec
+        self._directory = directory
+        self._header = sweepdir.result_header(spec.axes)
+        self.rows: dict[tuple[int, int], dict[str, str]] = {}
+        seeds = set(spec.seeds)
+        for row in sweepdir.read_results(directory, self._header):
+            key = self._key(row)
+            if key[0] >= len(spec.points) or key[1] not in seeds or key in self.rows:
+                raise RunError(
+                    f"{directory / sweepdir.RESULTS_FILE}: has a row (point {row['point']}, seed "
+                    f"{row['seed']}) that is not of this sweep, or twice; the sweep directory "
+                    "was changed by hand. Start a new sweep."
+                )
+            self.rows[key] = row
+        self._per_point = {point.index: 0 for point in spec.points}
+        for point, _ in self.rows:
+            self._per_point[point] += 1
+        self._tables: dict[int, dict[str, np.ndarray]] = {}
+        self._dirty: set[int] = set()
+        self._last_flush = -math.inf  # the first results are saved at once
+
+    def _key(self, row: dict[str, str]) -> tuple[int, int]:
+        try:
+            return int(row["point"]), int(row["seed"])
+        except (KeyError, ValueError):
+            raise RunError(
+                f"{self._directory / sweepdir.RESULTS_FILE}: has a damaged row ({row}); start a "
+                "new sweep."
+            ) from None
+
+    def points_done(self) -> int:
+        return sum(1 for count in self._per_point.values() if count == len(self._spec.seeds))
+
+    def add(self, finished: list[Any]) -> None:
+        spec = self._spec
+        for point, seed, cells, q_table in finished:
+            if point not in self._tables:
+                self._tables[point] = sweepdir.read_tables(self._directory, spec.point_id(point))
+            self._tables[point][spec.seed_key(seed)] = q_table
+            values = spec.points[point].values
+            self.rows[(point, seed)] = {
+                "point": spec.point_id(point),
+                **{key: axis_cell(values[key]) for key in spec.axes},
+                **cells,
+            }
+            self._per_point[point] += 1
+            self._dirty.add(point)
+        self.flush()
+
+    def flush(self, *, force: bool = False) -> None:
+        """Save the tables of the points that changed, then ``results.csv``."""
+        if not self._dirty or (not force and time.monotonic() - self._last_flush < FLUSH_SECONDS):
+            return
+        for point in sorted(self._dirty):
+            sweepdir.write_tables(self._directory, self._spec.point_id(point), self._tables[point])
+            if self._per_point[point] == len(self._spec.seeds):
+                del self._tables[point]  # complete: its file holds every seed
+        sweepdir.write_results(self._directory, self._header, self.sorted_rows())
+        self._dirty.clear()
+        self._last_flush = time.monotonic()
+
+    def sorted_rows(self) -> list[dict[str, str]]:
+        return [self.rows[key] for key in sorted(self.rows)]
+
+
+def points_header(spec: SweepSpec) -> list[str]:
+    """The ``points.csv`` header: ``point``, the axes, then the statistics."""
+    return ["point", *spec.axes, *PointStatistics.columns()]
+
+
+def point_statistics(rows: Sequence[dict[str, str]]) -> PointStatistics:
+    """The statistics of one point from its ``results.csv`` rows."""
+    means = [float(row["eval_mean"]) for row in rows if row["eval_mean"]]
+    has_rate = all(row["success"] in ("true", "false") for row in rows if row["eval_mean"])
+    stats = summarize_point(
+        means,
+        [row["success"] == "true" for row in rows if row["eval_mean"]],
+        [_number(row["solved_episode"]) for row in rows if row["eval_mean"]],
+        [_number(row["env_steps_to_solve"]) for row in rows if row["eval_mean"]],
+    )
+    if not has_rate:  # no reward threshold: there is no success to count
+        stats = dataclasses.replace(
+            stats, success_rate=None, success_rate_low=None, success_rate_high=None
+        )
+    return stats
+
+
+def _number(text: str) -> float | None:
+    return float(text) if text else None
+
+
+def summarize_sweep(
+    spec: SweepSpec, directory: Path, rows: Sequence[dict[str, str]]
+) -> list[dict[str, str]]:
+    """Write ``points.csv`` and ``sweep.png`` from the finished rows; return the point rows."""
+    by_point: dict[str, list[dict[str, str]]] = {}
+    for row in rows:
+        by_point.setdefault(row["point"], []).append(row)
+    point_rows = []
+    statistics = []
+    for point in spec.points:
+        point_id = spec.point_id(point.index)
+        stats = point_statistics(by_point.get(point_id, []))
+        statistics.append(stats)
+        point_rows.append(
+            {
+                "point": point_id,
+                **{key: axis_cell(point.values[key]) for key in spec.axes},
+                **{name: cell(value) for name, value in stats.as_row().items()},
+            }
+        )
+    sweepdir.write_points(directory, points_header(spec), point_rows)
+    sweepdir.write_figure(directory, sweep_png(spec, statistics, by_point))
+    return point_rows
+
+
+def sweep_png(
+    spec: SweepSpec,
+    statistics: Sequence[PointStatistics],
+    by_point: dict[str, list[dict[str, str]]],
+) -> bytes:
+    """Draw ``sweep.png``: the statistics against the axes, and the performance profiles."""
+    from cartpole_q.figures import SweepAxis, figure_png, sweep_figure
+
+    axes = [SweepAxis(key, [axis_cell(v) for v in values]) for key, values in spec.grid.items()]
+    if spec.zip:  # the zip group is one more axis
+        first = next(iter(spec.zip.values()))
+        axes.append(SweepAxis(" + ".join(spec.zip), [axis_cell(v) for v in first]))
+    eval_means = []
+    for point in spec.points:
+        rows = by_point.get(spec.point_id(point.index), [])
+        eval_means.append(np.array([float(row["eval_mean"]) for row in rows if row["eval_mean"]]))
+    threshold = _threshold(spec)
+    figure = sweep_figure(
+        spec.name,
+        axes,
+        [spec.point_id(point.index) for point in spec.points],
+        [stats.as_row() for stats in statistics],
+        eval_means,
+        threshold,
+    )
+    return figure_png(figure)
+
+
+def _threshold(spec: SweepSpec) -> float | None:
+    """The base config's reward threshold (for the profile's reference line)."""
+    from cartpole_q.envs.gym import inspect_env
+
+    try:
+        return inspect_env(spec.points[0].config).reward_threshold
+    except ConfigError:
+        return None

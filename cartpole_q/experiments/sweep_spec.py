@@ -1,0 +1,244 @@
+"""The sweep file: its axes over dotted config keys, its seeds, and the points they make.
+
+A sweep file (design.md, "Sweep directory") names a base config, the seeds every point
+runs, ``grid`` axes (their cartesian product, in file order, last axis fastest) and
+``zip`` axes (moving together, one more axis after the grid's). Loading it checks
+everything before any work starts: unknown keys (with the closest valid one), values
+invalid for their key (naming the point and the key), empty axes, zip axes of different
+lengths, and axes the sweep cannot vary (``seed``, ``train.seeds``).
+"""
+
+from __future__ import annotations
+
+import difflib
+import itertools
+import json
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cartpole_q.config import (
+    Config,
+    ConfigError,
+    format_seeds,
+    load_config,
+    parse_seeds,
+    read_yaml_mapping,
+)
+
+SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip")
+"""the keys a sweep file may have"""
+FORBIDDEN_AXES = ("seed", "train.seeds")
+"""config keys a sweep cannot vary: its ``seeds`` say which seeds every point runs"""
+DEFAULT_MAX_RUNS = 20_000
+"""a sweep of more runs (points x seeds) needs ``--yes`` (or a larger ``--max-runs``)"""
+_NAME = re.compile(r"[A-Za-z0-9_-]+")
+
+
+@dataclass(frozen=True)
+class Point:
+    """One point of a sweep: its id, the axis values that define it, and its config."""
+
+    index: int
+    values: dict[str, Any]
+    """axis key -> value, grid axes first (file order), then the zip axes"""
+    config: Config
+    """the point's resolved config (its ``seed`` is the base's; runs override it)"""
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A checked sweep: everything ``sweep.yaml`` holds, and the points it expands to."""
+
+    name: str
+    base: dict[str, Any]
+    """the full resolved base config, as ``Config.to_dict`` gives it (``train.seeds`` null)"""
+    seeds: tuple[int, ...]
+    grid: dict[str, list[Any]]
+    zip: dict[str, list[Any]]
+    points: tuple[Point, ...]
+
+    @property
+    def axes(self) -> list[str]:
+        """The axis keys, grid axes first, then the zip axes: one column each."""
+        return [*self.grid, *self.zip]
+
+    @property
+    def runs(self) -> int:
+        """Points times seeds."""
+        return len(self.points) * len(self.seeds)
+
+    def point_id(self, index: int) -> str:
+        """The point's directory name: its index zero-padded to at least 3 digits."""
+        return f"{index:0{max(3, len(str(len(self.points) - 1)))}d}"
+
+    def seed_key(self, seed: int) -> str:
+        """The key of a seed's table in ``q_tables.npz``, padded like ``train --seeds``."""
+        return f"seed-{seed:0{max(3, len(str(max(self.seeds))))}d}"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The resolved sweep, as ``sweep.yaml`` holds it (loading it gives this sweep back)."""
+        resolved: dict[str, Any] = {
+            "name": self.name,
+            "base": self.base,
+            "seeds": format_seeds(self.seeds),
+            "grid": self.grid,
+        }
+        if self.zip:
+            resolved["zip"] = self.zip
+        return resolved
+
+
+def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) -> SweepSpec:
+    """Read and check a sweep file (or a mapping laid out like one) and expand its points.
+
+    Args:
+        source: a sweep YAML file, or a mapping with the same keys (a ``base`` path in it
+            is then relative to the current directory).
+        label: how errors name the sweep (default: the file's path, or "sweep mapping").
+
+    Returns:
+        The checked sweep, every point's config resolved and validated.
+
+    Raises:
+        ConfigError: naming the file, the key (and the point) and what is wrong.
+    """
+    if isinstance(source, Mapping):
+        raw: Mapping[str, Any] = source
+        where = label or "sweep mapping"
+        base_dir = Path()
+        default_name = "sweep"
+    else:
+        raw = read_yaml_mapping(source)
+        where = label or str(source)
+        base_dir = source.parent
+        default_name = safe_name(source.stem)
+    for key in raw:
+        if key not in SWEEP_KEYS:
+            close = difflib.get_close_matches(str(key), SWEEP_KEYS, n=1)
+            hint = (
+                f"; did you mean {close[0]!r}?"
+                if close
+                else f"; valid keys: {', '.join(SWEEP_KEYS)}."
+            )
+            raise ConfigError(f"{where}: unknown key {key!r}{hint}")
+    name = raw.get("name", default_name)
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ConfigError(
+            f"{where}: name: must be letters, digits, '-' or '_' (it names the sweep "
+            f"directory), got {json.dumps(name, default=str)}."
+        )
+    base = load_base(raw.get("base"), where, base_dir)
+    try:
+        seeds = parse_seeds(raw.get("seeds", base.seed))
+    except ValueError as error:
+        raise ConfigError(f"{where}: seeds: {error}") from None
+    grid = _axes(raw.get("grid"), "grid", where)
+    zipped = _axes(raw.get("zip"), "zip", where)
+    lengths = {key: len(values) for key, values in zipped.items()}
+    if len(set(lengths.values())) > 1:
+        shown = ", ".join(f"{key} has {n}" for key, n in lengths.items())
+        raise ConfigError(
+            f"{where}: zip: its axes move together, so they need the same number of values "
+            f"({shown})."
+        )
+    for key in zipped:
+        if key in grid:
+            raise ConfigError(
+                f"{where}: zip.{key}: is a grid axis too; a key can be one axis only."
+            )
+    base_mapping = base.to_dict()
+    points = _expand(name, base_mapping, grid, zipped, where)
+    return SweepSpec(name, base_mapping, seeds, grid, zipped, points)
+
+
+def safe_name(stem: str) -> str:
+    """A file name's stem as a sweep or tune name: letters, digits, '-' and '_'."""
+    cleaned = re.sub(r"[^A-Za-z0-9_-]+", "-", stem).strip("-")
+    return cleaned or "sweep"
+
+
+def load_base(base: Any, where: str, base_dir: Path) -> Config:
+    """The base config: a file (relative to the sweep file), a shipped name, or a mapping."""
+    if base is None:
+        config = load_config()
+    elif isinstance(base, Mapping):
+        config = load_config(base, source=f"{where}: base")
+    elif isinstance(base, str) and base.strip():
+        path = base_dir / base
+        config = load_config(path if path.is_file() else base)
+    else:
+        raise ConfigError(
+            f"{where}: base: must be a config file (relative to the sweep file), the name of "
+            f"a shipped config, or a mapping of config keys; got {json.dumps(base, default=str)}."
+        )
+    # The sweep's own seeds say which seeds every point runs.
+    return config.for_seed(config.seed)
+
+
+def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
+    """Check one axes section: dotted keys mapped to non-empty lists of values."""
+    if axes is None:
+        return {}
+    if not isinstance(axes, Mapping):
+        raise ConfigError(
+            f"{where}: {section}: must map dotted config keys to lists of values, e.g. "
+            f"{section}: {{agent.alpha: [0.1, 0.3]}}."
+        )
+    checked: dict[str, list[Any]] = {}
+    for key, values in axes.items():
+        if not isinstance(key, str) or not key:
+            raise ConfigError(f"{where}: {section}: {key!r} is not a dotted config key.")
+        if key in FORBIDDEN_AXES or key.startswith("train.seeds."):
+            raise ConfigError(
+                f"{where}: {section}.{key}: cannot be an axis; the sweep's `seeds` say which "
+                "seeds every point runs (and each result row names its seed)."
+            )
+        if not isinstance(values, list):
+            raise ConfigError(
+                f"{where}: {section}.{key}: must be a list of the values to try, got "
+                f"{json.dumps(values, default=str)}."
+            )
+        if not values:
+            raise ConfigError(
+                f"{where}: {section}.{key}: is empty; an axis needs at least one value."
+            )
+        checked[key] = values
+    return checked
+
+
+def _expand(
+    name: str,
+    base: dict[str, Any],
+    grid: dict[str, list[Any]],
+    zipped: dict[str, list[Any]],
+    where: str,
+) -> tuple[Point, ...]:
+    """Every point: the grid's product (last axis fastest), then the zip group as one axis."""
+    grid_values = list(itertools.product(*grid.values()))
+    zip_values = list(zip(*zipped.values(), strict=True)) if zipped else [()]
+    count = len(grid_values) * len(zip_values)
+    width = max(3, len(str(count - 1)))
+    points: list[Point] = []
+    for combination in itertools.product(grid_values, zip_values):
+        values = dict(zip([*grid, *zipped], [*combination[0], *combination[1]], strict=True))
+        index = len(points)
+        overrides = {"name": f"{name}-{index:0{width}d}", **values}
+        shown = ", ".join(f"{key}={axis_cell(value)}" for key, value in values.items())
+        label = f"{where}: point {index:0{width}d}" + (f" ({shown})" if shown else "")
+        config = load_config(base, overrides, source=f"{where}: base", override_source=label)
+        points.append(Point(index, values, config))
+    return tuple(points)
+
+
+def axis_cell(value: Any) -> str:
+    """An axis value as its CSV cell: strings as they are, everything else as JSON.
+
+    >>> axis_cell(0.1), axis_cell("sarsa"), axis_cell([1, 1, 6, 12]), axis_cell(True)
+    ('0.1', 'sarsa', '[1, 1, 6, 12]', 'true')
+    """
+    if isinstance(value, str):
+        return value
+    return json.dumps(value)

@@ -1,0 +1,380 @@
+"""Tuning with Optuna: each trial a config, scored on every seed of the tune file.
+
+Trials run one after another in this process (ask, run every seed, tell), the seeds of a
+trial spread over the workers; so the same tune file and sampler seed give the same
+trials in the same order whatever ``--workers`` is. Several processes (or machines
+sharing a file system) can work on one study: each asks the storage for its next trial,
+and the trial numbers the storage hands out are never duplicated.
+
+The objective, maximised: ``success_rate`` or ``iqm_eval_return`` over the seeds, minus a
+tie-breaker of ``1e-9`` times the median env steps each seed trained to its solve (or in
+all, if it did not solve): smaller than one seed's share of the success rate for any run
+under ten million steps, so among equally good trials the faster learner wins.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import socket
+import time
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import ConfigError
+from cartpole_q.errors import RunError
+from cartpole_q.experiments.backends import execute
+from cartpole_q.experiments.statistics import iqm, summarize_point
+from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, run_task
+from cartpole_q.experiments.sweep_spec import axis_cell
+from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
+from cartpole_q.store import tunedir
+from cartpole_q.store.sweepdir import cell
+
+TIE_BREAK = 1e-9
+"""objective penalty per env step (median over seeds) to break ties between trials"""
+OWNER = "owner"
+"""the user attribute naming the process (host:pid) that runs a trial"""
+
+
+def optuna_module() -> Any:
+    """Optuna, or a clear error if the extra is not installed."""
+    try:
+        import optuna
+    except ImportError:
+        raise ConfigError(
+            "cartpole-q tune needs Optuna; install it with `pip install 'cartpole-q[tune]'` "
+            "(or `pip install optuna`)."
+        ) from None
+    optuna.logging.set_verbosity(optuna.logging.WARNING)
+    # Optuna's matplotlib plots are marked experimental; the warning says nothing to a user.
+    warnings.filterwarnings("ignore", category=optuna.exceptions.ExperimentalWarning)
+    return optuna
+
+
+def storage_for(directory: Path, url: str | None) -> Any:
+    """The study's storage: Optuna's journal file in the tune directory, or ``url``."""
+    optuna = optuna_module()
+    if url is None:
+        from optuna.storages import JournalStorage
+        from optuna.storages.journal import JournalFileBackend
+
+        return JournalStorage(JournalFileBackend(str(directory / tunedir.JOURNAL_FILE)))
+    try:
+        return optuna.storages.get_storage(url)
+    except Exception as error:  # Optuna raises many kinds for a bad URL
+        raise ConfigError(f"--storage {url}: cannot open this Optuna storage ({error}).") from None
+
+
+def sampler_for(spec: TuneSpec) -> Any:
+    """The seeded sampler the tune file asks for."""
+    optuna = optuna_module()
+    seed = spec.sampler["seed"]
+    if spec.sampler["type"] == "random":
+        return optuna.samplers.RandomSampler(seed=seed)
+    return optuna.samplers.TPESampler(seed=seed)
+
+
+def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
+    """Create the tune directory, write ``tune.yaml`` and create the study."""
+    directory = tunedir.create_tune_dir(spec.name, out)
+    tunedir.write_tune(directory, spec.to_dict(), storage_url)
+    study(spec, directory, storage_url)
+    return directory
+
+
+def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:
+    """The tune file and storage URL of a tune directory (``--resume``)."""
+    data, storage_url = tunedir.tune_file(directory)
+    return load_tune(data, label=str(directory / tunedir.TUNE_FILE)), storage_url
+
+
+def study(spec: TuneSpec, directory: Path, storage_url: str | None) -> Any:
+    """The study of this tune directory (created on first use)."""
+    optuna = optuna_module()
+    return optuna.create_study(
+        study_name=spec.name, storage=storage_for(directory, storage_url),
+        sampler=sampler_for(spec), direction="maximize", load_if_exists=True,
+    )  # fmt: skip
+
+
+@dataclass
+class TuneOutcome:
+    """How a tune call ended."""
+
+    directory: Path
+    complete: bool
+    finished_trials: int
+    best: dict[str, Any] | None
+
+
+def suggest(trial: Any, dimension: Dimension) -> Any:
+    """The trial's value for one dimension (choices are suggested by their text)."""
+    if dimension.choices:
+        texts = [axis_cell(choice) for choice in dimension.choices]
+        chosen = trial.suggest_categorical(dimension.key, texts)
+        return dimension.choices[texts.index(chosen)]
+    assert dimension.low is not None and dimension.high is not None
+    if dimension.integer:
+        step = int(dimension.step or 1)
+        return trial.suggest_int(
+            dimension.key, int(dimension.low), int(dimension.high), step=step, log=dimension.log
+        )
+    return trial.suggest_float(
+        dimension.key, dimension.low, dimension.high, log=dimension.log, step=dimension.step
+    )
+
+
+def _alive_here(owner: str) -> bool:
+    host, _, pid = owner.rpartition(":")
+    if host != socket.gethostname():
+        return True  # another machine's: it may well be running
+    try:
+        os.kill(int(pid), 0)
+    except (ValueError, ProcessLookupError):
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def fail_abandoned(the_study: Any) -> int:
+    """Mark running trials whose process (on this machine) is gone as failed; count them."""
+    optuna = optuna_module()
+    failed = 0
+    for trial in the_study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.RUNNING,)):
+        owner = trial.user_attrs.get(OWNER)
+        if owner is None or not _alive_here(owner):
+            the_study._storage.set_trial_state_values(trial._trial_id, optuna.trial.TrialState.FAIL)
+            failed += 1
+    return failed
+
+
+def counted(the_study: Any) -> list[Any]:
+    """The trials that count toward ``trials``: finished, pruned or running."""
+    optuna = optuna_module()
+    states = (
+        optuna.trial.TrialState.COMPLETE,
+        optuna.trial.TrialState.PRUNED,
+        optuna.trial.TrialState.RUNNING,
+    )
+    return list(the_study.get_trials(deepcopy=False, states=states))
+
+
+def run_tune(
+    spec: TuneSpec,
+    directory: Path,
+    storage_url: str | None,
+    *,
+    trials: int | None = None,
+    workers: int = 1,
+    backend: str = "local",
+    address: str | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    on_trial: Callable[[dict[str, Any]], None] | None = None,
+) -> TuneOutcome:
+    """Run trials until the study has ``trials`` (default: the tune file's) of them.
+
+    Raises:
+        ConfigError: Optuna is missing, or the storage cannot be opened.
+    """
+    optuna = optuna_module()
+    total = trials or spec.trials
+    the_study = study(spec, directory, storage_url)
+    fail_abandoned(the_study)
+    owner = f"{socket.gethostname()}:{os.getpid()}"
+    while not (should_stop is not None and should_stop()):
+        if len(counted(the_study)) >= total:
+            break
+        trial = the_study.ask()
+        trial.set_user_attr(OWNER, owner)
+        ahead = [t for t in counted(the_study) if t.number < trial.number]
+        if len(ahead) >= total:  # another process took the last trial meanwhile
+            the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
+            break
+        values = {dimension.key: suggest(trial, dimension) for dimension in spec.space}
+        started = time.perf_counter()
+        try:
+            rows = evaluate_trial(
+                spec, trial, values, the_study, workers, backend, address, should_stop
+            )
+        except BaseException:
+            the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
+            raise
+        if rows is None:  # pruned: it could not beat the best trial
+            the_study.tell(trial, state=optuna.trial.TrialState.PRUNED)
+            continue
+        if len(rows) < len(spec.seeds):  # stopped by a signal: not a result
+            the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
+            break
+        figures = trial_figures(spec, rows)
+        for name, value in figures.items():
+            trial.set_user_attr(name, value)
+        trial.set_user_attr("seconds", round(time.perf_counter() - started, 3))
+        the_study.tell(trial, figures["objective"])
+        if on_trial is not None:
+            on_trial({"number": trial.number, "values": values, **figures})
+    finished = [
+        t
+        for t in the_study.get_trials(deepcopy=False)
+        if t.state.is_finished() and t.state.name == "COMPLETE"
+    ]
+    complete = len(counted(the_study)) >= total and not any(
+        t.state.name == "RUNNING" for t in the_study.get_trials(deepcopy=False)
+    )
+    best = write_outputs(spec, directory, the_study) if finished else None
+    return TuneOutcome(directory, complete, len(finished), best)
+
+
+def evaluate_trial(
+    spec: TuneSpec, trial: Any, values: dict[str, Any], the_study: Any, workers: int,
+    backend: str, address: str | None, should_stop: Callable[[], bool] | None,
+) -> list[dict[str, str]] | None:  # fmt: skip
+    """Run the trial's config on every seed; None if pruned.
+
+    The first seed runs in this process (loading the compiled loop, which forked workers
+    then share); with the pruner, seeds run in rounds and the trial stops once even all
+    its remaining seeds succeeding could not beat the best trial so far.
+    """
+    config = spec.config_for(values, f"trial {trial.number}")
+    mapping = config.to_dict()
+    seeds = list(spec.seeds)
+    rows: list[dict[str, str]] = []
+
+    def collect(index: int, finished: list[Any]) -> None:
+        for _, seed, cells, _ in finished:
+            rows.append({**cells, "seed": str(seed)})
+
+    class _Here:
+        def should_stop(self) -> bool:
+            return should_stop is not None and should_stop()
+
+    collect(0, run_task(_Here(), [(trial.number, mapping, seeds[:1])]))
+    position = 1
+    round_size = max(len(seeds), 1) if not spec.pruner else max(5, 2 * workers)
+    while position < len(seeds):
+        if should_stop is not None and should_stop():
+            break
+        chunk = seeds[position : position + round_size]
+        position += len(chunk)
+        size = max(1, min(MAX_RUNS_PER_TASK, math.ceil(len(chunk) / (4 * workers))))
+        jobs = [
+            ([(trial.number, mapping, tuple(chunk[i : i + size]))],)
+            for i in range(0, len(chunk), size)
+        ]
+        execute(run_task, jobs, collect, backend=backend, workers=min(workers, len(jobs)),
+                address=address, should_stop=should_stop)  # fmt: skip
+        if spec.pruner and position < len(seeds) and _cannot_win(the_study, rows, len(seeds)):
+            return None
+    rows.sort(key=lambda row: int(row["seed"]))
+    return rows
+
+
+def _cannot_win(the_study: Any, rows: list[dict[str, str]], seeds: int) -> bool:
+    try:
+        best = the_study.best_value
+    except ValueError:
+        return False  # no finished trial yet
+    successes = sum(row["success"] == "true" for row in rows)
+    return bool((successes + seeds - len(rows)) / seeds < best)
+
+
+def trial_figures(spec: TuneSpec, rows: list[dict[str, str]]) -> dict[str, Any]:
+    """A trial's statistics over its seeds, and its objective value."""
+    means = [float(row["eval_mean"]) for row in rows]
+    stats = summarize_point(
+        means,
+        [row["success"] == "true" for row in rows],
+        [float(row["solved_episode"]) if row["solved_episode"] else None for row in rows],
+        [float(row["env_steps_to_solve"]) if row["env_steps_to_solve"] else None for row in rows],
+    )
+    steps = [float(row["env_steps_to_solve"] or row["env_steps"]) for row in rows]
+    tie_break = float(np.median(steps))
+    primary = stats.success_rate if spec.objective == "success_rate" else iqm(means)
+    figures = {name: value for name, value in stats.as_row().items() if value is not None}
+    figures["median_env_steps"] = tie_break
+    figures["objective"] = float(primary or 0.0) - TIE_BREAK * tie_break
+    return figures
+
+
+TRIAL_COLUMNS = (
+    "success_rate", "success_rate_low", "success_rate_high", "iqm_eval_return",
+    "iqm_eval_return_low", "iqm_eval_return_high", "median_solved_episode",
+    "median_env_steps_to_solve", "median_env_steps", "seconds",
+)  # fmt: skip
+
+
+def write_outputs(spec: TuneSpec, directory: Path, the_study: Any) -> dict[str, Any]:
+    """Write ``trials.csv``, ``best.yaml``, ``history.png`` and ``importance.png``.
+
+    Returns:
+        The best trial: ``number``, ``values``, ``objective`` and its figures.
+    """
+    trials = the_study.get_trials(deepcopy=False)
+    keys = [dimension.key for dimension in spec.space]
+    header = ["trial", "state", *keys, "objective", *TRIAL_COLUMNS]
+    rows = []
+    for trial in trials:
+        rows.append({
+            "trial": str(trial.number),
+            "state": trial.state.name.lower(),
+            **{key: cell(trial.params.get(key)) if not isinstance(trial.params.get(key), str) else trial.params[key] for key in keys},
+            "objective": cell(trial.value),
+            **{name: cell(trial.user_attrs.get(name)) for name in TRIAL_COLUMNS},
+        })  # fmt: skip
+    tunedir.write_trials(directory, header, rows)
+    best_trial = the_study.best_trial
+    values = {d.key: _param_value(d, best_trial.params[d.key]) for d in spec.space}
+    best_config = spec.config_for(values, f"trial {best_trial.number}")
+    tunedir.write_best(directory, best_config, best_trial.number)
+    tunedir.write_figures(directory, *_figures(the_study))
+    return {"number": best_trial.number, "values": values, "objective": best_trial.value,
+            **best_trial.user_attrs}  # fmt: skip
+
+
+def _param_value(dimension: Dimension, value: Any) -> Any:
+    if dimension.choices:
+        texts = [axis_cell(choice) for choice in dimension.choices]
+        return dimension.choices[texts.index(value)]
+    return value
+
+
+def _figures(the_study: Any) -> tuple[bytes, bytes | None]:
+    """Optuna's history and importance plots as PNG bytes (no importance below 2 trials)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from optuna.visualization import matplotlib as optuna_plots
+
+    def png(axes: Any) -> bytes:
+        figure = axes.figure
+        figure.set_size_inches(8, 4.5)
+        figure.tight_layout()
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=100)
+        plt.close(figure)
+        return buffer.getvalue()
+
+    history = png(optuna_plots.plot_optimization_history(the_study))
+    complete = [t for t in the_study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
+    if len(complete) < 2:
+        return history, None
+    try:
+        return history, png(optuna_plots.plot_param_importances(the_study))
+    except (RuntimeError, ValueError):
+        return history, None  # e.g. every trial had the same value
+
+
+def load_best(directory: Path) -> Path:
+    """The ``best.yaml`` of a finished tune directory."""
+    path = directory / tunedir.BEST_FILE
+    if not path.is_file():
+        raise RunError(f"{directory}: has no {tunedir.BEST_FILE} yet.")
+    return path

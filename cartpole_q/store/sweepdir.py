@@ -1,0 +1,201 @@
+"""The sweep directory (design.md, "Sweep directory"): its files, written atomically, and read back.
+
+``sweep.yaml`` and every ``points/<p>/config.yaml`` are written before any run starts.
+After each batch of finished runs, the touched points' ``q_tables.npz`` and then
+``results.csv`` are rewritten whole: a (point, seed) is done if and only if it has a row,
+so a sweep killed at any moment resumes without losing or duplicating a finished row.
+``points.csv`` and ``sweep.png`` are written at the end.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import zipfile
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from cartpole_q.errors import RunError
+from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
+from cartpole_q.store.rundir import create_run_dir, write_config
+
+SWEEP_FILE = "sweep.yaml"
+RESULTS_FILE = "results.csv"
+POINTS_FILE = "points.csv"
+POINTS_DIR = "points"
+TABLES_FILE = "q_tables.npz"
+FIGURE_FILE = "sweep.png"
+SWEEPS_ROOT = Path("sweeps")
+RESULT_COLUMNS = (
+    "seed",
+    "solved_episode",
+    "env_steps_to_solve",
+    "first_greedy_success_env_steps",
+    "eval_mean",
+    "success",
+    "episodes",
+    "env_steps",
+    "train_seconds",
+)
+"""the ``results.csv`` columns after ``point`` and the axes"""
+TIMING_COLUMNS = ("train_seconds",)
+"""the only columns that depend on the machine, the backend or an interruption"""
+
+
+def create_sweep_dir(name: str, out: Path | None) -> Path:
+    """Create the sweep directory: ``out`` (new or empty), else ``sweeps/<name>-<stamp>/``.
+
+    Raises:
+        RunError: ``out`` is a file or a non-empty directory, or cannot be created.
+    """
+    return create_run_dir(name, out, runs_root=SWEEPS_ROOT)
+
+
+def write_sweep(
+    directory: Path, resolved: Mapping[str, Any], configs: Sequence[tuple[str, Any]]
+) -> None:
+    """Write ``sweep.yaml`` and each point's ``config.yaml`` (``configs``: point id, Config)."""
+    header = (
+        "# Resolved sweep: `base` is the full config every point starts from.\n"
+        "# `cartpole-q sweep --resume DIR` runs whatever results.csv does not have yet.\n"
+    )
+    text = yaml.safe_dump(dict(resolved), sort_keys=False, default_flow_style=None)
+    for point_id, config in configs:
+        point_dir = directory / POINTS_DIR / point_id
+        point_dir.mkdir(parents=True, exist_ok=True)
+        write_config(point_dir, config)
+    atomic_write_text(directory / SWEEP_FILE, header + text)
+
+
+def sweep_file(directory: Path) -> Path:
+    """The ``sweep.yaml`` of a sweep directory.
+
+    Raises:
+        RunError: ``directory`` is not a sweep directory.
+    """
+    path = directory / SWEEP_FILE
+    if not path.is_file():
+        raise RunError(f"{directory}: is not a sweep directory (it has no {SWEEP_FILE}).")
+    remove_stale_temporaries(directory)
+    return path
+
+
+def result_header(axes: Sequence[str]) -> list[str]:
+    """The ``results.csv`` header: ``point``, the axes, then :data:`RESULT_COLUMNS`."""
+    return ["point", *axes, *RESULT_COLUMNS]
+
+
+def cell(value: Any) -> str:
+    """A value as a CSV cell: empty for missing, ``true``/``false``, floats round-trip.
+
+    >>> cell(None), cell(True), cell(0.1), cell(7)
+    ('', 'true', '0.1', '7')
+    """
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def csv_text(header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> str:
+    """CSV text (Unix line ends) of rows whose cells are already strings."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(header)
+    for row in rows:
+        writer.writerow([row[column] for column in header])
+    return buffer.getvalue()
+
+
+def write_results(
+    directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]
+) -> None:
+    """Rewrite ``results.csv`` whole (rows already in (point, seed) order)."""
+    atomic_write_text(directory / RESULTS_FILE, csv_text(header, rows))
+
+
+def read_results(directory: Path, header: Sequence[str]) -> list[dict[str, str]]:
+    """The rows of ``results.csv`` as cells (none if it does not exist yet).
+
+    Raises:
+        RunError: the file's header is not the sweep's.
+    """
+    path = directory / RESULTS_FILE
+    if not path.is_file():
+        return []
+    with path.open(newline="", encoding="utf-8") as file:
+        reader = csv.DictReader(file)
+        if reader.fieldnames != list(header):
+            raise RunError(
+                f"{path}: its columns are not the ones {SWEEP_FILE} gives; the sweep directory "
+                "was changed by hand. Start a new sweep."
+            )
+        return [dict(row) for row in reader]
+
+
+def tables_path(directory: Path, point_id: str) -> Path:
+    """Where a point's ``q_tables.npz`` goes."""
+    return directory / POINTS_DIR / point_id / TABLES_FILE
+
+
+def write_tables(directory: Path, point_id: str, tables: Mapping[str, np.ndarray]) -> None:
+    """Rewrite a point's ``q_tables.npz`` whole, keys in order (``seed-000``, ...)."""
+    buffer = io.BytesIO()
+    arrays: dict[str, Any] = {key: tables[key] for key in sorted(tables)}
+    np.savez(buffer, **arrays)
+    atomic_write_bytes(tables_path(directory, point_id), buffer.getvalue())
+
+
+def read_tables(directory: Path, point_id: str) -> dict[str, np.ndarray]:
+    """A point's saved tables by key (none if it has no file yet).
+
+    Raises:
+        RunError: the file is damaged.
+    """
+    path = tables_path(directory, point_id)
+    if not path.is_file():
+        return {}
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return {key: archive[key] for key in archive.files}
+    except (OSError, ValueError, zipfile.BadZipFile) as error:
+        raise RunError(
+            f"{path}: cannot be read ({error}); the sweep directory is damaged."
+        ) from None
+
+
+def write_points(directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
+    """Write ``points.csv``."""
+    atomic_write_text(directory / POINTS_FILE, csv_text(header, rows))
+
+
+def write_figure(directory: Path, png: bytes) -> None:
+    """Write ``sweep.png``."""
+    atomic_write_bytes(directory / FIGURE_FILE, png)
+
+
+def point_results(point_dir: Path) -> list[dict[str, str]] | None:
+    """The ``results.csv`` rows of a sweep point (``<sweep>/points/<p>``); None if not one.
+
+    Raises:
+        RunError: it is a sweep point without any result yet.
+    """
+    point_dir = Path(point_dir)
+    sweep = point_dir.parent.parent
+    if point_dir.parent.name != POINTS_DIR or not (sweep / SWEEP_FILE).is_file():
+        return None
+    path = sweep / RESULTS_FILE
+    rows = []
+    if path.is_file():
+        with path.open(newline="", encoding="utf-8") as file:
+            rows = [row for row in csv.DictReader(file) if row.get("point") == point_dir.name]
+    if not rows:
+        raise RunError(f"{point_dir}: this sweep point has no finished run in {path} yet.")
+    return rows

@@ -1,0 +1,84 @@
+"""The tune directory: ``tune.yaml``, Optuna's journal, and the results written at the end.
+
+``tune.yaml`` is written before the first trial and holds the resolved tune file and the
+storage URL (none: the journal file ``study.journal`` here). The journal is Optuna's own
+append-only log; it survives a kill -9 and lets several processes share one study.
+``trials.csv``, ``best.yaml``, ``history.png`` and ``importance.png`` are rewritten at
+the end of every ``tune`` call.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from cartpole_q.config import Config, ConfigError, read_yaml_mapping
+from cartpole_q.errors import RunError
+from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
+from cartpole_q.store.rundir import create_run_dir
+from cartpole_q.store.sweepdir import csv_text
+
+TUNE_FILE = "tune.yaml"
+JOURNAL_FILE = "study.journal"
+TRIALS_FILE = "trials.csv"
+BEST_FILE = "best.yaml"
+HISTORY_FILE = "history.png"
+IMPORTANCE_FILE = "importance.png"
+TUNES_ROOT = Path("tunes")
+
+
+def create_tune_dir(name: str, out: Path | None) -> Path:
+    """Create the tune directory: ``out`` (new or empty), else ``tunes/<name>-<stamp>/``."""
+    return create_run_dir(name, out, runs_root=TUNES_ROOT)
+
+
+def write_tune(directory: Path, resolved: Mapping[str, Any], storage: str | None) -> None:
+    """Write ``tune.yaml``: the resolved tune file, and where the study is stored."""
+    header = (
+        "# Resolved tune file. `cartpole-q tune --resume DIR` goes on with the study\n"
+        "# (`--trials N` raises its total); `storage: null` is the journal file here.\n"
+    )
+    data = {**resolved, "storage": storage}
+    text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None)
+    atomic_write_text(directory / TUNE_FILE, header + text)
+
+
+def tune_file(directory: Path) -> tuple[dict[str, Any], str | None]:
+    """The resolved tune file (without ``storage``) and the storage URL of a tune directory.
+
+    Raises:
+        RunError: ``directory`` is not a tune directory.
+    """
+    path = directory / TUNE_FILE
+    if not path.is_file():
+        raise RunError(f"{directory}: is not a tune directory (it has no {TUNE_FILE}).")
+    remove_stale_temporaries(directory)
+    data = read_yaml_mapping(path)
+    storage = data.pop("storage", None)
+    if storage is not None and not isinstance(storage, str):
+        raise ConfigError(f"{path}: storage: must be an Optuna storage URL or null.")
+    return data, storage
+
+
+def write_trials(directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
+    """Rewrite ``trials.csv``."""
+    atomic_write_text(directory / TRIALS_FILE, csv_text(header, rows))
+
+
+def write_best(directory: Path, config: Config, trial: int) -> None:
+    """Write ``best.yaml``: the best trial's complete config (``train --config`` takes it)."""
+    header = (
+        f"# The best trial ({trial}) of this study: a complete config.\n"
+        f"# cartpole-q train --config {directory / BEST_FILE}\n"
+    )
+    atomic_write_text(directory / BEST_FILE, header + config.to_yaml())
+
+
+def write_figures(directory: Path, history: bytes, importance: bytes | None) -> None:
+    """Write ``history.png`` and, when there is one, ``importance.png``."""
+    atomic_write_bytes(directory / HISTORY_FILE, history)
+    if importance is not None:
+        atomic_write_bytes(directory / IMPORTANCE_FILE, importance)

@@ -1,0 +1,334 @@
+"""Sweeps: the sweep file's checks, the directory contract, and results that depend on nothing.
+
+Every (point, seed) must be exactly ``train --config points/<p>/config.yaml --seed S``;
+``results.csv`` must not depend on the number of workers, the backend, or a kill -9 and
+``--resume`` (timings aside).
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.experiments import sweep as sweeping
+from cartpole_q.experiments.statistics import summarize_point
+from cartpole_q.experiments.sweep_spec import load_sweep
+from cartpole_q.store import sweepdir
+from tests.conftest import invoke, write_yaml
+
+# Short runs: 60 episodes of CartPole (few solve), so a sweep of 12 runs takes a second.
+BASE = {
+    "name": "base",
+    "train": {"episodes": 60, "eval_every": 20, "eval_episodes": 2, "stop_when_solved": True},
+    "eval": {"episodes": 3},
+}
+SWEEP = {
+    "name": "tiny",
+    "base": BASE,
+    "seeds": "0-2",
+    "grid": {"agent.alpha": [0.1, 0.5], "agent.algorithm": ["q_learning", "sarsa"]},
+}
+
+
+def _results(directory: Path) -> list[dict[str, str]]:
+    with (directory / sweepdir.RESULTS_FILE).open(newline="") as file:
+        return list(csv.DictReader(file))
+
+
+def _without_timings(rows: list[dict[str, str]]) -> list[dict[str, str]]:
+    return [{k: v for k, v in row.items() if k not in sweepdir.TIMING_COLUMNS} for row in rows]
+
+
+# -- the sweep file -----------------------------------------------------------------------
+
+
+def test_points_are_the_grid_product_last_axis_fastest_then_the_zip_group() -> None:
+    spec = load_sweep(
+        {
+            "seeds": "0-1",
+            "grid": {"agent.alpha": [0.1, 0.2], "agent.gamma": [0.9, 0.99, 1.0]},
+            "zip": {
+                "discretization.bins": [[1, 1, 2, 10], [1, 1, 6, 12]],
+                "agent.q_init": [0, 100],
+            },
+        }
+    )
+    assert spec.axes == ["agent.alpha", "agent.gamma", "discretization.bins", "agent.q_init"]
+    assert len(spec.points) == 2 * 3 * 2
+    assert [p.values["agent.gamma"] for p in spec.points[:6]] == [0.9, 0.9, 0.99, 0.99, 1.0, 1.0]
+    assert spec.points[1].values == {
+        "agent.alpha": 0.1, "agent.gamma": 0.9, "discretization.bins": [1, 1, 6, 12],
+        "agent.q_init": 100,
+    }  # fmt: skip
+    assert spec.points[7].config.agent.alpha.start == 0.2
+    assert spec.points[7].config.discretization.bins == (1, 1, 6, 12)
+    assert spec.points[7].config.name == "sweep-007"
+    assert spec.point_id(7) == "007"
+    assert spec.seed_key(1) == "seed-001"
+    assert spec.runs == 24
+
+
+def test_no_axes_is_one_point_and_seeds_default_to_the_base_seed() -> None:
+    spec = load_sweep({"base": {"seed": 5}})
+    assert len(spec.points) == 1
+    assert spec.seeds == (5,)
+
+
+def test_the_resolved_sweep_loads_back_to_the_same_points(tmp_path: Path) -> None:
+    spec = load_sweep({**SWEEP, "zip": {"agent.gamma": [0.9, 1.0], "agent.q_init": [0, 1]}})
+    path = write_yaml(tmp_path / "sweep.yaml", spec.to_dict())
+    again = load_sweep(path)
+    assert again.to_dict() == spec.to_dict()
+    assert [p.config for p in again.points] == [p.config for p in spec.points]
+    assert spec.to_dict()["seeds"] == "0-2"
+    assert spec.to_dict()["base"]["train"]["seeds"] is None
+
+
+def test_a_base_path_is_relative_to_the_sweep_file(tmp_path: Path) -> None:
+    (tmp_path / "configs").mkdir()
+    write_yaml(tmp_path / "configs" / "mine.yaml", {"agent": {"gamma": 0.95}})
+    sweep = write_yaml(tmp_path / "s.yaml", {"base": "configs/mine.yaml"})
+    assert load_sweep(sweep).points[0].config.agent.gamma == 0.95
+    shipped = write_yaml(tmp_path / "t.yaml", {"base": "blog"})
+    assert load_sweep(shipped).points[0].config.discretization.bins == (10, 10, 10, 10)
+
+
+BAD_SWEEPS = [
+    pytest.param({"gird": {}}, "unknown key 'gird'; did you mean 'grid'?", id="top-level typo"),
+    pytest.param(
+        {"grid": {"agent.alpah": [0.1]}}, "did you mean 'agent.alpha'", id="axis key typo"
+    ),
+    pytest.param(
+        {"grid": {"agent.alpha": [0.1, -1]}},
+        "s.yaml: point 001 (agent.alpha=-1): agent.alpha: must be in (0, 1]",
+        id="invalid value names point and key",
+    ),
+    pytest.param({"grid": {"agent.alpha": []}}, "grid.agent.alpha: is empty", id="empty axis"),
+    pytest.param({"grid": {"agent.alpha": 0.1}}, "must be a list", id="not a list"),
+    pytest.param(
+        {"zip": {"agent.alpha": [0.1, 0.2], "agent.gamma": [0.9]}},
+        "same number of values (agent.alpha has 2, agent.gamma has 1)",
+        id="zip lengths",
+    ),
+    pytest.param(
+        {"grid": {"agent.alpha": [0.1]}, "zip": {"agent.alpha": [0.2]}},
+        "zip.agent.alpha: is a grid axis too",
+        id="zip repeats grid",
+    ),
+    pytest.param({"grid": {"seed": [1, 2]}}, "grid.seed: cannot be an axis", id="seed axis"),
+    pytest.param(
+        {"grid": {"train.seeds": ["0-3"]}}, "grid.train.seeds: cannot be an axis", id="seeds axis"
+    ),
+    pytest.param({"seeds": "0-x"}, "seeds: must be seeds like", id="bad seeds"),
+    pytest.param({"name": "a b"}, "name: must be letters", id="bad name"),
+    pytest.param({"base": 3}, "base: must be a config file", id="bad base"),
+]
+
+
+@pytest.mark.parametrize(("data", "message"), BAD_SWEEPS)
+def test_bad_sweep_files_are_refused_naming_the_key(
+    tmp_path: Path, data: dict[str, Any], message: str
+) -> None:
+    path = write_yaml(tmp_path / "s.yaml", data)
+    with pytest.raises(ConfigError) as error:
+        load_sweep(path)
+    assert message in str(error.value)
+    assert str(path) in str(error.value)
+
+
+def test_the_command_refuses_bad_input_with_exit_2_and_writes_nothing(in_tmp: Path) -> None:
+    bad = write_yaml(in_tmp / "bad.yaml", {"grid": {"agent.alpha": [2.0]}})
+    result = invoke("sweep", bad)
+    assert result.exit_code == 2
+    assert "point 000 (agent.alpha=2.0): agent.alpha" in result.output
+    assert "Traceback" not in result.output
+    assert not (in_tmp / "sweeps").exists()
+    big = write_yaml(in_tmp / "big.yaml", {"seeds": "0-99", "grid": {"agent.alpha": [0.1, 0.2]}})
+    result = invoke("sweep", big, "--max-runs", "150")
+    assert result.exit_code == 2
+    assert "2 points x 100 seeds = 200 runs, more than --max-runs 150; pass --yes" in result.output
+    assert not (in_tmp / "sweeps").exists()
+    assert invoke("sweep").exit_code == 2
+    assert invoke("sweep", big, "--resume", in_tmp).exit_code == 2
+    result = invoke("sweep", "--resume", in_tmp)
+    assert result.exit_code == 2
+    assert "is not a sweep directory" in result.output
+
+
+# -- running a sweep ------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``SWEEP`` run by the command line in this process, one worker."""
+    base = tmp_path_factory.mktemp("sweep")
+    path = write_yaml(base / "tiny.yaml", SWEEP)
+    result = invoke("sweep", path, "--out", base / "out", "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[-1] == str(base / "out")
+    return base / "out"
+
+
+def test_the_sweep_directory_has_the_contract_files(reference: Path) -> None:
+    resolved = yaml.safe_load((reference / sweepdir.SWEEP_FILE).read_text())
+    assert resolved["seeds"] == "0-2"
+    assert load_config(resolved["base"]) == load_config(BASE).for_seed(0)
+    rows = _results(reference)
+    assert list(rows[0]) == [
+        "point", "agent.alpha", "agent.algorithm", "seed", "solved_episode",
+        "env_steps_to_solve", "first_greedy_success_env_steps", "eval_mean", "success",
+        "episodes", "env_steps", "train_seconds",
+    ]  # fmt: skip
+    assert [(row["point"], row["seed"]) for row in rows] == [
+        (f"{p:03d}", str(s)) for p in range(4) for s in range(3)
+    ]
+    assert [row["agent.algorithm"] for row in rows[:6]] == ["q_learning"] * 3 + ["sarsa"] * 3
+    for point in range(4):
+        with np.load(reference / "points" / f"{point:03d}" / "q_tables.npz") as tables:
+            assert tables.files == ["seed-000", "seed-001", "seed-002"]
+        assert (reference / "points" / f"{point:03d}" / "config.yaml").is_file()
+    assert (reference / sweepdir.FIGURE_FILE).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize(("point", "seed"), [(0, 0), (3, 2)])
+def test_each_run_is_exactly_train_with_the_point_config_and_seed(
+    reference: Path, tmp_path: Path, point: int, seed: int
+) -> None:
+    point_dir = reference / "points" / f"{point:03d}"
+    result = invoke("train", "-c", point_dir / "config.yaml", "--seed", seed, "--out",
+                    tmp_path / "run", "-q")  # fmt: skip
+    assert result.exit_code == 0, result.output
+    trained = np.load(tmp_path / "run" / "q_table.npy")
+    with np.load(point_dir / "q_tables.npz") as tables:
+        assert tables[f"seed-{seed:03d}"].tobytes() == trained.tobytes()
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    row = next(
+        r for r in _results(reference) if r["point"] == f"{point:03d}" and r["seed"] == str(seed)
+    )
+    assert float(row["eval_mean"]) == summary["eval"]["mean"]
+    assert row["solved_episode"] == (
+        "" if summary["solved_episode"] is None else str(summary["solved_episode"])
+    )
+    assert int(row["episodes"]) == summary["episodes"]
+    assert int(row["env_steps"]) == summary["env_steps"]
+    assert row["success"] == (
+        "true" if summary["eval"]["mean"] >= summary["reward_threshold"] else "false"
+    )
+    greedy = summary["first_greedy_success"]
+    assert row["first_greedy_success_env_steps"] == (
+        "" if greedy is None else str(greedy["env_steps"])
+    )
+
+
+def test_points_csv_holds_each_points_statistics(reference: Path) -> None:
+    rows = _results(reference)
+    with (reference / sweepdir.POINTS_FILE).open(newline="") as file:
+        points = list(csv.DictReader(file))
+    assert [p["point"] for p in points] == ["000", "001", "002", "003"]
+    for point in points:
+        mine = [r for r in rows if r["point"] == point["point"]]
+        expected = summarize_point(
+            [float(r["eval_mean"]) for r in mine],
+            [r["success"] == "true" for r in mine],
+            [float(r["solved_episode"]) if r["solved_episode"] else None for r in mine],
+            [float(r["env_steps_to_solve"]) if r["env_steps_to_solve"] else None for r in mine],
+        )
+        for name, value in expected.as_row().items():
+            assert point[name] == sweepdir.cell(value), name
+
+
+def test_results_do_not_depend_on_the_number_of_workers(reference: Path, tmp_path: Path) -> None:
+    spec = load_sweep(reference / sweepdir.SWEEP_FILE)
+    directory = sweeping.start_sweep(spec, tmp_path / "two")
+    outcome = sweeping.run_sweep(spec, directory, workers=2)
+    assert outcome.complete
+    assert _without_timings(_results(directory)) == _without_timings(_results(reference))
+    assert (directory / sweepdir.POINTS_FILE).read_bytes() == (
+        reference / sweepdir.POINTS_FILE
+    ).read_bytes()
+
+
+def test_a_stopped_sweep_resumes_to_the_same_results(reference: Path, tmp_path: Path) -> None:
+    spec = load_sweep(reference / sweepdir.SWEEP_FILE)
+    directory = sweeping.start_sweep(spec, tmp_path / "stopped")
+    calls = iter(range(1000))
+    outcome = sweeping.run_sweep(spec, directory, workers=1, should_stop=lambda: next(calls) >= 5)
+    assert not outcome.complete
+    assert 0 < outcome.done_runs < spec.runs
+    assert len(_results(directory)) == outcome.done_runs
+    assert not (directory / sweepdir.POINTS_FILE).exists()
+    result = invoke("sweep", "--resume", directory, "--workers", 1, "-q")
+    assert result.exit_code == 0, result.output
+    assert _without_timings(_results(directory)) == _without_timings(_results(reference))
+    for point in range(4):
+        name = Path("points") / f"{point:03d}" / "q_tables.npz"
+        with np.load(directory / name) as mine, np.load(reference / name) as theirs:
+            assert {k: mine[k].tobytes() for k in mine.files} == {
+                k: theirs[k].tobytes() for k in theirs.files
+            }
+
+
+@pytest.mark.slow
+def test_kill_9_at_any_moment_then_resume_loses_and_duplicates_nothing(
+    reference: Path, tmp_path: Path
+) -> None:
+    """A real process, killed with SIGKILL (workers included) as soon as rows appear."""
+    path = write_yaml(tmp_path / "kill.yaml", {**SWEEP, "seeds": "0-99"})
+    directory = tmp_path / "killed"
+    with (tmp_path / "err").open("wb") as err:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "cartpole_q", "sweep", str(path), "--out", str(directory),
+             "--workers", "2"],
+            stdout=subprocess.DEVNULL, stderr=err, start_new_session=True, cwd=tmp_path,
+        )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while not (directory / sweepdir.RESULTS_FILE).is_file():
+            assert process.poll() is None, (tmp_path / "err").read_text()
+            assert time.monotonic() < deadline, "no results.csv appeared"
+            time.sleep(0.02)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    done = _results(directory)
+    assert 0 < len(done) < 4 * 100
+    result = invoke("sweep", "--resume", directory, "-q")
+    assert result.exit_code == 0, result.output
+    rows = _results(directory)
+    assert [(r["point"], r["seed"]) for r in rows] == [
+        (f"{p:03d}", str(s)) for p in range(4) for s in range(100)
+    ]
+    kept = {(r["point"], r["seed"]): r for r in _without_timings(rows)}
+    for row in _without_timings(done):
+        assert kept[(row["point"], row["seed"])] == row
+    # and the same as an uninterrupted run of the first three seeds
+    first = [r for r in _without_timings(rows) if int(r["seed"]) < 3]
+    assert first == _without_timings(_results(reference))
+
+
+@pytest.mark.slow
+def test_the_ray_backend_gives_the_same_results_on_a_local_cluster(
+    reference: Path, tmp_path: Path
+) -> None:
+    ray = pytest.importorskip("ray")
+    spec = load_sweep(reference / sweepdir.SWEEP_FILE)
+    directory = sweeping.start_sweep(spec, tmp_path / "ray")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        outcome = sweeping.run_sweep(spec, directory, workers=2, backend="ray")
+    finally:
+        ray.shutdown()
+    assert outcome.complete
+    assert _without_timings(_results(directory)) == _without_timings(_results(reference))

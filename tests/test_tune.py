@@ -1,0 +1,216 @@
+"""Tuning: bad tune files, a real Optuna journal and SQLite storage, kill -9, shared studies."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.experiments.tune_spec import load_tune
+from cartpole_q.store import tunedir
+from tests.conftest import invoke, write_yaml
+
+pytest.importorskip("optuna")
+
+BASE = {
+    "name": "base",
+    "train": {"episodes": 60, "eval_every": 20, "eval_episodes": 2},
+    "eval": {"episodes": 3},
+}
+TUNE = {
+    "name": "small",
+    "base": BASE,
+    "seeds": "0-3",
+    "trials": 6,
+    "space": {
+        "agent.alpha": {"low": 0.05, "high": 1.0, "log": True},
+        "agent.q_init": {"low": 0, "high": 300},
+        "agent.algorithm": {"choices": ["q_learning", "sarsa"]},
+        "discretization.bins": {"choices": [[1, 1, 2, 10], [1, 1, 6, 12]]},
+    },
+    "sampler": {"type": "tpe", "seed": 3},
+}
+
+
+def _trials(directory: Path) -> list[dict[str, str]]:
+    with (directory / tunedir.TRIALS_FILE).open(newline="") as file:
+        return [{k: v for k, v in row.items() if k != "seconds"} for row in csv.DictReader(file)]
+
+
+BAD_TUNES = [
+    pytest.param({"spaces": {}}, "unknown key 'spaces'; did you mean 'space'?", id="typo"),
+    pytest.param({"space": {"agent.alpah": {"low": 0.1, "high": 1}}}, "did you mean 'agent.alpha'", id="key"),
+    pytest.param({"space": {"agent.alpha": {"low": 0.5, "high": 0.1}}}, "low (0.5) is above high (0.1)", id="reversed"),
+    pytest.param({"space": {"agent.alpha": {"low": 0.5, "high": 0.5}}}, "the range is empty", id="empty"),
+    pytest.param({"space": {"agent.q_init": {"low": 0, "high": 5, "log": True}}}, "a log range must stay above 0", id="log-0"),
+    pytest.param({"space": {"agent.alpha": {"low": 0.1, "high": 2.0}}}, "agent.alpha: must be in (0, 1]", id="invalid high"),
+    pytest.param({"space": {"agent.algorithm": {"choices": ["q_learning", "dqn"]}}}, "space.agent.algorithm (dqn)", id="bad choice"),
+    pytest.param({"space": {"agent.alpha": {"choices": []}}}, "choices: must be a non-empty list", id="no choices"),
+    pytest.param({"space": {"seed": {"low": 0, "high": 9}}}, "space.seed: cannot be searched", id="seed"),
+    pytest.param({"space": {}}, "space: must map dotted config keys", id="no space"),
+    pytest.param({"objective": "speed", "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "objective: must be one of", id="objective"),
+    pytest.param({"trials": 0, "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "trials: must be an integer", id="trials"),
+    pytest.param({"sampler": {"type": "cmaes"}, "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "sampler.type", id="sampler"),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("data", "message"), BAD_TUNES)
+def test_bad_tune_files_are_refused_naming_the_key(
+    tmp_path: Path, data: dict[str, Any], message: str
+) -> None:
+    path = write_yaml(tmp_path / "t.yaml", data)
+    with pytest.raises(ConfigError) as error:
+        load_tune(path)
+    assert message in str(error.value)
+    assert str(path) in str(error.value)
+    result = invoke("tune", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("tune")
+    path = write_yaml(base / "small.yaml", TUNE)
+    result = invoke("tune", path, "--out", base / "out", "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert result.output.splitlines()[-1] == str(base / "out")
+    return base / "out"
+
+
+def test_a_study_writes_its_files_and_a_best_config_train_takes(
+    reference: Path, tmp_path: Path
+) -> None:
+    rows = _trials(reference)
+    assert [row["trial"] for row in rows] == [str(n) for n in range(6)]
+    assert {row["state"] for row in rows} == {"complete"}
+    for name in (tunedir.TUNE_FILE, tunedir.JOURNAL_FILE, tunedir.BEST_FILE, tunedir.HISTORY_FILE):
+        assert (reference / name).is_file(), name
+    best = max(rows, key=lambda row: float(row["objective"]))
+    config = load_config(reference / tunedir.BEST_FILE)
+    assert config.agent.algorithm == best["agent.algorithm"]
+    assert config.agent.alpha.start == float(best["agent.alpha"])
+    assert config.train.episodes == 60
+    result = invoke(
+        "train",
+        "-c",
+        reference / tunedir.BEST_FILE,
+        "--seeds",
+        "0-3",
+        "--out",
+        tmp_path / "run",
+        "-q",
+    )
+    assert result.exit_code == 0, result.output
+    means = [float(row["eval_mean"]) for row in _seed_rows(tmp_path / "run")]
+    successes = sum(mean >= 475 for mean in means)
+    assert successes / 4 == float(best["success_rate"])
+
+
+def _seed_rows(parent: Path) -> list[dict[str, Any]]:
+    import json
+
+    return [
+        {"eval_mean": json.loads((child / "summary.json").read_text())["eval"]["mean"]}
+        for child in sorted(parent.glob("seed-*"))
+    ]
+
+
+def test_the_same_tune_file_gives_the_same_trials_whatever_the_workers(
+    reference: Path, tmp_path: Path
+) -> None:
+    path = write_yaml(tmp_path / "small.yaml", TUNE)
+    result = invoke("tune", path, "--out", tmp_path / "two", "--workers", 2, "-q")
+    assert result.exit_code == 0, result.output
+    assert _trials(tmp_path / "two") == _trials(reference)
+
+
+def test_resume_with_more_trials_raises_the_total_and_sqlite_works(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 2})
+    url = f"sqlite:///{tmp_path / 'study.db'}"
+    result = invoke("tune", path, "--out", tmp_path / "out", "--storage", url, "-q")
+    assert result.exit_code == 0, result.output
+    assert len(_trials(tmp_path / "out")) == 2
+    assert not (tmp_path / "out" / tunedir.JOURNAL_FILE).exists()
+    result = invoke("tune", "--resume", tmp_path / "out", "--trials", 4, "-q")
+    assert result.exit_code == 0, result.output
+    assert [row["trial"] for row in _trials(tmp_path / "out")] == ["0", "1", "2", "3"]
+    assert invoke("tune", "--resume", tmp_path / "out", "--storage", url).exit_code == 2
+
+
+def _start(tmp_path: Path, *args: object) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "cartpole_q", "tune", *map(str, args), "-q"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True, cwd=tmp_path,
+    )  # fmt: skip
+
+
+def _journal_trials(directory: Path) -> list[Any]:
+    import optuna
+
+    spec_data, _ = tunedir.tune_file(directory)
+    storage = optuna.storages.JournalStorage(
+        optuna.storages.journal.JournalFileBackend(str(directory / tunedir.JOURNAL_FILE))
+    )
+    return optuna.load_study(study_name=spec_data["name"], storage=storage).get_trials()
+
+
+@pytest.mark.slow
+def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "k.yaml", {**TUNE, "trials": 12, "seeds": "0-19"})
+    out = tmp_path / "out"
+    process = _start(tmp_path, path, "--out", out, "--workers", 1)
+    try:
+        deadline = time.monotonic() + 120
+        while sum(t.state.name == "COMPLETE" for t in _read_or_empty(out)) < 2:
+            assert process.poll() is None, process.stderr.read() if process.stderr else ""
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    assert len([t for t in _journal_trials(out) if t.state.name == "COMPLETE"]) < 12
+    result = invoke("tune", "--resume", out, "-q")
+    assert result.exit_code == 0, result.output
+    trials = _journal_trials(out)
+    assert sum(t.state.name == "COMPLETE" for t in trials) == 12
+    assert not [t for t in trials if t.state.name == "RUNNING"]
+
+
+def _read_or_empty(directory: Path) -> list[Any]:
+    if not (directory / tunedir.JOURNAL_FILE).is_file():
+        return []
+    try:
+        return _journal_trials(directory)
+    except Exception:  # the study is not created yet
+        return []
+
+
+@pytest.mark.slow
+def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 16, "seeds": "0-9"})
+    out = tmp_path / "out"
+    first = _start(tmp_path, path, "--out", out, "--workers", 1)
+    deadline = time.monotonic() + 120
+    while not _read_or_empty(out):
+        assert first.poll() is None
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    second = _start(tmp_path, "--resume", out, "--workers", 1)
+    for process in (first, second):
+        assert process.wait(timeout=300) == 0, process.stderr.read() if process.stderr else ""
+    trials = _journal_trials(out)
+    complete = [t for t in trials if t.state.name == "COMPLETE"]
+    assert len(complete) == 16
+    assert len({t.number for t in complete}) == 16
+    owners = {t.user_attrs["owner"] for t in complete}
+    assert len(owners) == 2, "both processes ran trials"
+    assert not [t for t in trials if t.state.name == "RUNNING"]
