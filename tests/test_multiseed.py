@@ -101,3 +101,20 @@ def test_worker_processes_give_the_same_results(seeds_run: Path, tmp_path: Path)
         name = f"seed-00{seed}"
         for file in ("q_table.npy", "metrics.csv"):
             assert (parent / name / file).read_bytes() == (seeds_run / name / file).read_bytes()
+
+
+def test_a_multi_seed_run_draws_figures_only_when_asked(seeds_run: Path, tmp_path: Path) -> None:
+    """Figures would cost more than the training: none by default, all with --seed-plots."""
+    assert not list(seeds_run.rglob("reward_curve.png"))
+    parent = tmp_path / "plotted"
+    result = invoke(
+        "train", "--seeds", "0-1", "--workers", "2", "--seed-plots", "--out", parent, "-q"
+    )
+    assert result.exit_code == 0, result.output
+    for path in (parent, parent / "seed-000", parent / "seed-001"):
+        with Image.open(path / "reward_curve.png") as image:
+            assert image.size[0] > 0
+    for name in ("q_table.npy", "metrics.csv"):
+        assert (parent / "seed-001" / name).read_bytes() == (
+            seeds_run / "seed-001" / name
+        ).read_bytes()

@@ -734,56 +734,83 @@ def sweep_command(
 ) -> None:
     """Train and evaluate every point of a sweep on every seed; the last line printed is its directory."""
     with _exit_codes():
+        import contextlib
         import os
 
-        from cartpole_q.experiments import sweep as sweeping
-        from cartpole_q.experiments.run import StopRequest
-        from cartpole_q.progress import make_sweep_progress
+        from cartpole_q.experiments.backends import ray_connection
 
-        if resume is not None:
-            if sweep_file is not None or out is not None:
-                raise UserError(
-                    "--resume finishes a sweep exactly as it was started, so it takes neither "
-                    "a SWEEP.yaml nor --out."
-                )
-            spec = sweeping.load_sweep_dir(resume)
-            directory = resume
-        else:
-            if sweep_file is None:
-                raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
-            spec = sweeping.prepare_sweep(sweep_file)
-            if spec.runs > max_runs and not yes:
-                raise UserError(
-                    f"{sweep_file}: {len(spec.points)} points x {len(spec.seeds)} seeds = "
-                    f"{spec.runs:,} runs, more than --max-runs {max_runs:,}; pass --yes to run "
-                    "them all (or raise --max-runs)."
-                )
-            directory = sweeping.start_sweep(spec, out)
         if address is not None and backend is not BackendChoice.ray:
             raise UserError("--address is for --backend ray.")
-        workers = workers or max(1, min(os.cpu_count() or 1, spec.runs))
-        progress = make_sweep_progress(quiet)
-        hint = f"finish it with `cartpole-q sweep --resume {directory}`"
-        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
-            try:
-                outcome = sweeping.run_sweep(
-                    spec, directory, workers=workers, backend=backend.value, address=address,
-                    progress=progress, should_stop=stop.is_set,
-                )  # fmt: skip
-            except KeyboardInterrupt:
-                typer.echo(f"interrupted at once: the finished runs are saved; {hint}", err=True)
-                raise typer.Exit(EXIT_INTERRUPTED) from None
-        if not quiet and outcome.complete:
-            from cartpole_q.cli.report import print_sweep_summary
+        # Connected (or failed to connect) before the sweep directory is created.
+        connection = (
+            ray_connection(workers or os.cpu_count() or 1, address)
+            if backend is BackendChoice.ray
+            else contextlib.nullcontext()
+        )
+        with connection:
+            _sweep(sweep_file, resume, out, workers, backend, address, max_runs, yes, quiet)
 
-            print_sweep_summary(outcome)
-        typer.echo(str(directory))
-        if not outcome.complete:
-            typer.echo(
-                f"interrupted: {outcome.done_runs:,} of {outcome.total_runs:,} runs done; {hint}",
-                err=True,
+
+def _sweep(
+    sweep_file: Path | None,
+    resume: Path | None,
+    out: Path | None,
+    workers: int | None,
+    backend: BackendChoice,
+    address: str | None,
+    max_runs: int,
+    yes: bool,
+    quiet: bool,
+) -> None:
+    """The sweep command, once connected to its backend (see :func:`sweep_command`)."""
+    import os
+
+    from cartpole_q.experiments import sweep as sweeping
+    from cartpole_q.experiments.run import StopRequest
+    from cartpole_q.progress import make_sweep_progress
+
+    if resume is not None:
+        if sweep_file is not None or out is not None:
+            raise UserError(
+                "--resume finishes a sweep exactly as it was started, so it takes neither "
+                "a SWEEP.yaml nor --out."
             )
-            raise typer.Exit(EXIT_INTERRUPTED)
+        spec = sweeping.load_sweep_dir(resume)
+        directory = resume
+    else:
+        if sweep_file is None:
+            raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
+        spec = sweeping.prepare_sweep(sweep_file)
+        if spec.runs > max_runs and not yes:
+            raise UserError(
+                f"{sweep_file}: {len(spec.points)} points x {len(spec.seeds)} seeds = "
+                f"{spec.runs:,} runs, more than --max-runs {max_runs:,}; pass --yes to run "
+                "them all (or raise --max-runs)."
+            )
+        directory = sweeping.start_sweep(spec, out)
+    workers = workers or max(1, min(os.cpu_count() or 1, spec.runs))
+    progress = make_sweep_progress(quiet)
+    hint = f"finish it with `cartpole-q sweep --resume {directory}`"
+    with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+        try:
+            outcome = sweeping.run_sweep(
+                spec, directory, workers=workers, backend=backend.value, address=address,
+                progress=progress, should_stop=stop.is_set,
+            )  # fmt: skip
+        except KeyboardInterrupt:
+            typer.echo(f"interrupted at once: the finished runs are saved; {hint}", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
+    if not quiet and outcome.complete:
+        from cartpole_q.cli.report import print_sweep_summary
+
+        print_sweep_summary(outcome)
+    typer.echo(str(directory))
+    if not outcome.complete:
+        typer.echo(
+            f"interrupted: {outcome.done_runs:,} of {outcome.total_runs:,} runs done; {hint}",
+            err=True,
+        )
+        raise typer.Exit(EXIT_INTERRUPTED)
 
 
 @app.command("optimum", cls=_Command)
@@ -941,7 +968,9 @@ def tune_command(
         workers = workers or max(1, min(os.cpu_count() or 1, len(spec.seeds)))
 
         def report(trial: dict[str, Any]) -> None:
-            if not quiet:
+            if not quiet and trial.get("pruned"):
+                typer.echo(f"trial {trial['number']}: pruned (it could not beat the best)")
+            elif not quiet:
                 shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
                 rate = trial.get("success_rate")
                 rate_text = "" if rate is None else f"success {rate:.2f}, "

@@ -8,7 +8,8 @@ when ``backend="ray"`` is asked for, so the base install does not need it.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 from cartpole_q.errors import ConfigError
@@ -85,6 +86,58 @@ def _call(function: Callable[..., Any], job: tuple[Any, ...]) -> Any:
     return function(_NeverStop(), *job)
 
 
+def _ray() -> Any:
+    try:
+        import ray
+    except ImportError:
+        raise ConfigError(
+            "--backend ray: Ray is not installed; install it with "
+            "`pip install 'cartpole-q[ray]'` (or `pip install ray`)."
+        ) from None
+    return ray
+
+
+def connect_ray(workers: int, address: str | None) -> bool:
+    """Connect to the Ray cluster at ``address``, or start a local one with ``workers`` CPUs.
+
+    Returns:
+        Whether this call connected (False: it was connected already).
+
+    Raises:
+        ConfigError: Ray is not installed, or no cluster answers at ``address``.
+    """
+    ray = _ray()
+    if ray.is_initialized():
+        return False
+    try:
+        if address is None:
+            ray.init(
+                num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                configure_logging=False,
+            )  # fmt: skip
+        else:
+            ray.init(address=address, log_to_driver=False, configure_logging=False)
+    except ConnectionError as error:
+        raise ConfigError(
+            f"--address {address}: cannot connect to a Ray cluster ({error}). Is `ray start "
+            "--head` running there? Ray 2.59 and later use token authentication: on the head "
+            "machine `--address auto` works; elsewhere set RAY_AUTH_MODE=token and give the "
+            "cluster's token (see the README)."
+        ) from None
+    return True
+
+
+@contextmanager
+def ray_connection(workers: int, address: str | None) -> Iterator[None]:
+    """Stay connected to Ray inside the block; disconnect (or stop the local cluster) after."""
+    connected = connect_ray(workers, address)
+    try:
+        yield
+    finally:
+        if connected:
+            _ray().shutdown()
+
+
 def _execute_ray(
     function: Callable[..., Any],
     jobs: Sequence[tuple[Any, ...]],
@@ -93,46 +146,20 @@ def _execute_ray(
     address: str | None,
     should_stop: Callable[[], bool] | None,
 ) -> bool:
-    try:
-        import ray
-    except ImportError:
-        raise ConfigError(
-            "--backend ray: Ray is not installed; install it with "
-            "`pip install 'cartpole-q[ray]'` (or `pip install ray`)."
-        ) from None
-    started_here = not ray.is_initialized()
-    if started_here:
-        try:
-            if address is None:
-                ray.init(
-                    num_cpus=workers, include_dashboard=False, log_to_driver=False,
-                    configure_logging=False,
-                )  # fmt: skip
-            else:
-                ray.init(address=address, log_to_driver=False, configure_logging=False)
-        except ConnectionError as error:
-            raise ConfigError(
-                f"--address {address}: cannot connect to a Ray cluster ({error})."
-            ) from None
-    pending: dict[Any, int] = {}
-    try:
+    ray = _ray()
+    with ray_connection(workers, address):
         remote = ray.remote(num_cpus=1, max_retries=0)(_call)
         pending = {remote.remote(function, job): index for index, job in enumerate(jobs)}
-        while pending:
-            if should_stop is not None and should_stop():
-                for ref in pending:
-                    ray.cancel(ref, force=True)
-                return False
-            ready, _ = ray.wait(
-                list(pending), num_returns=len(pending), timeout=0.1, fetch_local=True
-            )
-            for ref in ready:
-                on_result(pending.pop(ref), ray.get(ref))
-        return True
-    except BaseException:
-        for ref in pending:
-            ray.cancel(ref, force=True)
-        raise
-    finally:
-        if started_here:
-            ray.shutdown()  # stops the local cluster started here, or disconnects
+        try:
+            while pending:
+                if should_stop is not None and should_stop():
+                    return False
+                ready, _ = ray.wait(
+                    list(pending), num_returns=len(pending), timeout=0.1, fetch_local=True
+                )
+                for ref in ready:
+                    on_result(pending.pop(ref), ray.get(ref))
+            return True
+        finally:
+            for ref in pending:  # stopped, or failed: nothing more is wanted
+                ray.cancel(ref, force=True)

@@ -6,10 +6,12 @@ trials in the same order whatever ``--workers`` is. Several processes (or machin
 sharing a file system) can work on one study: each asks the storage for its next trial,
 and the trial numbers the storage hands out are never duplicated.
 
-The objective, maximised: ``success_rate`` or ``iqm_eval_return`` over the seeds, minus a
-tie-breaker of ``1e-9`` times the median env steps each seed trained to its solve (or in
-all, if it did not solve): smaller than one seed's share of the success rate for any run
-under ten million steps, so among equally good trials the faster learner wins.
+The objective, maximised: ``success_rate`` (plus a bonus below ``0.001`` that grows with the
+IQM eval return, so that among trials with the same rate, all 0 early on, the better
+learner wins and the sampler has a slope) or ``iqm_eval_return`` over the seeds, minus a
+tie-breaker of ``1e-9`` times the median env steps each seed trained to its solve (ten
+million for a seed that never solved): smaller than one seed's share of the success rate,
+so among equally good trials the faster learner wins.
 """
 
 from __future__ import annotations
@@ -37,8 +39,12 @@ from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
 from cartpole_q.store import tunedir
 from cartpole_q.store.sweepdir import cell
 
+IQM_BONUS = 1e-3
+"""with objective success_rate: the most a trial's IQM eval return adds (below one seed's share)"""
 TIE_BREAK = 1e-9
 """objective penalty per env step (median over seeds) to break ties between trials"""
+UNSOLVED_STEPS = 1e7
+"""the tie-breaker's env steps for a seed that never solved (a penalty of 0.01)"""
 OWNER = "owner"
 """the user attribute naming the process (host:pid) that runs a trial"""
 
@@ -209,11 +215,16 @@ def run_tune(
             raise
         if rows is None:  # pruned: it could not beat the best trial
             the_study.tell(trial, state=optuna.trial.TrialState.PRUNED)
+            if on_trial is not None:
+                on_trial({"number": trial.number, "values": values, "pruned": True})
             continue
         if len(rows) < len(spec.seeds):  # stopped by a signal: not a result
             the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
             break
-        figures = trial_figures(spec, rows)
+        from cartpole_q.envs.gym import inspect_env
+
+        threshold = inspect_env(spec.config_for(values)).reward_threshold
+        figures = trial_figures(spec, rows, threshold)
         for name, value in figures.items():
             trial.set_user_attr(name, value)
         trial.set_user_attr("seconds", round(time.perf_counter() - started, 3))
@@ -285,8 +296,16 @@ def _cannot_win(the_study: Any, rows: list[dict[str, str]], seeds: int) -> bool:
     return bool((successes + seeds - len(rows)) / seeds < best)
 
 
-def trial_figures(spec: TuneSpec, rows: list[dict[str, str]]) -> dict[str, Any]:
-    """A trial's statistics over its seeds, and its objective value."""
+def trial_figures(
+    spec: TuneSpec, rows: list[dict[str, str]], threshold: float | None = None
+) -> dict[str, Any]:
+    """A trial's statistics over its seeds, and its objective value.
+
+    Args:
+        spec: the tune file.
+        rows: the trial's ``results.csv``-like rows, one per seed.
+        threshold: the reward threshold (it scales the IQM bonus; 100 when None).
+    """
     means = [float(row["eval_mean"]) for row in rows]
     stats = summarize_point(
         means,
@@ -294,12 +313,20 @@ def trial_figures(spec: TuneSpec, rows: list[dict[str, str]]) -> dict[str, Any]:
         [float(row["solved_episode"]) if row["solved_episode"] else None for row in rows],
         [float(row["env_steps_to_solve"]) if row["env_steps_to_solve"] else None for row in rows],
     )
-    steps = [float(row["env_steps_to_solve"] or row["env_steps"]) for row in rows]
+    # An unsolved seed counts as UNSOLVED_STEPS, so failing fast never looks like learning fast.
+    steps = [float(row["env_steps_to_solve"] or UNSOLVED_STEPS) for row in rows]
     tie_break = float(np.median(steps))
-    primary = stats.success_rate if spec.objective == "success_rate" else iqm(means)
     figures = {name: value for name, value in stats.as_row().items() if value is not None}
     figures["median_env_steps"] = tie_break
-    figures["objective"] = float(primary or 0.0) - TIE_BREAK * tie_break
+    if spec.objective == "success_rate":
+        # Among trials with the same success rate (all at 0 early on), the higher IQM eval
+        # return wins: a bounded bonus below one seed's share, so the sampler has a slope.
+        scale = abs(threshold or 0.0) or 100.0
+        bonus = IQM_BONUS * (0.5 + math.atan(iqm(means) / scale) / math.pi)
+        primary = float(stats.success_rate or 0.0) + bonus
+    else:
+        primary = iqm(means)
+    figures["objective"] = primary - TIE_BREAK * tie_break
     return figures
 
 
