@@ -995,7 +995,7 @@ def tune_command(
         if not quiet and outcome.best is not None:
             best = outcome.best
             typer.echo(
-                f"best: trial {best['number']} of {outcome.finished_trials} finished, "
+                f"best: trial {best['number']} ({outcome.finished_trials} trials complete), "
                 f"objective {best['objective']:.6g}: "
                 + ", ".join(f"{k}={v}" for k, v in best["values"].items())
             )

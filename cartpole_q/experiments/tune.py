@@ -288,10 +288,16 @@ def evaluate_trial(
 
 
 def _cannot_win(the_study: Any, rows: list[dict[str, str]], seeds: int) -> bool:
+    """Whether even all remaining seeds succeeding would leave a lower success rate than the best's.
+
+    Equal rates are not pruned: the trial could still win on the tie-breakers.
+    """
     try:
-        best = the_study.best_value
+        best = the_study.best_trial.user_attrs.get("success_rate")
     except ValueError:
         return False  # no finished trial yet
+    if best is None:
+        return False
     successes = sum(row["success"] == "true" for row in rows)
     return bool((successes + seeds - len(rows)) / seeds < best)
 
