@@ -332,3 +332,34 @@ def test_the_ray_backend_gives_the_same_results_on_a_local_cluster(
         ray.shutdown()
     assert outcome.complete
     assert _without_timings(_results(directory)) == _without_timings(_results(reference))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("signum", "count"),
+    [
+        pytest.param(signal.SIGTERM, 1, id="SIGTERM"),
+        pytest.param(signal.SIGINT, 2, id="SIGINT-twice"),
+    ],
+)
+def test_a_signal_ends_the_sweep_with_130_and_no_process_left(
+    reference: Path, tmp_path: Path, signum: int, count: int
+) -> None:
+    from tests.test_signals import _assert_ends_cleanly, _signal, _start
+
+    path = write_yaml(tmp_path / "sig.yaml", {**SWEEP, "seeds": "0-199"})
+    directory = tmp_path / "sig"
+    process = _start(tmp_path, "sweep", path, "--out", directory, "--workers", 2, "-q")
+    deadline = time.monotonic() + 120
+    while not (directory / sweepdir.RESULTS_FILE).is_file():
+        assert process.poll() is None, (tmp_path / "stderr").read_text()
+        assert time.monotonic() < deadline, "no results.csv appeared"
+        time.sleep(0.02)
+    _signal(process, signum, count, group=True)
+    stderr = _assert_ends_cleanly(process, tmp_path)
+    assert f"cartpole-q sweep --resume {directory}" in stderr
+    result = invoke("sweep", "--resume", directory, "-q")
+    assert result.exit_code == 0, result.output
+    rows = _without_timings(_results(directory))
+    assert len(rows) == 4 * 200
+    assert [r for r in rows if int(r["seed"]) < 3] == _without_timings(_results(reference))

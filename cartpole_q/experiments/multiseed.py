@@ -245,6 +245,7 @@ def _dispatch(
     """Hand out the jobs to idle workers and collect their messages until none is busy."""
     idle = list(range(len(conns)))
     busy: dict[int, int] = {}  # worker -> job
+    arrived: list[int] = []  # finished jobs whose results on_result has not seen yet
     next_job = 0
     stopping = False
     while True:
@@ -257,6 +258,11 @@ def _dispatch(
             conns[worker].send(("job", function, jobs[next_job]))
             busy[worker] = next_job
             next_job += 1
+        # Only now, with every idle worker busy again, hand results on (saving them takes time).
+        for job in arrived:
+            if on_result is not None:
+                on_result(job, results[job])
+        arrived.clear()
         if not busy:
             return
         wait_connections([conns[worker] for worker in busy], timeout=0.1)
@@ -275,8 +281,7 @@ def _dispatch(
                     job = busy.pop(worker)
                     results[job] = payload[0]
                     idle.append(worker)
-                    if on_result is not None:
-                        on_result(job, payload[0])
+                    arrived.append(job)
                 elif kind == "error":
                     raise _worker_exception(*payload)
                 elif kind == "start":
