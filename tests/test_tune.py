@@ -214,3 +214,26 @@ def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path
     owners = {t.user_attrs["owner"] for t in complete}
     assert len(owners) == 2, "both processes ran trials"
     assert not [t for t in trials if t.state.name == "RUNNING"]
+
+
+@pytest.mark.slow
+def test_sigterm_ends_a_study_with_130_and_resume_finishes_it(tmp_path: Path) -> None:
+    from tests.test_signals import _assert_ends_cleanly, _signal
+    from tests.test_signals import _start as start_command
+
+    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 40, "seeds": "0-19"})
+    out = tmp_path / "out"
+    process = start_command(tmp_path, "tune", path, "--out", out, "--workers", 2, "-q")
+    deadline = time.monotonic() + 120
+    while sum(t.state.name == "COMPLETE" for t in _read_or_empty(out)) < 1:
+        assert process.poll() is None, (tmp_path / "stderr").read_text()
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    _signal(process, signal.SIGTERM, 1, group=True)
+    stderr = _assert_ends_cleanly(process, tmp_path)
+    assert f"cartpole-q tune --resume {out}" in stderr
+    assert (out / tunedir.TRIALS_FILE).is_file()  # the finished trials are summarised
+    result = invoke("tune", "--resume", out, "-q")
+    assert result.exit_code == 0, result.output
+    trials = _journal_trials(out)
+    assert sum(t.state.name == "COMPLETE" for t in trials) == 40
