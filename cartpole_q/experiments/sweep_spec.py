@@ -115,21 +115,8 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
         where = label or str(source)
         base_dir = source.parent
         default_name = safe_name(source.stem)
-    for key in raw:
-        if key not in SWEEP_KEYS:
-            close = difflib.get_close_matches(str(key), SWEEP_KEYS, n=1)
-            hint = (
-                f"; did you mean {close[0]!r}?"
-                if close
-                else f"; valid keys: {', '.join(SWEEP_KEYS)}."
-            )
-            raise ConfigError(f"{where}: unknown key {key!r}{hint}")
-    name = raw.get("name", default_name)
-    if not isinstance(name, str) or not _NAME.fullmatch(name):
-        raise ConfigError(
-            f"{where}: name: must be letters, digits, '-' or '_' (it names the sweep "
-            f"directory), got {json.dumps(name, default=str)}."
-        )
+    check_top_keys(raw, SWEEP_KEYS, where)
+    name = checked_name(raw, default_name, where)
     base = load_base(raw.get("base"), where, base_dir)
     try:
         seeds = parse_seeds(raw.get("seeds", base.seed))
@@ -152,6 +139,36 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points)
+
+
+def check_top_keys(raw: Mapping[str, Any], valid: tuple[str, ...], where: str) -> None:
+    """Refuse a key a sweep or tune file does not know, suggesting the closest valid one.
+
+    Raises:
+        ConfigError: naming the file and the key.
+    """
+    for key in raw:
+        if key not in valid:
+            close = difflib.get_close_matches(str(key), valid, n=1)
+            hint = (
+                f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(valid)}."
+            )
+            raise ConfigError(f"{where}: unknown key {key!r}{hint}")
+
+
+def checked_name(raw: Mapping[str, Any], default: str, where: str) -> str:
+    """The file's ``name`` (it names the directory): letters, digits, '-' and '_'.
+
+    Raises:
+        ConfigError: any other name.
+    """
+    name = raw.get("name", default)
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise ConfigError(
+            f"{where}: name: must be letters, digits, '-' or '_' (it names the directory), "
+            f"got {json.dumps(name, default=str)}."
+        )
+    return name
 
 
 def safe_name(stem: str) -> str:

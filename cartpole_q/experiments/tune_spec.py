@@ -25,7 +25,14 @@ from cartpole_q.config import (
     parse_seeds,
     read_yaml_mapping,
 )
-from cartpole_q.experiments.sweep_spec import FORBIDDEN_AXES, axis_cell, load_base, safe_name
+from cartpole_q.experiments.sweep_spec import (
+    FORBIDDEN_AXES,
+    axis_cell,
+    check_top_keys,
+    checked_name,
+    load_base,
+    safe_name,
+)
 
 TUNE_KEYS = ("name", "base", "seeds", "trials", "objective", "space", "sampler", "pruner")
 OBJECTIVES = ("success_rate", "iqm_eval_return")
@@ -105,20 +112,8 @@ def load_tune(source: Path | Mapping[str, Any], *, label: str | None = None) -> 
     else:
         raw = read_yaml_mapping(source)
         where, base_dir, default_name = label or str(source), source.parent, safe_name(source.stem)
-    for key in raw:
-        if key not in TUNE_KEYS:
-            close = difflib.get_close_matches(str(key), TUNE_KEYS, n=1)
-            hint = (
-                f"; did you mean {close[0]!r}?"
-                if close
-                else f"; valid keys: {', '.join(TUNE_KEYS)}."
-            )
-            raise ConfigError(f"{where}: unknown key {key!r}{hint}")
-    name = raw.get("name", default_name)
-    if not isinstance(name, str) or not _NAME.fullmatch(name):
-        raise ConfigError(
-            f"{where}: name: must be letters, digits, '-' or '_', got {json.dumps(name, default=str)}."
-        )
+    check_top_keys(raw, TUNE_KEYS, where)
+    name = checked_name(raw, default_name, where)
     base = load_base(raw.get("base"), where, base_dir).to_dict()
     try:
         seeds = parse_seeds(raw.get("seeds", "0-19"))
