@@ -237,3 +237,39 @@ def test_sigterm_ends_a_study_with_130_and_resume_finishes_it(tmp_path: Path) ->
     assert result.exit_code == 0, result.output
     trials = _journal_trials(out)
     assert sum(t.state.name == "COMPLETE" for t in trials) == 40
+
+
+def test_the_pruner_stops_a_trial_only_when_it_cannot_reach_the_best_rate() -> None:
+    from types import SimpleNamespace
+
+    from cartpole_q.experiments.tune import _cannot_win
+
+    study = SimpleNamespace(best_trial=SimpleNamespace(user_attrs={"success_rate": 0.5}))
+    rows = [{"success": "true"}] + [{"success": "false"}] * 5  # 6 of 10 seeds run
+    assert not _cannot_win(study, rows, 10)  # 1 + 4 more = 0.5: a tie may still win
+    assert _cannot_win(study, [{"success": "false"}] * 6, 10)  # at most 0.4
+    assert not _cannot_win(study, [{"success": "false"}] * 5, 10)  # 0.5 still possible
+
+    class NoTrialYet:
+        @property
+        def best_trial(self) -> None:
+            raise ValueError("no trial")
+
+    assert not _cannot_win(NoTrialYet(), [{"success": "false"}] * 9, 10)
+
+
+def test_a_pruned_study_lists_its_pruned_trials(tmp_path: Path) -> None:
+    data = {**TUNE, "seeds": "0-9", "trials": 8, "pruner": True,
+            "space": {"agent.alpha": {"low": 0.05, "high": 1.0, "log": True},
+                      "agent.q_init": {"low": 0, "high": 300}}}  # fmt: skip
+    path = write_yaml(tmp_path / "p.yaml", data)
+    result = invoke("tune", path, "--out", tmp_path / "out", "--workers", 1)
+    assert result.exit_code == 0, result.output
+    rows = _trials(tmp_path / "out")
+    assert len(rows) == 8
+    assert {row["state"] for row in rows} <= {"complete", "pruned"}
+    best = max(float(row["success_rate"]) for row in rows if row["state"] == "complete")
+    for row in rows:
+        if row["state"] == "pruned":
+            assert row["success_rate"] == ""  # no result: it stopped early
+    assert best > 0

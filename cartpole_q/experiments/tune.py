@@ -281,8 +281,11 @@ def evaluate_trial(
         ]
         execute(run_task, jobs, collect, backend=backend, workers=min(workers, len(jobs)),
                 address=address, should_stop=should_stop)  # fmt: skip
-        if spec.pruner and position < len(seeds) and _cannot_win(the_study, rows, len(seeds)):
-            return None
+        if spec.pruner and position < len(seeds):
+            # Reported, so that samplers can rank a pruned trial by how far it got.
+            trial.report(sum(row["success"] == "true" for row in rows) / len(seeds), len(rows))
+            if _cannot_win(the_study, rows, len(seeds)):
+                return None
     rows.sort(key=lambda row: int(row["seed"]))
     return rows
 
