@@ -273,3 +273,19 @@ def test_a_pruned_study_lists_its_pruned_trials(tmp_path: Path) -> None:
         if row["state"] == "pruned":
             assert row["success_rate"] == ""  # no result: it stopped early
     assert best > 0
+
+
+@pytest.mark.slow
+def test_trials_on_a_local_ray_cluster_are_the_same(reference: Path, tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray")
+    from cartpole_q.experiments import tune as tuning
+
+    spec = load_tune(write_yaml(tmp_path / "small.yaml", TUNE))
+    directory = tuning.start_tune(spec, tmp_path / "ray", None)
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        outcome = tuning.run_tune(spec, directory, None, workers=2, backend="ray")
+    finally:
+        ray.shutdown()
+    assert outcome.complete
+    assert _trials(directory) == _trials(reference)
