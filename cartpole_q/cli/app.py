@@ -706,7 +706,7 @@ def sweep_command(
     backend: Annotated[
         BackendChoice,
         typer.Option(
-            help="Run on local processes, or as Ray tasks (`pip install 'cartpole-q[ray]'`)."
+            help="Run on local processes, or as Ray tasks (`pip install 'cartpole-q\\[ray]'`)."
         ),
     ] = BackendChoice.local,
     address: Annotated[
