@@ -96,11 +96,19 @@ def test_the_resolved_sweep_loads_back_to_the_same_points(tmp_path: Path) -> Non
     assert spec.to_dict()["base"]["train"]["seeds"] is None
 
 
-def test_a_base_path_is_relative_to_the_sweep_file(tmp_path: Path) -> None:
+def test_a_base_path_is_relative_to_the_sweep_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     (tmp_path / "configs").mkdir()
     write_yaml(tmp_path / "configs" / "mine.yaml", {"agent": {"gamma": 0.95}})
     sweep = write_yaml(tmp_path / "s.yaml", {"base": "configs/mine.yaml"})
     assert load_sweep(sweep).points[0].config.agent.gamma == 0.95
+    # never relative to the current directory, even where that would find a file
+    (tmp_path / "sub").mkdir()
+    monkeypatch.chdir(tmp_path)
+    inner = write_yaml(tmp_path / "sub" / "s.yaml", {"base": "configs/mine.yaml"})
+    with pytest.raises(ConfigError, match=r"sub/configs/mine\.yaml is not a file"):
+        load_sweep(inner)
     shipped = write_yaml(tmp_path / "t.yaml", {"base": "blog"})
     assert load_sweep(shipped).points[0].config.discretization.bins == (10, 10, 10, 10)
 
@@ -134,6 +142,16 @@ BAD_SWEEPS = [
     pytest.param({"seeds": "0-x"}, "seeds: must be seeds like", id="bad seeds"),
     pytest.param({"name": "a b"}, "name: must be letters", id="bad name"),
     pytest.param({"base": 3}, "base: must be a config file", id="bad base"),
+    pytest.param(
+        {"grid": {"agent.alpha": [0.1]}, "zip": {"agent": [{"alpha": 0.5}]}},
+        "agent and agent.alpha: one key holds the other",
+        id="overlapping axes",
+    ),
+    pytest.param(
+        {"base": "configs/nothere.yaml"},
+        "is not a file (a base path is relative to the sweep file)",
+        id="missing base file",
+    ),
 ]
 
 
@@ -363,3 +381,30 @@ def test_a_signal_ends_the_sweep_with_130_and_no_process_left(
     rows = _without_timings(_results(directory))
     assert len(rows) == 4 * 200
     assert [r for r in rows if int(r["seed"]) < 3] == _without_timings(_results(reference))
+
+
+def test_an_interruption_while_saving_loses_nothing_saved_and_resumes(
+    reference: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C (or a failed write) during a save: no other error hides it."""
+    spec = load_sweep(reference / sweepdir.SWEEP_FILE)
+    directory = sweeping.start_sweep(spec, tmp_path / "saving")
+    real_write = sweepdir.write_results
+    calls = []
+
+    def write_then_interrupt(*args: Any, **kwargs: Any) -> None:
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        real_write(*args, **kwargs)
+
+    monkeypatch.setattr(sweepdir, "write_results", write_then_interrupt)
+    monkeypatch.setattr(sweeping, "MAX_RUNS_PER_TASK", 3)  # several saves
+    monkeypatch.setattr(sweeping, "FLUSH_SECONDS", 0.0)
+    with pytest.raises(KeyboardInterrupt):
+        sweeping.run_sweep(spec, directory, workers=1)
+    monkeypatch.setattr(sweepdir, "write_results", real_write)
+    assert 0 < len(_results(directory)) < spec.runs
+    outcome = sweeping.run_sweep(spec, directory, workers=1)
+    assert outcome.complete
+    assert _without_timings(_results(directory)) == _without_timings(_results(reference))

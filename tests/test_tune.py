@@ -59,6 +59,9 @@ BAD_TUNES = [
     pytest.param({"objective": "speed", "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "objective: must be one of", id="objective"),
     pytest.param({"trials": 0, "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "trials: must be an integer", id="trials"),
     pytest.param({"sampler": {"type": "cmaes"}, "space": {"agent.alpha": {"low": 0.1, "high": 1}}}, "sampler.type", id="sampler"),
+    pytest.param({"space": {"agent.q_init": {"low": 0, "high": 10, "int": True, "step": 0.5}}}, "needs a whole step", id="int step"),
+    pytest.param({"space": {"train.episodes": {"low": 10, "high": 30}}}, "train.episodes: must be an integer", id="float on int key"),
+    pytest.param({"space": {"agent.epsilon": {"choices": [0.1]}, "agent.epsilon.end": {"low": 0, "high": 0.1}}}, "one key holds the other", id="overlap"),
 ]  # fmt: skip
 
 
@@ -142,7 +145,11 @@ def test_resume_with_more_trials_raises_the_total_and_sqlite_works(tmp_path: Pat
     assert not (tmp_path / "out" / tunedir.JOURNAL_FILE).exists()
     result = invoke("tune", "--resume", tmp_path / "out", "--trials", 4, "-q")
     assert result.exit_code == 0, result.output
-    assert [row["trial"] for row in _trials(tmp_path / "out")] == ["0", "1", "2", "3"]
+    rows = _trials(tmp_path / "out")
+    assert [row["trial"] for row in rows] == ["0", "1", "2", "3"]
+    # the resumed process draws new values, not the first trials' again
+    drawn = [tuple(row[key] for key in TUNE["space"]) for row in rows]
+    assert len(set(drawn)) == 4
     assert invoke("tune", "--resume", tmp_path / "out", "--storage", url).exit_code == 2
 
 
@@ -258,21 +265,26 @@ def test_the_pruner_stops_a_trial_only_when_it_cannot_reach_the_best_rate() -> N
     assert not _cannot_win(NoTrialYet(), [{"success": "false"}] * 9, 10)
 
 
-def test_a_pruned_study_lists_its_pruned_trials(tmp_path: Path) -> None:
-    data = {**TUNE, "seeds": "0-9", "trials": 8, "pruner": True,
-            "space": {"agent.alpha": {"low": 0.05, "high": 1.0, "log": True},
-                      "agent.q_init": {"low": 0, "high": 300}}}  # fmt: skip
-    path = write_yaml(tmp_path / "p.yaml", data)
-    result = invoke("tune", path, "--out", tmp_path / "out", "--workers", 1)
-    assert result.exit_code == 0, result.output
-    rows = _trials(tmp_path / "out")
-    assert len(rows) == 8
-    assert {row["state"] for row in rows} <= {"complete", "pruned"}
-    best = max(float(row["success_rate"]) for row in rows if row["state"] == "complete")
-    for row in rows:
-        if row["state"] == "pruned":
-            assert row["success_rate"] == ""  # no result: it stopped early
-    assert best > 0
+def test_a_trial_that_cannot_reach_the_best_rate_is_pruned(tmp_path: Path) -> None:
+    """A good trial first (every seed succeeds), then one that learns nothing: pruned."""
+    from cartpole_q.experiments import tune as tuning
+
+    data = {"name": "prune", "seeds": "0-9", "trials": 2, "pruner": True,
+            "space": {"agent.alpha": {"choices": [0.3, 0.0001]}}}  # fmt: skip
+    spec = load_tune(write_yaml(tmp_path / "p.yaml", data))
+    directory = tuning.start_tune(spec, tmp_path / "out", None)
+    the_study = tuning.study(spec, directory, None)
+    the_study.enqueue_trial({"agent.alpha": "0.3"})
+    the_study.enqueue_trial({"agent.alpha": "0.0001"})
+    outcome = tuning.run_tune(spec, directory, None, workers=1)
+    assert outcome.complete
+    rows = _trials(directory)
+    assert [(row["state"], row["agent.alpha"]) for row in rows] == [
+        ("complete", "0.3"),
+        ("pruned", "0.0001"),
+    ]
+    assert rows[0]["success_rate"] == "1.0"
+    assert rows[1]["success_rate"] == ""
 
 
 @pytest.mark.slow

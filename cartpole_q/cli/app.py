@@ -970,7 +970,7 @@ def tune_command(
                 if tune_file is None:
                     raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
                 spec = load_tune(tune_file)
-                storage_url = storage
+                storage_url = tuning.absolute_url(storage)
                 tuning.optuna_module()
                 if storage_url is not None:
                     tuning.storage_for(Path(), storage_url)

@@ -8,6 +8,8 @@ when ``backend="ray"`` is asked for, so the base install does not need it.
 
 from __future__ import annotations
 
+import signal
+import threading
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -109,6 +111,10 @@ def connect_ray(workers: int, address: str | None) -> bool:
     ray = _ray()
     if ray.is_initialized():
         return False
+    # ray.init installs its own SIGTERM handler (sys.exit); the command's own handling of
+    # SIGINT and SIGTERM (exit 130, finished work saved) must stay in place.
+    main = threading.current_thread() is threading.main_thread()
+    handlers = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     try:
         if address is None:
             ray.init(
@@ -124,6 +130,11 @@ def connect_ray(workers: int, address: str | None) -> bool:
             "machine `--address auto` works; elsewhere set RAY_AUTH_MODE=token and give the "
             "cluster's token (see the README)."
         ) from None
+    finally:
+        if main:
+            for signum, handler in handlers.items():
+                if handler is not None:
+                    signal.signal(signum, handler)
     return True
 
 

@@ -295,9 +295,11 @@ class _Book:
             return
         for point in sorted(self._dirty):
             sweepdir.write_tables(self._directory, self._spec.point_id(point), self._tables[point])
+        sweepdir.write_results(self._directory, self._header, self.sorted_rows())
+        # Only once both are written: an interruption above leaves everything to save again.
+        for point in self._dirty:
             if self._per_point[point] == len(self._spec.seeds):
                 del self._tables[point]  # complete: its file holds every seed
-        sweepdir.write_results(self._directory, self._header, self.sorted_rows())
         self._dirty.clear()
         self._last_flush = time.monotonic()
 

@@ -136,6 +136,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
             raise ConfigError(
                 f"{where}: zip.{key}: is a grid axis too; a key can be one axis only."
             )
+    check_overlaps([*grid, *zipped], where)
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points)
@@ -171,6 +172,23 @@ def checked_name(raw: Mapping[str, Any], default: str, where: str) -> str:
     return name
 
 
+def check_overlaps(keys: list[str], where: str) -> None:
+    """Refuse two keys where one holds the other (``agent`` and ``agent.alpha``).
+
+    Both would set the inner key, and the row would name a value the run did not use.
+
+    Raises:
+        ConfigError: naming both keys.
+    """
+    for key in keys:
+        for other in keys:
+            if other != key and other.startswith(f"{key}."):
+                raise ConfigError(
+                    f"{where}: {key} and {other}: one key holds the other, so both would set "
+                    f"{other}; vary it through one of them only."
+                )
+
+
 def safe_name(stem: str) -> str:
     """A file name's stem as a sweep or tune name: letters, digits, '-' and '_'."""
     cleaned = re.sub(r"[^A-Za-z0-9_-]+", "-", stem).strip("-")
@@ -184,8 +202,17 @@ def load_base(base: Any, where: str, base_dir: Path) -> Config:
     elif isinstance(base, Mapping):
         config = load_config(base, source=f"{where}: base")
     elif isinstance(base, str) and base.strip():
-        path = base_dir / base
-        config = load_config(path if path.is_file() else base)
+        looks_like_a_path = "/" in base or base.endswith((".yaml", ".yml"))
+        if looks_like_a_path:  # relative to the sweep file, never to the current directory
+            path = base_dir / base
+            if not path.is_file():
+                raise ConfigError(
+                    f"{where}: base: {path} is not a file (a base path is relative to the "
+                    "sweep file)."
+                )
+            config = load_config(path)
+        else:
+            config = load_config(base)  # a shipped config's name
     else:
         raise ConfigError(
             f"{where}: base: must be a config file (relative to the sweep file), the name of "

@@ -16,6 +16,7 @@ so among equally good trials the faster learner wins.
 
 from __future__ import annotations
 
+import datetime
 import io
 import math
 import os
@@ -78,10 +79,28 @@ def storage_for(directory: Path, url: str | None) -> Any:
         raise ConfigError(f"--storage {url}: cannot open this Optuna storage ({error}).") from None
 
 
-def sampler_for(spec: TuneSpec) -> Any:
-    """The seeded sampler the tune file asks for."""
+def absolute_url(url: str | None) -> str | None:
+    """A storage URL that names the same database from any directory (SQLite paths made absolute).
+
+    >>> absolute_url("sqlite:////tmp/study.db"), absolute_url(None)
+    ('sqlite:////tmp/study.db', None)
+    """
+    prefix = "sqlite:///"
+    if url is None or not url.startswith(prefix) or url.startswith(prefix + "/"):
+        return url
+    return prefix + str(Path(url[len(prefix) :]).resolve())
+
+
+def sampler_for(spec: TuneSpec, trial_number: int = 0) -> Any:
+    """The sampler the tune file asks for, seeded for one trial.
+
+    The seed is derived from the tune file's seed and the trial's number, so a resumed
+    study, or a second process joining it, draws new values instead of repeating the first
+    trials' (a sampler seeded once per process would), and an uninterrupted study and a
+    resumed one draw the same.
+    """
     optuna = optuna_module()
-    seed = spec.sampler["seed"]
+    seed = int(np.random.SeedSequence([spec.sampler["seed"], trial_number]).generate_state(1)[0])
     if spec.sampler["type"] == "random":
         return optuna.samplers.RandomSampler(seed=seed)
     return optuna.samplers.TPESampler(seed=seed)
@@ -91,7 +110,7 @@ def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Pat
     """Create the tune directory, write ``tune.yaml`` and create the study."""
     directory = tunedir.create_tune_dir(spec.name, out)
     tunedir.write_tune(directory, spec.to_dict(), storage_url)
-    study(spec, directory, storage_url)
+    study(spec, directory, storage_url, create=True)
     return directory
 
 
@@ -101,13 +120,26 @@ def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:
     return load_tune(data, label=str(directory / tunedir.TUNE_FILE)), storage_url
 
 
-def study(spec: TuneSpec, directory: Path, storage_url: str | None) -> Any:
-    """The study of this tune directory (created on first use)."""
+def study(spec: TuneSpec, directory: Path, storage_url: str | None, *, create: bool = False) -> Any:
+    """The study of this tune directory (created by :func:`start_tune`, loaded after).
+
+    Raises:
+        RunError: the storage has no such study (e.g. a moved database file).
+    """
     optuna = optuna_module()
-    return optuna.create_study(
-        study_name=spec.name, storage=storage_for(directory, storage_url),
-        sampler=sampler_for(spec), direction="maximize", load_if_exists=True,
-    )  # fmt: skip
+    storage = storage_for(directory, storage_url)
+    if create:
+        return optuna.create_study(
+            study_name=spec.name, storage=storage, sampler=sampler_for(spec),
+            direction="maximize", load_if_exists=True,
+        )  # fmt: skip
+    try:
+        return optuna.load_study(study_name=spec.name, storage=storage, sampler=sampler_for(spec))
+    except KeyError:
+        where = storage_url or directory / tunedir.JOURNAL_FILE
+        raise RunError(
+            f"{directory}: its study {spec.name!r} is not in {where}; was the storage moved?"
+        ) from None
 
 
 @dataclass
@@ -154,9 +186,17 @@ def fail_abandoned(the_study: Any) -> int:
     """Mark running trials whose process (on this machine) is gone as failed; count them."""
     optuna = optuna_module()
     failed = 0
+    now = datetime.datetime.now()
     for trial in the_study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.RUNNING,)):
         owner = trial.user_attrs.get(OWNER)
-        if owner is None or not _alive_here(owner):
+        if owner is None:
+            # Its process was killed between asking for it and naming itself, or is about
+            # to name itself: only the first, a minute on, is abandoned.
+            started = trial.datetime_start
+            abandoned = started is not None and (now - started).total_seconds() > 60
+        else:
+            abandoned = not _alive_here(owner)
+        if abandoned:
             the_study._storage.set_trial_state_values(trial._trial_id, optuna.trial.TrialState.FAIL)
             failed += 1
     return failed
@@ -198,6 +238,7 @@ def run_tune(
     while not (should_stop is not None and should_stop()):
         if len(counted(the_study)) >= total:
             break
+        the_study.sampler = sampler_for(spec, len(the_study.get_trials(deepcopy=False)))
         trial = the_study.ask()
         trial.set_user_attr(OWNER, owner)
         ahead = [t for t in counted(the_study) if t.number < trial.number]

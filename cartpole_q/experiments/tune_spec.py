@@ -28,6 +28,7 @@ from cartpole_q.config import (
 from cartpole_q.experiments.sweep_spec import (
     FORBIDDEN_AXES,
     axis_cell,
+    check_overlaps,
     check_top_keys,
     checked_name,
     load_base,
@@ -53,6 +54,17 @@ class Dimension:
     step: float | None = None
     integer: bool = False
     choices: tuple[Any, ...] = ()
+
+    def probes(self) -> tuple[Any, ...]:
+        """Values a trial may take, checked against the key before any trial.
+
+        Both ends and one inside, which is not a whole number unless the range is ``int``,
+        so that a float range on an integer key is refused at once.
+        """
+        assert self.low is not None and self.high is not None
+        if self.integer:
+            return (int(self.low), int(self.high), int((self.low + self.high) // 2))
+        return (self.low, self.high, self.low + (self.high - self.low) * 0.37)
 
     def to_dict(self) -> dict[str, Any]:
         """The dimension as the tune file writes it."""
@@ -187,7 +199,7 @@ def _space(value: Any, where: str, base: dict[str, Any]) -> tuple[Dimension, ...
             tried = dimension.choices
         else:
             dimension = _range(key, spec, label)
-            tried = (dimension.low, dimension.high)
+            tried = dimension.probes()
         for candidate in tried:
             load_config(
                 base,
@@ -196,6 +208,7 @@ def _space(value: Any, where: str, base: dict[str, Any]) -> tuple[Dimension, ...
                 override_source=f"{label} ({axis_cell(candidate)})",
             )
         dimensions.append(dimension)
+    check_overlaps([dimension.key for dimension in dimensions], where)
     return tuple(dimensions)
 
 
@@ -240,6 +253,8 @@ def _range(key: str, spec: Mapping[str, Any], label: str) -> Dimension:
             raise ConfigError(f"{label}: step must be above 0, and cannot go with log.")
     if integer and (low != int(low) or high != int(high)):
         raise ConfigError(f"{label}: an int range needs whole low and high.")
+    if integer and step is not None and step != int(step):
+        raise ConfigError(f"{label}: an int range needs a whole step, got {step:g}.")
     return Dimension(key, low, high, log, step, integer)
 
 
