@@ -672,6 +672,24 @@ class BackendChoice(StrEnum):
     ray = "ray"
 
 
+@contextmanager
+def _backend_connection(
+    backend: BackendChoice, workers: int | None, address: str | None
+) -> Iterator[None]:
+    """With ``--backend ray``, stay connected to Ray (a local cluster without ``--address``)."""
+    if address is not None and backend is not BackendChoice.ray:
+        raise UserError("--address is for --backend ray.")
+    if backend is not BackendChoice.ray:
+        yield
+        return
+    import os
+
+    from cartpole_q.experiments.backends import ray_connection
+
+    with ray_connection(workers or os.cpu_count() or 1, address):
+        yield
+
+
 @app.command("sweep", cls=_Command)
 def sweep_command(
     sweep_file: Annotated[
@@ -733,22 +751,9 @@ def sweep_command(
     ] = False,
 ) -> None:
     """Train and evaluate every point of a sweep on every seed; the last line printed is its directory."""
-    with _exit_codes():
-        import contextlib
-        import os
-
-        from cartpole_q.experiments.backends import ray_connection
-
-        if address is not None and backend is not BackendChoice.ray:
-            raise UserError("--address is for --backend ray.")
-        # Connected (or failed to connect) before the sweep directory is created.
-        connection = (
-            ray_connection(workers or os.cpu_count() or 1, address)
-            if backend is BackendChoice.ray
-            else contextlib.nullcontext()
-        )
-        with connection:
-            _sweep(sweep_file, resume, out, workers, backend, address, max_runs, yes, quiet)
+    # Connected (or refused) before the sweep directory is created.
+    with _exit_codes(), _backend_connection(backend, workers, address):
+        _sweep(sweep_file, resume, out, workers, backend, address, max_runs, yes, quiet)
 
 
 def _sweep(
@@ -939,83 +944,70 @@ def tune_command(
     ] = False,
 ) -> None:
     """Search config values with Optuna, each trial scored on every seed; the last line is its directory."""
-    with _exit_codes():
-        import contextlib
+    # Connected (or refused) before the tune directory is created, and once for all trials.
+    with _exit_codes(), _backend_connection(backend, workers, address):
         import os
 
         from cartpole_q.experiments import tune as tuning
-        from cartpole_q.experiments.backends import ray_connection
         from cartpole_q.experiments.run import StopRequest
         from cartpole_q.experiments.tune_spec import load_tune
 
-        if address is not None and backend is not BackendChoice.ray:
-            raise UserError("--address is for --backend ray.")
-        # Connected (or failed to connect) before the tune directory is created, and once
-        # for all trials.
-        connection = (
-            ray_connection(workers or os.cpu_count() or 1, address)
-            if backend is BackendChoice.ray
-            else contextlib.nullcontext()
-        )
-        with connection:
-            if resume is not None:
-                if tune_file is not None or out is not None or storage is not None:
-                    raise UserError(
-                        "--resume goes on with the study as it was started, so it takes neither a "
-                        "TUNE.yaml, --out nor --storage (only --trials, to raise the total)."
-                    )
-                spec, storage_url = tuning.load_tune_dir(resume)
-                directory = resume
-            else:
-                if tune_file is None:
-                    raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
-                spec = load_tune(tune_file)
-                storage_url = tuning.absolute_url(storage)
-                tuning.optuna_module()
-                if storage_url is not None:
-                    tuning.storage_for(Path(), storage_url)
-                directory = tuning.start_tune(spec, out, storage_url)
-            workers = workers or max(1, min(os.cpu_count() or 1, len(spec.seeds)))
-
-            def report(trial: dict[str, Any]) -> None:
-                if not quiet and trial.get("pruned"):
-                    typer.echo(f"trial {trial['number']}: pruned (it could not beat the best)")
-                elif not quiet:
-                    shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
-                    rate = trial.get("success_rate")
-                    rate_text = "" if rate is None else f"success {rate:.2f}, "
-                    typer.echo(
-                        f"trial {trial['number']}: {rate_text}IQM {trial.get('iqm_eval_return', float('nan')):.1f}"
-                        f" ({shown})"
-                    )
-
-            with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
-                try:
-                    outcome = tuning.run_tune(
-                        spec, directory, storage_url, trials=trials, workers=workers,
-                        backend=backend.value, address=address, should_stop=stop.is_set,
-                        on_trial=report,
-                    )  # fmt: skip
-                except KeyboardInterrupt:
-                    typer.echo(
-                        f"interrupted at once; go on with `cartpole-q tune --resume {directory}`",
-                        err=True,
-                    )
-                    raise typer.Exit(EXIT_INTERRUPTED) from None
-            if not quiet and outcome.best is not None:
-                best = outcome.best
-                typer.echo(
-                    f"best: trial {best['number']} ({outcome.finished_trials} trials complete), "
-                    f"objective {best['objective']:.6g}: "
-                    + ", ".join(f"{k}={v}" for k, v in best["values"].items())
+        if resume is not None:
+            if tune_file is not None or out is not None or storage is not None:
+                raise UserError(
+                    "--resume goes on with the study as it was started, so it takes neither a "
+                    "TUNE.yaml, --out nor --storage (only --trials, to raise the total)."
                 )
-                typer.echo(f"trials.csv, best.yaml, history.png and importance.png in {directory}")
-            typer.echo(str(directory))
-            if stop.is_set():
+            spec, storage_url = tuning.load_tune_dir(resume)
+            directory = resume
+        else:
+            if tune_file is None:
+                raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
+            spec = load_tune(tune_file)
+            storage_url = tuning.absolute_url(storage)
+            tuning.optuna_module()
+            if storage_url is not None:
+                tuning.storage_for(Path(), storage_url)
+            directory = tuning.start_tune(spec, out, storage_url)
+        workers = workers or max(1, min(os.cpu_count() or 1, len(spec.seeds)))
+
+        def report(trial: dict[str, Any]) -> None:
+            if not quiet and trial.get("pruned"):
+                typer.echo(f"trial {trial['number']}: pruned (it could not beat the best)")
+            elif not quiet:
+                shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
+                rate = trial.get("success_rate")
+                rate_text = "" if rate is None else f"success {rate:.2f}, "
                 typer.echo(
-                    f"interrupted: go on with `cartpole-q tune --resume {directory}`", err=True
+                    f"trial {trial['number']}: {rate_text}IQM {trial.get('iqm_eval_return', float('nan')):.1f}"
+                    f" ({shown})"
                 )
-                raise typer.Exit(EXIT_INTERRUPTED)
+
+        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+            try:
+                outcome = tuning.run_tune(
+                    spec, directory, storage_url, trials=trials, workers=workers,
+                    backend=backend.value, address=address, should_stop=stop.is_set,
+                    on_trial=report,
+                )  # fmt: skip
+            except KeyboardInterrupt:
+                typer.echo(
+                    f"interrupted at once; go on with `cartpole-q tune --resume {directory}`",
+                    err=True,
+                )
+                raise typer.Exit(EXIT_INTERRUPTED) from None
+        if not quiet and outcome.best is not None:
+            best = outcome.best
+            typer.echo(
+                f"best: trial {best['number']} ({outcome.finished_trials} trials complete), "
+                f"objective {best['objective']:.6g}: "
+                + ", ".join(f"{k}={v}" for k, v in best["values"].items())
+            )
+            typer.echo(f"trials.csv, best.yaml, history.png and importance.png in {directory}")
+        typer.echo(str(directory))
+        if stop.is_set():
+            typer.echo(f"interrupted: go on with `cartpole-q tune --resume {directory}`", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def main() -> None:
