@@ -18,6 +18,7 @@ Arrays are read with ``allow_pickle=False`` only.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import functools
 import io
@@ -112,7 +113,12 @@ def write_config(run_dir: Path, config: Config) -> None:
         "# `cartpole-q train --resume` continues the run only while nothing here changes\n"
         "# but train.episodes (which may grow, to extend the run).\n"
     )
-    atomic_write_text(run_dir / CONFIG_FILE, header + config.to_yaml())
+    text = header + config.to_yaml()
+    path = run_dir / CONFIG_FILE
+    with contextlib.suppress(OSError, UnicodeDecodeError):
+        if path.read_text(encoding="utf-8") == text:
+            return  # already written (a new run's directory gets it before training)
+    atomic_write_text(path, text)
 
 
 # -- writing a finished (or interrupted) run ------------------------------------------
