@@ -70,7 +70,7 @@ def test_plain_reporter_names_its_rate() -> None:
 def test_a_workers_last_progress_reaches_the_parent_before_its_outcome() -> None:
     import multiprocessing
 
-    from cartpole_q.experiments.multiseed import _PipeReporter
+    from cartpole_q.experiments.workers import _PipeReporter
 
     receiver, sender = multiprocessing.Pipe(duplex=False)
     reporter = _PipeReporter(sender, min_interval=3600.0)

@@ -408,3 +408,179 @@ def test_an_interruption_while_saving_loses_nothing_saved_and_resumes(
     outcome = sweeping.run_sweep(spec, directory, workers=1)
     assert outcome.complete
     assert _without_timings(_results(directory)) == _without_timings(_results(reference))
+
+
+# -- resume: a study never mixes results ------------------------------------------------------
+
+
+def _stopped_sweep(tmp_path: Path, data: dict[str, Any], after: int = 5) -> Path:
+    """A sweep started by the command's code and stopped after ``after`` runs."""
+    path = write_yaml(tmp_path / "s.yaml", data)
+    spec = load_sweep(path)
+    directory = sweeping.start_sweep(spec, tmp_path / "stopped")
+    calls = iter(range(10_000))
+    outcome = sweeping.run_sweep(
+        spec, directory, workers=1, should_stop=lambda: next(calls) >= after
+    )
+    assert 0 < outcome.done_runs < spec.runs
+    return directory
+
+
+def _edit_sweep_yaml(directory: Path, edit: Any) -> None:
+    path = directory / sweepdir.SWEEP_FILE
+    data = yaml.safe_load(path.read_text())
+    edit(data)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
+EDITS = [
+    pytest.param(
+        lambda d: d["grid"].update({"agent.alpha": [0.1, 0.9]}),
+        "agent.alpha: point 002 started with 0.5, sweep.yaml now gives 0.9",
+        id="an axis value",
+    ),
+    pytest.param(
+        lambda d: d["base"]["train"].update({"episodes": 61}),
+        "train.episodes: point 000 started with 60, sweep.yaml now gives 61",
+        id="a base key",
+    ),
+    pytest.param(
+        lambda d: d["grid"].update({"agent.alpha": [0.1, 0.5, 0.9]}),
+        "the sweep started with 4 points, sweep.yaml now gives 6",
+        id="one more axis value",
+    ),
+    pytest.param(
+        lambda d: d.update({"seeds": "1-2"}),
+        "seeds: it now gives 1-2, but",
+        id="a finished seed taken away",
+    ),
+    pytest.param(
+        lambda d: d.update({"name": "other"}),
+        'name: point 000 started with "tiny-000", sweep.yaml now gives "other-000"',
+        id="the name",
+    ),
+]
+
+
+@pytest.mark.parametrize(("edit", "message"), EDITS)
+def test_resume_refuses_a_sweep_yaml_edited_since_the_start(
+    tmp_path: Path, edit: Any, message: str
+) -> None:
+    directory = _stopped_sweep(tmp_path, SWEEP)
+    before = _results(directory)
+    _edit_sweep_yaml(directory, edit)
+    result = invoke("sweep", "--resume", directory, "--workers", 1, "-q")
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert "Traceback" not in result.output
+    assert _results(directory) == before  # nothing run, nothing rewritten
+    assert not (directory / sweepdir.POINTS_FILE).exists()
+
+
+def test_resume_may_add_seeds_and_then_equals_a_sweep_of_them_all(
+    reference: Path, tmp_path: Path
+) -> None:
+    directory = _stopped_sweep(tmp_path, {**SWEEP, "seeds": "0-1"}, after=2)
+    _edit_sweep_yaml(directory, lambda d: d.update({"seeds": "0-2"}))
+    result = invoke("sweep", "--resume", directory, "--workers", 1, "-q")
+    assert result.exit_code == 0, result.output
+    assert _without_timings(_results(directory)) == _without_timings(_results(reference))
+
+
+# -- one writer at a time, and what a kill or a signal leaves ------------------------------------
+
+# Slow runs: the gymnasium engine, 100 episodes each (about a tenth of a second per run).
+SLOW = {
+    "name": "slow",
+    "base": {
+        **BASE,
+        "engine": "gymnasium",
+        "train": {**BASE["train"], "episodes": 100, "stop_when_solved": False, "eval_every": 0},
+    },
+    "seeds": "0-199",
+}
+
+
+def _start_sweep(tmp_path: Path, *args: object) -> subprocess.Popen[bytes]:
+    from tests.test_signals import _start
+
+    return _start(tmp_path, "sweep", *args)
+
+
+def _wait_for(path: Path, process: subprocess.Popen[bytes], tmp_path: Path) -> None:
+    deadline = time.monotonic() + 120
+    while not path.is_file():
+        assert process.poll() is None, (tmp_path / "stderr").read_text()
+        assert time.monotonic() < deadline, f"{path} never appeared"
+        time.sleep(0.01)
+
+
+@pytest.mark.slow
+def test_a_second_writer_is_refused_naming_the_holders_pid(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "slow.yaml", {**SLOW, "seeds": "0-11"})
+    directory = tmp_path / "locked"
+    process = _start_sweep(tmp_path, path, "--out", directory, "--workers", 1, "-q")
+    try:
+        _wait_for(directory / sweepdir.RESULTS_FILE, process, tmp_path)
+        result = invoke("sweep", "--resume", directory, "--workers", 1, "-q")
+        assert result.exit_code == 2, result.output
+        assert f"another cartpole-q process (pid {process.pid}) is writing this sweep" in (
+            result.output
+        )
+        assert process.poll() is None  # the holder goes on undisturbed
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    # kill -9 released the lock: the sweep resumes
+    result = invoke("sweep", "--resume", directory, "--workers", 2, "-q")
+    assert result.exit_code == 0, result.output
+    assert len(_results(directory)) == 12
+
+
+@pytest.mark.slow
+def test_every_finished_run_is_saved_at_once_whatever_the_task_size(tmp_path: Path) -> None:
+    """Tasks of 25 runs: the first results.csv holds the first runs, not whole tasks."""
+    fast = {**SLOW, "base": {**SLOW["base"], "engine": "numba"}}
+    path = write_yaml(tmp_path / "fast.yaml", fast)
+    directory = tmp_path / "streamed"
+    spec = load_sweep(path)
+    tasks = sweeping.plan_tasks(spec, [(0, seed) for seed in spec.seeds], workers=2)
+    assert len(tasks[0][0][2]) == 25  # runs per task
+    process = _start_sweep(tmp_path, path, "--out", directory, "--workers", 2, "-q")
+    try:
+        _wait_for(directory / sweepdir.RESULTS_FILE, process, tmp_path)
+        first = len(_results(directory))
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+    assert 1 <= first < 25, "runs reach results.csv one by one, not a task at a time"
+    saved = _results(directory)
+    result = invoke("sweep", "--resume", directory, "--workers", 2, "-q")
+    assert result.exit_code == 0, result.output
+    rows = {(r["point"], r["seed"]): r for r in _without_timings(_results(directory))}
+    assert len(rows) == 200
+    for row in _without_timings(saved):
+        assert rows[(row["point"], row["seed"])] == row
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("early", [True, False], ids=["before-any-run", "after-some-runs"])
+def test_a_second_sigint_says_exactly_what_is_saved(tmp_path: Path, early: bool) -> None:
+    from tests.test_signals import _assert_ends_cleanly, _signal
+
+    path = write_yaml(tmp_path / "slow.yaml", SLOW)
+    directory = tmp_path / "sig"
+    process = _start_sweep(tmp_path, path, "--out", directory, "--workers", 2, "-q")
+    _wait_for(directory / (sweepdir.SWEEP_FILE if early else sweepdir.RESULTS_FILE), process,
+              tmp_path)  # fmt: skip
+    _signal(process, signal.SIGINT, 2, group=True)
+    stderr = _assert_ends_cleanly(process, tmp_path)
+    results = directory / sweepdir.RESULTS_FILE
+    # Stopped at once, or (when the first signal ended it before the second came) politely:
+    # either way the message says exactly what results.csv holds.
+    saved = len(_results(directory)) if results.is_file() else 0
+    if saved:
+        assert f": {saved} of 200 runs are saved in {results}" in stderr
+    else:
+        assert f": no run had finished, so nothing is saved in {results} yet" in stderr
+    assert f"cartpole-q sweep --resume {directory}" in stderr

@@ -314,7 +314,8 @@ def _train_into(
                 )  # fmt: skip
                 summary = outcome.summary
             else:
-                from cartpole_q.experiments.multiseed import default_workers, run_seeds
+                from cartpole_q.experiments.multiseed import run_seeds
+                from cartpole_q.experiments.workers import default_workers
 
                 summary = run_seeds(
                     prepared, run_dir, workers=workers or default_workers(len(seeds)),
@@ -684,7 +685,7 @@ def _backend_connection(
         return
     import os
 
-    from cartpole_q.experiments.backends import ray_connection
+    from cartpole_q.experiments.workers import ray_connection
 
     with ray_connection(workers or os.cpu_count() or 1, address):
         yield
@@ -768,11 +769,10 @@ def _sweep(
     quiet: bool,
 ) -> None:
     """The sweep command, once connected to its backend (see :func:`sweep_command`)."""
-    import os
-
     from cartpole_q.experiments import sweep as sweeping
-    from cartpole_q.experiments.run import StopRequest
-    from cartpole_q.progress import make_sweep_progress
+    from cartpole_q.experiments.sweep import saved_text
+    from cartpole_q.store import sweepdir
+    from cartpole_q.store.lock import directory_lock
 
     if resume is not None:
         if sweep_file is not None or out is not None:
@@ -780,8 +780,10 @@ def _sweep(
                 "--resume finishes a sweep exactly as it was started, so it takes neither "
                 "a SWEEP.yaml nor --out."
             )
-        spec = sweeping.load_sweep_dir(resume)
-        directory = resume
+        sweepdir.sweep_file(resume)  # a sweep directory, before a lock file goes into it
+        with directory_lock(resume, "sweep"):
+            spec = sweeping.load_sweep_dir(resume)
+            outcome = _run_sweep(spec, resume, workers, backend, address, quiet)
     else:
         if sweep_file is None:
             raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
@@ -793,29 +795,49 @@ def _sweep(
                 "them all (or raise --max-runs)."
             )
         directory = sweeping.start_sweep(spec, out)
-    workers = workers or max(1, min(os.cpu_count() or 1, spec.runs))
-    progress = make_sweep_progress(quiet)
-    hint = f"finish it with `cartpole-q sweep --resume {directory}`"
-    with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
-        try:
-            outcome = sweeping.run_sweep(
-                spec, directory, workers=workers, backend=backend.value, address=address,
-                progress=progress, should_stop=stop.is_set,
-            )  # fmt: skip
-        except KeyboardInterrupt:
-            typer.echo(f"interrupted at once: the finished runs are saved; {hint}", err=True)
-            raise typer.Exit(EXIT_INTERRUPTED) from None
+        with directory_lock(directory, "sweep"):
+            outcome = _run_sweep(spec, directory, workers, backend, address, quiet)
     if not quiet and outcome.complete:
         from cartpole_q.cli.report import print_sweep_summary
 
         print_sweep_summary(outcome)
-    typer.echo(str(directory))
+    typer.echo(str(outcome.directory))
     if not outcome.complete:
+        saved = saved_text(outcome.directory, outcome.done_runs, outcome.total_runs)
         typer.echo(
-            f"interrupted: {outcome.done_runs:,} of {outcome.total_runs:,} runs done; {hint}",
+            f"interrupted: {saved}; finish it with `cartpole-q sweep --resume "
+            f"{outcome.directory}`",
             err=True,
         )
         raise typer.Exit(EXIT_INTERRUPTED)
+
+
+def _run_sweep(
+    spec: Any,
+    directory: Path,
+    workers: int | None,
+    backend: BackendChoice,
+    address: str | None,
+    quiet: bool,
+) -> Any:
+    """Run a (locked) sweep directory until done or stopped; exit 130 on a second signal."""
+    from cartpole_q.experiments import sweep as sweeping
+    from cartpole_q.experiments.run import StopRequest
+    from cartpole_q.experiments.workers import default_workers
+    from cartpole_q.progress import make_sweep_progress
+
+    progress = make_sweep_progress(quiet)
+    hint = f"finish it with `cartpole-q sweep --resume {directory}`"
+    with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+        try:
+            return sweeping.run_sweep(
+                spec, directory, workers=workers or default_workers(spec.runs),
+                backend=backend.value, address=address, progress=progress,
+                should_stop=stop.is_set,
+            )  # fmt: skip
+        except sweeping.SweepInterrupted as interrupted:
+            typer.echo(f"interrupted at once: {interrupted.text}; {hint}", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
 
 
 @app.command("optimum", cls=_Command)

@@ -21,6 +21,7 @@ from cartpole_q.config.loading import (
     read_yaml_mapping,
     resolve_config_path,
     shipped_configs,
+    shown_value,
 )
 from cartpole_q.config.schema import (
     ALGORITHMS,
@@ -74,4 +75,5 @@ __all__ = [
     "read_yaml_mapping",
     "resolve_config_path",
     "shipped_configs",
+    "shown_value",
 ]

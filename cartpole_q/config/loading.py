@@ -20,6 +20,7 @@ import copy
 import dataclasses
 import difflib
 import functools
+import json
 import math
 import os
 import re
@@ -761,6 +762,17 @@ def config_differences(old: Config, new: Config) -> list[tuple[str, Any, Any]]:
 
 NOT_SET = "(not set)"
 """stands for a key that one of two compared configs does not have"""
+
+
+def shown_value(value: Any) -> str:
+    """A config value as a message shows it: 0.995, [1, 1, 2, 10], "CartPole-v1", null.
+
+    >>> shown_value([1, 2]), shown_value("sarsa"), shown_value(None), shown_value(NOT_SET)
+    ('[1, 2]', '"sarsa"', 'null', '(not set)')
+    """
+    if value is NOT_SET:
+        return str(value)
+    return json.dumps(value, default=str)
 
 
 def _differences(old: Any, new: Any, prefix: str) -> list[tuple[str, Any, Any]]:

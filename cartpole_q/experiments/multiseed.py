@@ -9,43 +9,34 @@ one per core; a seed's results do not depend on which worker ran it, or when.
 from __future__ import annotations
 
 import dataclasses
-import math
-import multiprocessing
 import os
-import pickle
-import signal
-import sys
-import threading
 import time
-import traceback
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager, suppress
-from multiprocessing.connection import Connection
-from multiprocessing.connection import wait as wait_connections
-from multiprocessing.process import BaseProcess
+from contextlib import suppress
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from cartpole_q.config import format_seeds, load_config
-from cartpole_q.errors import RunError, UserError
+from cartpole_q.errors import RunError
 from cartpole_q.experiments.run import Prepared, execute_run, prepare
+from cartpole_q.experiments.workers import (
+    JobHandle,
+    chunk_size,
+    default_workers,
+    execute,
+    map_jobs,
+)
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import write_json
-from cartpole_q.training import Progress
 
 
 def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
     """The subdirectory of one seed: ``seed-007`` when the largest seed has up to 3 digits."""
     width = max(3, len(str(max(seeds))))
     return parent / f"seed-{seed:0{width}d}"
-
-
-def default_workers(n_seeds: int) -> int:
-    """One worker per core, never more than there are seeds."""
-    return max(1, min(os.cpu_count() or 1, n_seeds))
 
 
 def run_seeds(
@@ -94,31 +85,22 @@ def run_seeds(
             rundir.write_config(child, config.for_seed(seed))
         jobs.append((seed, child, child_resume))
 
-    interrupted = False
-    if workers <= 1:
-        for seed, child, child_resume in jobs:
-            if should_stop is not None and should_stop():
-                interrupted = True
-                break
-            outcome = execute_run(
-                child, prepare(config.for_seed(seed), str(child / rundir.CONFIG_FILE)),
-                resume=child_resume, should_stop=should_stop, reporter=reporter,
-                key="run", label=f"seed {seed}", plot=seed_plots,
-            )  # fmt: skip
-            interrupted = interrupted or outcome.result.interrupted
-    else:
-        # Several seeds per job: a worker loads the config and the compiled loop once per
-        # job, not once per seed; four jobs per worker keep the workers busy to the end.
-        size = max(1, math.ceil(len(jobs) / (4 * workers)))
-        items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
-        chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
-        results = run_in_workers(
-            _train_seeds, chunks, workers, reporter=reporter, should_stop=should_stop
-        )
-        interrupted = any(
-            result is NOT_STARTED or len(result) < len(chunk[0]) or any(result)
-            for result, chunk in zip(results, chunks, strict=True)
-        )
+    finished: list[int] = []
+
+    def on_item(index: int, item: tuple[int, bool]) -> None:
+        seed, interrupted = item
+        if not interrupted:
+            finished.append(seed)
+
+    # Several seeds per job: a worker loads the config and the compiled loop once per
+    # job, not once per seed.
+    items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
+    size = chunk_size(len(items), workers)
+    chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
+    execute(
+        _train_seeds, chunks, on_item, workers=workers, should_stop=should_stop, reporter=reporter
+    )
+    interrupted = len(finished) < len(jobs)
 
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
     if seed_plots:
@@ -135,357 +117,22 @@ def _plot_seeds(parent: Path) -> None:
         plot_rewards([parent], parent / rundir.CURVE_FILE, force=True)
 
 
-# -- worker processes: one helper for training and evaluating seeds ---------------------
-#
-# Workers ignore SIGINT and SIGTERM from their first instruction on (the parent blocks both
-# while it spawns them, the child inherits the mask, sets them to SIG_IGN and only then
-# unblocks them), so a signal to the whole process group reaches the parent alone, and the
-# parent decides. Each worker talks to the parent through its own pipe: no queue, no feeder
-# thread, no lock, nothing an exit handler could wait on. A worker whose parent dies is
-# killed by the kernel on Linux (PR_SET_PDEATHSIG); elsewhere it stops when its pipe closes.
-
-NOT_STARTED: Any = object()
-"""The result of a job that never started because a stop was requested first."""
-
-_STOP = "stop"
-_JOIN_SECONDS = 5.0
-
-
-class WorkerError(RuntimeError):
-    """A worker process failed in a way that cannot be passed on as its own exception."""
-
-
-def run_in_workers(
-    function: Callable[..., Any],
-    jobs: Sequence[tuple[Any, ...]],
-    workers: int,
-    *,
-    reporter: Reporter | None = None,
-    should_stop: Callable[[], bool] | None = None,
-    on_result: Callable[[int, Any], None] | None = None,
-) -> list[Any]:
-    """Call ``function(worker, *job)`` for every job in spawned worker processes.
-
-    Args:
-        function: a module-level function, called as ``function(worker, *job)`` with the
-            job's :class:`Worker` (to poll ``should_stop`` and report progress).
-        jobs: the argument tuples, started in this order.
-        workers: at most this many processes (never more than there are jobs).
-        reporter: receives the workers' progress.
-        should_stop: polled about ten times a second; once true, no job starts any more
-            and the running ones are asked to stop (their results are still awaited).
-        on_result: called in this process with each job's index and result as it
-            arrives (e.g. to save finished work while the rest runs).
-
-    Returns:
-        The results in job order; :data:`NOT_STARTED` for the jobs a stop left out.
-
-    Raises:
-        KeyboardInterrupt: raised here (by a signal handler) while waiting: every worker
-            is killed at once, then it propagates. A worker's exception propagates the
-            same way after the other workers are killed.
-    """
-    reporter = reporter or NullReporter()
-    results: list[Any] = [NOT_STARTED] * len(jobs)
-    if not jobs:
-        return results
-    context: Any = multiprocessing.get_context(_start_method())
-    if os.name == "posix":
-        # Started lazily by the first worker, multiprocessing's resource tracker unblocks
-        # SIGINT and SIGTERM once it runs; start it first so the block below holds.
-        from multiprocessing import resource_tracker
-
-        resource_tracker.ensure_running()
-    processes: list[BaseProcess] = []
-    conns: list[Connection] = []
-    try:
-        with _signals_blocked():
-            for number in range(min(workers, len(jobs))):
-                parent_end, child_end = context.Pipe()
-                process = context.Process(
-                    target=_worker_main, args=(child_end, os.getpid()),
-                    name=f"cartpole-q worker {number}", daemon=True,
-                )  # fmt: skip
-                processes.append(process)
-                conns.append(parent_end)
-                process.start()
-                child_end.close()
-        _dispatch(function, jobs, conns, processes, results, reporter, should_stop, on_result)
-    except BaseException:
-        _end_workers(processes, conns, kill=True)
-        raise
-    _end_workers(processes, conns, kill=False)
-    return results
-
-
-def _start_method() -> str:
-    """``fork`` where it is safe and cheap, else ``spawn``.
-
-    A forked worker starts in milliseconds with everything this process has imported and
-    compiled; a spawned one imports numpy, numba and gymnasium and loads the compiled
-    loop again (about 1.5 s), which would dominate a quick multi-seed run. Forking is
-    safe on Linux while this process has no other thread (a live progress bar has one;
-    a thread holding a lock at the fork would leave that lock held in the child).
-    """
-    if sys.platform.startswith("linux") and threading.active_count() == 1:
-        return "fork"
-    return "spawn"
-
-
-def _dispatch(
-    function: Callable[..., Any],
-    jobs: Sequence[tuple[Any, ...]],
-    conns: list[Connection],
-    processes: list[BaseProcess],
-    results: list[Any],
-    reporter: Reporter,
-    should_stop: Callable[[], bool] | None,
-    on_result: Callable[[int, Any], None] | None = None,
-) -> None:
-    """Hand out the jobs to idle workers and collect their messages until none is busy."""
-    idle = list(range(len(conns)))
-    busy: dict[int, int] = {}  # worker -> job
-    arrived: list[int] = []  # finished jobs whose results on_result has not seen yet
-    next_job = 0
-    stopping = False
-    while True:
-        if not stopping and should_stop is not None and should_stop():
-            stopping = True
-            for worker in busy:
-                _send(conns[worker], _STOP)
-        while idle and not stopping and next_job < len(jobs):
-            worker = idle.pop(0)
-            conns[worker].send(("job", function, jobs[next_job]))
-            busy[worker] = next_job
-            next_job += 1
-        # Only now, with every idle worker busy again, hand results on (saving them takes time).
-        for job in arrived:
-            if on_result is not None:
-                on_result(job, results[job])
-        arrived.clear()
-        if not busy:
-            return
-        wait_connections([conns[worker] for worker in busy], timeout=0.1)
-        for worker in list(busy):
-            conn = conns[worker]
-            while worker in busy and conn.poll():
-                try:
-                    kind, *payload = conn.recv()
-                except (EOFError, OSError):
-                    processes[worker].join(_JOIN_SECONDS)
-                    raise WorkerError(
-                        f"a worker process ended unexpectedly (exit code "
-                        f"{processes[worker].exitcode}) while it ran {jobs[busy[worker]]!r}."
-                    ) from None
-                if kind == "result":
-                    job = busy.pop(worker)
-                    results[job] = payload[0]
-                    idle.append(worker)
-                    arrived.append(job)
-                elif kind == "error":
-                    raise _worker_exception(*payload)
-                elif kind == "start":
-                    reporter.start(*payload)
-                elif kind == "update":
-                    key, *fields = payload
-                    reporter.update(key, Progress(*fields))
-                else:
-                    reporter.finish(*payload)
-
-
-def _send(conn: Connection, message: Any) -> None:
-    with suppress(OSError):  # the other end is gone; reading the pipe says so
-        conn.send(message)
-
-
-def _worker_exception(pickled: bytes | None, text: str) -> BaseException:
-    """The worker's exception as the worker raised it (else a ``WorkerError`` with its text)."""
-    if pickled is not None:
-        try:
-            error = pickle.loads(pickled)
-        except Exception:  # any failure to rebuild it: fall back to the text
-            error = None
-        if isinstance(error, BaseException):
-            if not isinstance(error, UserError):
-                error.__cause__ = WorkerError(f"in a worker process:\n{text}")
-            return error
-    return WorkerError(f"in a worker process:\n{text}")
-
-
-def _end_workers(processes: list[BaseProcess], conns: list[Connection], *, kill: bool) -> None:
-    """End every worker: politely after a normal end, at once (SIGKILL) otherwise.
-
-    Further SIGINT and SIGTERM are ignored meanwhile (this takes milliseconds), so a third
-    Ctrl-C cannot break the clean-up half-way and leave processes behind.
-    """
-    with _signals_ignored():
-        for process, conn in zip(processes, conns, strict=False):
-            if kill:
-                if process.pid is not None and process.exitcode is None:
-                    process.kill()
-            else:
-                _send(conn, None)
-        deadline = time.monotonic() + _JOIN_SECONDS
-        for process in processes:
-            if process.pid is None:
-                continue  # never started
-            process.join(max(0.0, deadline - time.monotonic()))
-            if process.exitcode is None:
-                process.kill()
-                process.join(_JOIN_SECONDS)
-        for conn in conns:
-            conn.close()
-
-
-@contextmanager
-def _signals_blocked() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back in this thread; the processes it spawns inherit the mask."""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-
-
-@contextmanager
-def _signals_ignored() -> Iterator[None]:
-    """Ignore SIGINT and SIGTERM (main thread only; elsewhere handlers cannot change)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {signum: signal.signal(signum, signal.SIG_IGN) for signum in _SIGNALS}
-    try:
-        yield
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
-
-
-_SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
-
-def _worker_main(conn: Connection, parent_pid: int) -> None:
-    """A worker's life: ignore signals, die with the parent, run jobs until told to end."""
-    for signum in _SIGNALS:
-        signal.signal(signum, signal.SIG_IGN)  # also discards one that arrived while blocked
-    if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(_SIGNALS))
-    _die_with_parent(parent_pid)
-    while True:
-        try:
-            message = conn.recv()
-        except (EOFError, OSError):
-            return  # the parent is gone
-        if message is None:
-            return
-        if message == _STOP:
-            continue  # the job it was meant for has already ended
-        _, function, args = message
-        try:
-            value = function(Worker(conn), *args)
-        except BaseException as error:  # every failure goes to the parent
-            text = traceback.format_exc()
-            try:
-                pickled: bytes | None = pickle.dumps(error)
-            except Exception:  # it cannot travel as itself
-                pickled = None
-            reply: tuple[Any, ...] = ("error", pickled, text)
-        else:
-            reply = ("result", value)
-        try:
-            conn.send(reply)
-        except OSError:
-            return
-
-
-def _die_with_parent(parent_pid: int) -> None:
-    """On Linux, ask the kernel to SIGKILL this process when its parent dies."""
-    if not sys.platform.startswith("linux"):
-        return
-    try:
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() != parent_pid:
-        os._exit(1)  # the parent died before the request took effect
-
-
-class Worker:
-    """A job's link to the parent process: stop requests in, progress out."""
-
-    def __init__(self, conn: Connection) -> None:
-        self._conn = conn
-        self._stopped = False
-
-    def should_stop(self) -> bool:
-        """Whether the parent asked this job to stop (or is gone)."""
-        if not self._stopped:
-            try:
-                while self._conn.poll():
-                    if self._conn.recv() in (_STOP, None):
-                        self._stopped = True
-            except (EOFError, OSError):
-                self._stopped = True  # the parent is gone
-        return self._stopped
-
-    def reporter(self) -> Reporter:
-        """A reporter whose messages reach the parent's."""
-        return _PipeReporter(self._conn)
-
-
-class _PipeReporter:
-    """Forwards a worker's progress to the parent process (throttled)."""
-
-    def __init__(self, conn: Connection, min_interval: float = 0.2) -> None:
-        self._conn = conn
-        self._min_interval = min_interval
-        self._last = 0.0
-        self._unsent: Progress | None = None
-
-    def start(self, key: Any, label: str, episodes: int) -> None:
-        _send(self._conn, ("start", key, label, episodes))
-
-    def update(self, key: Any, progress: Progress) -> None:
-        now = time.monotonic()
-        self._unsent = progress
-        if now - self._last >= self._min_interval:
-            self._last = now
-            self._send_update(key)
-
-    def _send_update(self, key: Any) -> None:
-        if self._unsent is not None:
-            _send(self._conn, ("update", key, *dataclasses.astuple(self._unsent)))
-            self._unsent = None
-
-    def finish(self, key: Any, line: str) -> None:
-        # the last update may have been throttled: the bar must end on the real count
-        self._send_update(key)
-        _send(self._conn, ("finish", key, line))
-
-    def close(self) -> None:
-        """Nothing to close."""
-
-
-def _train_seeds(worker: Worker, items: Sequence[tuple[str, int, bool]], plot: bool) -> list[bool]:
-    """Worker job: train seeds into their directories, one after another.
+def _train_seeds(
+    handle: JobHandle, items: Sequence[tuple[str, int, bool]], plot: bool
+) -> Iterator[tuple[int, bool]]:
+    """Job: train seeds into their directories, one after another.
 
     Each item is (seed directory, seed, resume). The seeds share one config but their
     seed, so it is checked against its environment once.
 
-    Returns:
-        Whether each started seed was interrupted; seeds a stop left out have no entry.
+    Yields:
+        ``(seed, interrupted)`` as each started seed ends; a stop leaves the rest out.
     """
-    interrupted: list[bool] = []
     env_info = None
-    reporter = worker.reporter()
+    reporter = handle.reporter()
     for child, seed, resume in items:
-        if worker.should_stop():
-            break
+        if handle.should_stop():
+            return
         path = Path(child)
         config = load_config(path / rundir.CONFIG_FILE)
         if env_info is None:
@@ -494,11 +141,10 @@ def _train_seeds(worker: Worker, items: Sequence[tuple[str, int, bool]], plot: b
         else:
             prepared = dataclasses.replace(prepared, config=config)
         outcome = execute_run(
-            path, prepared, resume=resume, should_stop=worker.should_stop, reporter=reporter,
+            path, prepared, resume=resume, should_stop=handle.should_stop, reporter=reporter,
             key=f"worker {os.getpid()}", label=f"seed {seed}", plot=plot,
         )  # fmt: skip
-        interrupted.append(outcome.result.interrupted)
-    return interrupted
+        yield seed, outcome.result.interrupted
 
 
 def _finished(child: Path) -> bool:
@@ -653,7 +299,7 @@ def seed_status(parent: Path) -> SeedStatus:
 
 
 def _evaluate_one(
-    worker: Worker | None,
+    handle: JobHandle | None,
     path: str,
     episodes: int | None,
     seed: int | None,
@@ -730,10 +376,7 @@ def evaluate_seeds(
         rundir.load_run(path)
     workers = workers or default_workers(len(paths))
     jobs = [(path, episodes, seed, physics, max_steps) for path in paths]
-    if workers <= 1:
-        results = [_evaluate_one(None, *job) for job in jobs]
-    else:
-        results = run_in_workers(_evaluate_one, jobs, workers)
+    results = map_jobs(_evaluate_one, jobs, workers)
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.evaluation import under_conditions
 

@@ -19,7 +19,13 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from cartpole_q.config import NOT_SET, Config, ConfigError, config_differences, load_config
+from cartpole_q.config import (
+    Config,
+    ConfigError,
+    config_differences,
+    load_config,
+    shown_value,
+)
 from cartpole_q.envs.gym import EnvInfo, inspect_env
 from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
@@ -313,8 +319,8 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
                 f"be shortened to {new}; --resume only continues or extends a run."
             )
         raise RunError(
-            f"{where}: {key}: the run was trained with {_shown(old)}, {rundir.CONFIG_FILE} "
-            f"now says {_shown(new)}. --resume continues a run exactly as it was trained, so "
+            f"{where}: {key}: the run was trained with {shown_value(old)}, {rundir.CONFIG_FILE} "
+            f"now says {shown_value(new)}. --resume continues a run exactly as it was trained, so "
             "only train.episodes may change (and only grow); put the value back, or train a "
             f"new run with `cartpole-q train --config {where}`."
         )
@@ -341,19 +347,10 @@ def _check_seed_configs(parent: Path, config: Config) -> None:
             key, old, new = differences[0]
             raise RunError(
                 f"{parent / rundir.CONFIG_FILE}: {key}: {child.name} was trained with "
-                f"{_shown(old)}, {rundir.CONFIG_FILE} now says {_shown(new)}. A multi-seed "
+                f"{shown_value(old)}, {rundir.CONFIG_FILE} now says {shown_value(new)}. A multi-seed "
                 "run resumes exactly as it was configured; put the value back (to train one "
                 f"seed longer: `cartpole-q train --resume {child} --episodes N`)."
             )
-
-
-def _shown(value: Any) -> str:
-    """A config value as YAML shows it: 0.995, [1, 1, 2, 10], "CartPole-v1", null."""
-    import json
-
-    if value is NOT_SET:
-        return value
-    return json.dumps(value, default=str)
 
 
 def outcome_line(label: str, summary: dict[str, Any]) -> str:

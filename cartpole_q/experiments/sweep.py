@@ -13,28 +13,53 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, load_config
+from cartpole_q.config import (
+    ConfigError,
+    config_differences,
+    format_seeds,
+    load_config,
+    shown_value,
+)
 from cartpole_q.errors import RunError
-from cartpole_q.experiments.backends import execute
 from cartpole_q.experiments.statistics import PointStatistics, summarize_point
 from cartpole_q.experiments.sweep_spec import SweepSpec, axis_cell, load_sweep
+from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store import sweepdir
 from cartpole_q.store.sweepdir import RESULT_COLUMNS, cell
 
 MAX_RUNS_PER_TASK = 100
-"""a task is at most this many runs (about a second for the default config)"""
-TASKS_PER_WORKER = 4
-"""split the work into at least this many tasks per worker, so that all finish together"""
+"""a task is at most this many runs (about a second for the default config); each run
+reaches the parent as soon as it ends, whatever the task's size"""
 FLUSH_SECONDS = 1.0
-"""save finished runs at most this often (a kill loses at most this much work)"""
+"""save finished runs at most this often (a kill loses at most this much finished work)"""
+
+
+def saved_text(directory: Path, saved: int, total: int) -> str:
+    """What a stopped sweep has saved, exactly.
+
+    >>> saved_text(Path("s"), 37, 400), saved_text(Path("s"), 0, 400)
+    ('37 of 400 runs are saved in s/results.csv', 'no run had finished, so nothing is saved in s/results.csv yet')
+    """
+    results = directory / sweepdir.RESULTS_FILE
+    if not saved:
+        return f"no run had finished, so nothing is saved in {results} yet"
+    return f"{saved:,} of {total:,} runs are saved in {results}"
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped at once (a second signal), with how many runs ``results.csv`` holds."""
+
+    def __init__(self, directory: Path, saved: int, total: int) -> None:
+        super().__init__(directory, saved, total)
+        self.text = saved_text(directory, saved, total)
 
 
 @dataclass
@@ -53,30 +78,30 @@ class SweepOutcome:
 # -- the worker side ---------------------------------------------------------------------
 
 
-def run_task(worker: Any, task: Sequence[tuple[int, dict[str, Any], Sequence[int]]]) -> list[Any]:
-    """Train and evaluate each (point, seed) of a task, as ``cartpole-q train`` would.
+def run_task(
+    handle: JobHandle, task: Sequence[tuple[int, dict[str, Any], Sequence[int]]]
+) -> Iterator[tuple[int, int, dict[str, str], np.ndarray]]:
+    """Job: train and evaluate each (point, seed) of a task, as ``cartpole-q train`` would.
 
     Args:
-        worker: its ``should_stop()`` ends the task early, after the current run.
+        handle: its ``should_stop()`` ends the task early, after the current run.
         task: (point index, the point's config as a mapping, its seeds) groups.
 
-    Returns:
-        ``(point, seed, cells, q_table)`` per finished run, ``cells`` keyed by
+    Yields:
+        ``(point, seed, cells, q_table)`` as each run ends, ``cells`` keyed by
         :data:`~cartpole_q.store.sweepdir.RESULT_COLUMNS`.
     """
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.training import train
 
-    finished: list[Any] = []
     for point, mapping, seeds in task:
         config = load_config(mapping)
         env_info = inspect_env(config)
         for seed in seeds:
-            if worker.should_stop():
-                return finished
+            if handle.should_stop():
+                return
             result = train(config.for_seed(seed), env_info=env_info)
-            finished.append((point, seed, result_cells(result, seed), result.q_table))
-    return finished
+            yield point, seed, result_cells(result, seed), result.q_table
 
 
 def result_cells(result: Any, seed: int) -> dict[str, str]:
@@ -149,8 +174,50 @@ def load_sweep_dir(directory: Path) -> SweepSpec:
     """
     path = sweepdir.sweep_file(directory)
     spec = load_sweep(path)
+    check_unchanged(spec, directory)
     check_points(spec, str(path))
     return spec
+
+
+def check_unchanged(spec: SweepSpec, directory: Path) -> None:
+    """Refuse a ``sweep.yaml`` that no longer describes the sweep the directory started.
+
+    The points' ``config.yaml`` files, written when the sweep started and never after,
+    are the record: every point must still exist with the same config (its name
+    included), so that no finished row is labelled with values it did not run with. Only
+    ``seeds`` may change, and only grow (checked against ``results.csv`` by the caller).
+
+    Raises:
+        RunError: naming the key, the point, and both values.
+    """
+    where = directory / sweepdir.SWEEP_FILE
+    started = sweepdir.point_ids(directory)
+    now = [spec.point_id(point.index) for point in spec.points]
+    advice = (
+        "--resume finishes a sweep exactly as it started (only `seeds` may grow); put "
+        "sweep.yaml back, or start a new sweep from the edited file."
+    )
+    if started != now:
+        raise RunError(
+            f"{where}: the sweep started with {len(started)} points, sweep.yaml now gives "
+            f"{len(now)} (its axes changed: {', '.join(spec.axes) or 'none'}). {advice}"
+        )
+    for point, point_id in zip(spec.points, now, strict=True):
+        config_path = sweepdir.point_config_path(directory, point_id)
+        try:
+            first = load_config(config_path)
+        except ConfigError as error:
+            raise RunError(
+                f"{config_path}: is not a valid config any more ({error}); the sweep directory "
+                "was changed by hand."
+            ) from None
+        differences = config_differences(first, point.config)
+        if differences:
+            key, old, new = differences[0]
+            raise RunError(
+                f"{where}: {key}: point {point_id} started with {shown_value(old)}, sweep.yaml "
+                f"now gives {shown_value(new)}. {advice}"
+            )
 
 
 def run_sweep(
@@ -192,15 +259,18 @@ def run_sweep(
     progress.start(spec.runs, len(book.rows), len(spec.points), book.points_done())
     tasks = plan_tasks(spec, missing, workers)
 
-    def on_result(index: int, finished: list[Any]) -> None:
-        book.add(finished)
+    def on_item(index: int, finished: tuple[int, int, dict[str, str], np.ndarray]) -> None:
+        book.add([finished])
         progress.advance(len(book.rows), book.points_done())
 
     try:
         execute(
-            run_task, [(task,) for task in tasks], on_result,
+            run_task, [(task,) for task in tasks], on_item,
             backend=backend, workers=workers, address=address, should_stop=should_stop,
         )  # fmt: skip
+    except KeyboardInterrupt:
+        book.flush(force=True)
+        raise SweepInterrupted(directory, book.saved, spec.runs) from None
     finally:
         book.flush(force=True)
         progress.close()
@@ -216,11 +286,11 @@ def plan_tasks(
     """Cut the missing (point, seed) runs, in order, into tasks of consecutive runs.
 
     A task holds up to :data:`MAX_RUNS_PER_TASK` runs, fewer when that leaves fewer than
-    :data:`TASKS_PER_WORKER` tasks per worker; consecutive seeds of a point stay together.
+    four tasks per worker; consecutive seeds of a point stay together.
     """
     if not missing:
         return []
-    size = max(1, min(MAX_RUNS_PER_TASK, math.ceil(len(missing) / (TASKS_PER_WORKER * workers))))
+    size = chunk_size(len(missing), workers, most=MAX_RUNS_PER_TASK)
     mappings: dict[int, dict[str, Any]] = {}
     tasks = []
     for start in range(0, len(missing), size):
@@ -245,14 +315,22 @@ class _Book:
         self._header = sweepdir.result_header(spec.axes)
         self.rows: dict[tuple[int, int], dict[str, str]] = {}
         seeds = set(spec.seeds)
+        results = directory / sweepdir.RESULTS_FILE
         for row in sweepdir.read_results(directory, self._header):
             key = self._key(row)
-            if key[0] >= len(spec.points) or key[1] not in seeds or key in self.rows:
+            if key[0] >= len(spec.points) or key in self.rows:
                 raise RunError(
-                    f"{directory / sweepdir.RESULTS_FILE}: has a row (point {row['point']}, seed "
-                    f"{row['seed']}) that is not of this sweep, or twice; the sweep directory "
-                    "was changed by hand. Start a new sweep."
+                    f"{results}: has a row (point {row['point']}, seed {row['seed']}) that is not "
+                    "of this sweep, or twice; the sweep directory was changed by hand. Start a "
+                    "new sweep."
                 )
+            if key[1] not in seeds:
+                raise RunError(
+                    f"{directory / sweepdir.SWEEP_FILE}: seeds: it now gives "
+                    f"{format_seeds(spec.seeds)}, but {results} holds finished runs of seed "
+                    f"{key[1]}; seeds may be added to a sweep, not taken away. Put them back."
+                )
+            self._check_axis_cells(row, key[0])
             self.rows[key] = row
         self._per_point = {point.index: 0 for point in spec.points}
         for point, _ in self.rows:
@@ -260,6 +338,8 @@ class _Book:
         self._tables: dict[int, dict[str, np.ndarray]] = {}
         self._dirty: set[int] = set()
         self._last_flush = -math.inf  # the first results are saved at once
+        self.saved = len(self.rows)
+        """how many rows ``results.csv`` holds"""
 
     def _key(self, row: dict[str, str]) -> tuple[int, int]:
         try:
@@ -269,6 +349,18 @@ class _Book:
                 f"{self._directory / sweepdir.RESULTS_FILE}: has a damaged row ({row}); start a "
                 "new sweep."
             ) from None
+
+    def _check_axis_cells(self, row: dict[str, str], point: int) -> None:
+        """Refuse a finished row whose axis cells are not the point's values any more."""
+        values = self._spec.points[point].values
+        for key in self._spec.axes:
+            now = axis_cell(values[key])
+            if row[key] != now:
+                raise RunError(
+                    f"{self._directory / sweepdir.SWEEP_FILE}: {key}: the finished runs of point "
+                    f"{row['point']} ran with {row[key]}, sweep.yaml now gives {now}; --resume "
+                    "finishes a sweep exactly as it started (only `seeds` may grow)."
+                )
 
     def points_done(self) -> int:
         return sum(1 for count in self._per_point.values() if count == len(self._spec.seeds))
@@ -295,7 +387,9 @@ class _Book:
             return
         for point in sorted(self._dirty):
             sweepdir.write_tables(self._directory, self._spec.point_id(point), self._tables[point])
-        sweepdir.write_results(self._directory, self._header, self.sorted_rows())
+        rows = self.sorted_rows()
+        sweepdir.write_results(self._directory, self._header, rows)
+        self.saved = len(rows)
         # Only once both are written: an interruption above leaves everything to save again.
         for point in self._dirty:
             if self._per_point[point] == len(self._spec.seeds):

@@ -32,11 +32,12 @@ import numpy as np
 
 from cartpole_q.config import ConfigError
 from cartpole_q.errors import RunError
-from cartpole_q.experiments.backends import execute
 from cartpole_q.experiments.statistics import iqm, summarize_point
 from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, run_task
 from cartpole_q.experiments.sweep_spec import axis_cell
 from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
+from cartpole_q.experiments.workers import InProcess, chunk_size, execute
+from cartpole_q.progress import NullReporter
 from cartpole_q.store import tunedir
 from cartpole_q.store.sweepdir import cell
 
@@ -299,15 +300,13 @@ def evaluate_trial(
     seeds = list(spec.seeds)
     rows: list[dict[str, str]] = []
 
-    def collect(index: int, finished: list[Any]) -> None:
-        for _, seed, cells, _ in finished:
-            rows.append({**cells, "seed": str(seed)})
+    def collect(index: int, finished: tuple[int, int, dict[str, str], Any]) -> None:
+        _, seed, cells, _ = finished
+        rows.append({**cells, "seed": str(seed)})
 
-    class _Here:
-        def should_stop(self) -> bool:
-            return should_stop is not None and should_stop()
-
-    collect(0, run_task(_Here(), [(trial.number, mapping, seeds[:1])]))
+    here = InProcess(should_stop, NullReporter())
+    for finished in run_task(here, [(trial.number, mapping, seeds[:1])]):
+        collect(0, finished)
     position = 1
     round_size = max(len(seeds), 1) if not spec.pruner else max(5, 2 * workers)
     while position < len(seeds):
@@ -315,7 +314,7 @@ def evaluate_trial(
             break
         chunk = seeds[position : position + round_size]
         position += len(chunk)
-        size = max(1, min(MAX_RUNS_PER_TASK, math.ceil(len(chunk) / (4 * workers))))
+        size = chunk_size(len(chunk), workers, most=MAX_RUNS_PER_TASK)
         jobs = [
             ([(trial.number, mapping, tuple(chunk[i : i + size]))],)
             for i in range(0, len(chunk), size)

@@ -21,7 +21,7 @@ import yaml
 
 from cartpole_q.errors import RunError
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
-from cartpole_q.store.rundir import create_run_dir, write_config
+from cartpole_q.store.rundir import CONFIG_FILE, create_run_dir, write_config
 
 SWEEP_FILE = "sweep.yaml"
 RESULTS_FILE = "results.csv"
@@ -82,6 +82,19 @@ def sweep_file(directory: Path) -> Path:
         raise RunError(f"{directory}: is not a sweep directory (it has no {SWEEP_FILE}).")
     remove_stale_temporaries(directory)
     return path
+
+
+def point_config_path(directory: Path, point_id: str) -> Path:
+    """A point's ``config.yaml``: written when the sweep starts, never rewritten."""
+    return directory / POINTS_DIR / point_id / CONFIG_FILE
+
+
+def point_ids(directory: Path) -> list[str]:
+    """The ids of the points the sweep started with (those with a ``config.yaml``), sorted."""
+    root = directory / POINTS_DIR
+    if not root.is_dir():
+        return []
+    return sorted(entry.name for entry in root.iterdir() if (entry / CONFIG_FILE).is_file())
 
 
 def result_header(axes: Sequence[str]) -> list[str]:
