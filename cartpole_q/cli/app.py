@@ -18,14 +18,53 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from typer.core import TyperCommand
+from typer.core import TyperCommand, TyperGroup
 
 from cartpole_q.errors import UserError
 
 EXIT_BAD_INPUT = 2
+MAX_SEED = 2**32 - 1
+"""the largest seed (as :data:`cartpole_q.config.MAX_SEED`; the CLI imports no config)"""
 EXIT_INTERRUPTED = 130
 
+
+class _App(TyperGroup):
+    """The root command: a usage error is one line on stderr and exit code 2, as ours are.
+
+    Typer would draw a box around it; a user reads the same one-paragraph form as every
+    other bad input (``error: ...``), with where to find the command's options.
+    """
+
+    def main(  # type: ignore[override]
+        self,
+        args: Any = None,
+        prog_name: str | None = None,
+        complete_var: str | None = None,
+        standalone_mode: bool = True,
+        **extra: Any,
+    ) -> Any:
+        """Run the command line; usage errors become one line and exit code 2."""
+        import sys
+
+        if not standalone_mode:
+            return super().main(args, prog_name, complete_var, standalone_mode, **extra)
+        try:
+            code = super().main(args, prog_name, complete_var, False, **extra)
+        except typer.Abort:
+            typer.echo("interrupted", err=True)
+            sys.exit(EXIT_INTERRUPTED)
+        except typer.TyperException as error:  # Typer's (click's) usage errors
+            exit_code = getattr(error, "exit_code", EXIT_BAD_INPUT)
+            context = getattr(error, "ctx", None)
+            where = f" (see `{context.command_path} --help`)" if context is not None else ""
+            message = error.format_message() if hasattr(error, "format_message") else str(error)
+            typer.echo(f"error: {message}{where}", err=True)
+            sys.exit(exit_code)
+        sys.exit(code if isinstance(code, int) else 0)
+
+
 app = typer.Typer(
+    cls=_App,
     name="cartpole-q",
     help="Tabular Q-learning on Gymnasium's CartPole-v1: train, evaluate, plot.",
     no_args_is_help=True,
@@ -155,7 +194,8 @@ def train(
         ),
     ] = None,
     seed: Annotated[
-        int | None, typer.Option(metavar="N", min=0, help="Run seed (overrides `seed`).")
+        int | None,
+        typer.Option(metavar="N", min=0, max=MAX_SEED, help="Run seed (overrides `seed`)."),
     ] = None,
     seeds: Annotated[
         str | None,
@@ -233,7 +273,12 @@ def train(
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with _exit_codes():
-        from cartpole_q.config import load_config, parse_assignment, resolve_config_path
+        from cartpole_q.config import (
+            Provenance,
+            load_config,
+            parse_assignment,
+            resolve_config_path,
+        )
         from cartpole_q.experiments import run as runner
 
         if resume is not None:
@@ -264,8 +309,8 @@ def train(
                 overrides["engine"] = engine.value
             loaded = load_config(config, overrides)
             _check_viewing(loaded.train.seeds, watch, video_every)
-            source = str(resolve_config_path(config)) if config else "default config"
-            prepared = runner.prepare(loaded, source)
+            file = str(resolve_config_path(config)) if config else "default config"
+            prepared = runner.prepare(loaded, Provenance(file, tuple(overrides)))
             run_dir = runner.start_run(prepared, out)
         _train_into(
             run_dir, prepared, resume is not None, workers, quiet, watch, video_every, seed_plots
@@ -370,6 +415,7 @@ def eval_command(
         typer.Option(
             metavar="N",
             min=0,
+            max=MAX_SEED,
             help="Seed of the first reset.",
             show_default="the run's eval.seed",
         ),
@@ -427,7 +473,7 @@ def eval_command(
         from cartpole_q.config import parse_assignment
         from cartpole_q.store import rundir
 
-        changed = {key: value for key, value in map(parse_assignment, physics or [])}
+        changed = dict(parse_assignment(text, "--physics") for text in physics or [])
         if rundir.is_multi_seed(run_dir):
             if video is not None or render:
                 raise UserError(
@@ -611,7 +657,10 @@ def robustness_command(
         int, typer.Option(metavar="N", min=1, help="Greedy episodes per grid point.")
     ] = 20,
     seed: Annotated[
-        int, typer.Option(metavar="N", min=0, help="Seed of each grid point's first reset.")
+        int,
+        typer.Option(
+            metavar="N", min=0, max=MAX_SEED, help="Seed of each grid point's first reset."
+        ),
     ] = 1000000,
     out: Annotated[
         Path | None,
@@ -805,8 +854,7 @@ def _sweep(
     if not outcome.complete:
         saved = saved_text(outcome.directory, outcome.done_runs, outcome.total_runs)
         typer.echo(
-            f"interrupted: {saved}; finish it with `cartpole-q sweep --resume "
-            f"{outcome.directory}`",
+            f"interrupted: {saved}; finish it with `cartpole-q sweep --resume {outcome.directory}`",
             err=True,
         )
         raise typer.Exit(EXIT_INTERRUPTED)
@@ -920,8 +968,8 @@ def tune_command(
         Path | None,
         typer.Option(
             metavar="DIR",
-            help="Go on with a tune directory's study: finish it after a kill, raise its "
-            "total with --trials, or join it from another process.",
+            help="Go on with a tune directory's study: finish it after a kill or a full disk, "
+            "or raise its total with --trials.",
         ),
     ] = None,
     out: Annotated[
@@ -940,10 +988,19 @@ def tune_command(
         str | None,
         typer.Option(
             metavar="URL",
-            help="An Optuna storage URL (sqlite:///study.db, postgresql://...).",
+            help="Where the study lives: an Optuna storage URL (sqlite:///study.db, "
+            "postgresql://...) or a journal file's path, to share it between processes.",
             show_default="the journal file DIR/study.journal",
         ),
     ] = None,
+    join: Annotated[
+        bool,
+        typer.Option(
+            "--join",
+            help="Add trials to the study of this name already in --storage (its search must "
+            "be this file's) instead of refusing it.",
+        ),
+    ] = False,
     workers: Annotated[
         int | None,
         typer.Option(
@@ -961,6 +1018,17 @@ def tune_command(
         str | None,
         typer.Option(metavar="ADDR", help="With --backend ray: a running cluster's address."),
     ] = None,
+    max_runs: Annotated[
+        int,
+        typer.Option(
+            metavar="N",
+            min=1,
+            help="Refuse studies of more runs (trials x seeds) than this, unless --yes.",
+        ),
+    ] = 200_000,
+    yes: Annotated[
+        bool, typer.Option("--yes", "-y", help="Run however many runs the study has.")
+    ] = False,
     quiet: Annotated[
         bool, typer.Option("--quiet", "-q", help="Print nothing but the tune directory.")
     ] = False,
@@ -968,68 +1036,94 @@ def tune_command(
     """Search config values with Optuna, each trial scored on every seed; the last line is its directory."""
     # Connected (or refused) before the tune directory is created, and once for all trials.
     with _exit_codes(), _backend_connection(backend, workers, address):
-        import os
-
         from cartpole_q.experiments import tune as tuning
-        from cartpole_q.experiments.run import StopRequest
         from cartpole_q.experiments.tune_spec import load_tune
+        from cartpole_q.store import tunedir
+        from cartpole_q.store.lock import directory_lock
 
         if resume is not None:
-            if tune_file is not None or out is not None or storage is not None:
+            if tune_file is not None or out is not None or storage is not None or join:
                 raise UserError(
                     "--resume goes on with the study as it was started, so it takes neither a "
-                    "TUNE.yaml, --out nor --storage (only --trials, to raise the total)."
+                    "TUNE.yaml, --out, --storage nor --join (only --trials, to raise the total)."
                 )
-            spec, storage_url = tuning.load_tune_dir(resume)
-            directory = resume
-        else:
-            if tune_file is None:
-                raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
-            spec = load_tune(tune_file)
-            storage_url = tuning.absolute_url(storage)
-            tuning.optuna_module()
-            if storage_url is not None:
-                tuning.storage_for(Path(), storage_url)
-            directory = tuning.start_tune(spec, out, storage_url)
-        workers = workers or max(1, min(os.cpu_count() or 1, len(spec.seeds)))
+            tunedir.tune_file(resume)  # a tune directory, before a lock file goes into it
+            with directory_lock(resume, "tune directory"):
+                spec, storage_url = tuning.load_tune_dir(resume)
+                _check_tune_size(spec, trials, max_runs, yes, str(resume / tunedir.TUNE_FILE))
+                _tune(spec, resume, storage_url, trials, workers, backend, address, quiet)
+            return
+        if tune_file is None:
+            raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
+        spec = load_tune(tune_file)
+        _check_tune_size(spec, trials, max_runs, yes, str(tune_file))
+        storage_url = tuning.absolute_url(storage)
+        tuning.optuna_module()
+        tuning.check_storage(spec, storage_url, join, str(tune_file))
+        directory = tuning.start_tune(spec, out, storage_url)
+        with directory_lock(directory, "tune directory"):
+            _tune(spec, directory, storage_url, trials, workers, backend, address, quiet)
 
-        def report(trial: dict[str, Any]) -> None:
-            if not quiet and trial.get("pruned"):
-                typer.echo(f"trial {trial['number']}: pruned (it could not beat the best)")
-            elif not quiet:
-                shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
-                rate = trial.get("success_rate")
-                rate_text = "" if rate is None else f"success {rate:.2f}, "
-                typer.echo(
-                    f"trial {trial['number']}: {rate_text}IQM {trial.get('iqm_eval_return', float('nan')):.1f}"
-                    f" ({shown})"
-                )
 
-        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
-            try:
-                outcome = tuning.run_tune(
-                    spec, directory, storage_url, trials=trials, workers=workers,
-                    backend=backend.value, address=address, should_stop=stop.is_set,
-                    on_trial=report,
-                )  # fmt: skip
-            except KeyboardInterrupt:
-                typer.echo(
-                    f"interrupted at once; go on with `cartpole-q tune --resume {directory}`",
-                    err=True,
-                )
-                raise typer.Exit(EXIT_INTERRUPTED) from None
-        if not quiet and outcome.best is not None:
-            best = outcome.best
-            typer.echo(
-                f"best: trial {best['number']} ({outcome.finished_trials} trials complete), "
-                f"objective {best['objective']:.6g}: "
-                + ", ".join(f"{k}={v}" for k, v in best["values"].items())
-            )
-            typer.echo(f"trials.csv, best.yaml, history.png and importance.png in {directory}")
-        typer.echo(str(directory))
-        if stop.is_set():
-            typer.echo(f"interrupted: go on with `cartpole-q tune --resume {directory}`", err=True)
-            raise typer.Exit(EXIT_INTERRUPTED)
+def _check_tune_size(spec: Any, trials: int | None, max_runs: int, yes: bool, where: str) -> None:
+    """Refuse a study of more runs than ``--max-runs`` without ``--yes``."""
+    total = trials or spec.trials
+    runs = total * len(spec.seeds)
+    if runs > max_runs and not yes:
+        raise UserError(
+            f"{where}: {total:,} trials x {len(spec.seeds):,} seeds = {runs:,} runs, more than "
+            f"--max-runs {max_runs:,}; pass --yes to run them all (or raise --max-runs)."
+        )
+
+
+def _tune(
+    spec: Any,
+    directory: Path,
+    storage_url: str | None,
+    trials: int | None,
+    workers: int | None,
+    backend: BackendChoice,
+    address: str | None,
+    quiet: bool,
+) -> None:
+    """Run a (locked) tune directory's study; print each trial and the best."""
+    from cartpole_q.experiments import tune as tuning
+    from cartpole_q.experiments.run import StopRequest
+    from cartpole_q.experiments.workers import default_workers
+
+    def report(trial: dict[str, Any]) -> None:
+        if not quiet and trial.get("pruned"):
+            typer.echo(f"trial {trial['number']}: pruned (it could not beat the best)")
+        elif not quiet:
+            shown = ", ".join(f"{k}={v}" for k, v in trial["values"].items())
+            rate = trial.get("success_rate")
+            rate_text = "" if rate is None else f"success {rate:.2f}, "
+            iqm = trial.get("iqm_eval_return", float("nan"))
+            typer.echo(f"trial {trial['number']}: {rate_text}IQM {iqm:.1f} ({shown})")
+
+    hint = f"go on with `cartpole-q tune --resume {directory}`"
+    with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+        try:
+            outcome = tuning.run_tune(
+                spec, directory, storage_url, trials=trials,
+                workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
+                address=address, should_stop=stop.is_set, on_trial=report,
+            )  # fmt: skip
+        except KeyboardInterrupt:
+            typer.echo(f"interrupted at once; {hint}", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED) from None
+    if not quiet and outcome.best is not None:
+        best = outcome.best
+        typer.echo(
+            f"best: trial {best['number']} ({outcome.finished_trials} trials complete), "
+            f"objective {best['objective']:.6g}: "
+            + ", ".join(f"{k}={v}" for k, v in best["values"].items())
+        )
+        typer.echo(f"trials.csv, best.yaml, history.png and importance.png in {directory}")
+    typer.echo(str(directory))
+    if stop.is_set():
+        typer.echo(f"interrupted: {hint}", err=True)
+        raise typer.Exit(EXIT_INTERRUPTED)
 
 
 def main() -> None:

@@ -35,11 +35,14 @@ import yaml
 from cartpole_q.config.schema import (
     ALGORITHMS,
     ENGINES,
+    EXACT_INTEGER,
     INTEGRATORS,
     MAX_EPISODES,
+    MAX_SEED,
     MAX_SEEDS,
     PHYSICS_ENV_IDS,
     PHYSICS_KEYS,
+    PHYSICS_RANGES,
     RANDOMIZED_KEYS,
     SCHEDULE_KINDS,
     AgentConfig,
@@ -146,6 +149,46 @@ OVERRIDE_SOURCE = "command line"
 """how errors name the source of an override (``--set``, ``--seed`` and the like)"""
 
 
+@dataclasses.dataclass(frozen=True)
+class Provenance:
+    """Where a config's values came from, so that a message blames the right one.
+
+    Checks made after loading (against the environment, say) name a field; the field's
+    value came from the file, or from an override (``--set env.id=...``).
+
+    >>> where = Provenance("blog.yaml", ("env.id", "agent.alpha"))
+    >>> where.of("env.id"), where.of("discretization.bins"), where.of("agent"), str(where)
+    ('command line', 'blog.yaml', 'command line', 'blog.yaml')
+    """
+
+    file: str
+    """the file (or "default config", or another label) the config was loaded from"""
+    overridden: tuple[str, ...] = ()
+    """the dotted keys set by overrides"""
+    override_source: str = OVERRIDE_SOURCE
+
+    def of(self, field: str) -> str:
+        """Who gave ``field`` (or a key inside it, or a section holding it)."""
+        for key in self.overridden:
+            if key == field or key.startswith(f"{field}.") or field.startswith(f"{key}."):
+                return self.override_source
+        return self.file
+
+    def __str__(self) -> str:
+        return self.file
+
+
+def blame(source: str | Provenance, field: str) -> str:
+    """The source to name in a message about ``field``.
+
+    A plain label as it is; a :class:`Provenance`, the file or the overrides that gave it.
+
+    >>> blame("a.yaml", "env.id"), blame(Provenance("a.yaml", ("env.id",)), "env.id")
+    ('a.yaml', 'command line')
+    """
+    return source.of(field) if isinstance(source, Provenance) else str(source)
+
+
 def _without_default_grid(
     raw: dict[str, Any], user: Mapping[Any, Any], overridden: list[str]
 ) -> dict[str, Any]:
@@ -190,7 +233,13 @@ def _leaf_paths(data: Mapping[Any, Any], prefix: str = "") -> list[str]:
     return paths
 
 
-def parse_assignment(text: str) -> tuple[str, Any]:
+_ASSIGNMENT_EXAMPLES = {
+    "--set": "--set agent.alpha=5e-4 or --set discretization.bins=[1,1,6,12]",
+    "--physics": "--physics length=0.75 or --physics gravity=12",
+}
+
+
+def parse_assignment(text: str, option: str = "--set") -> tuple[str, Any]:
     """Parse one ``--set KEY=VALUE``: the value is read as YAML (``5e-4``, ``[1, 2]``, ``true``).
 
     >>> parse_assignment("discretization.bins=[1, 1, 6, 12]")
@@ -203,15 +252,14 @@ def parse_assignment(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not equals or not key:
         raise ConfigError(
-            f"--set {text!r}: expected KEY=VALUE with a dotted config key, e.g. "
-            "--set agent.alpha=5e-4 or --set discretization.bins=[1,1,6,12]."
+            f"{option} {text!r}: expected KEY=VALUE, e.g. {_ASSIGNMENT_EXAMPLES.get(option, option)}."
         )
     try:
         parsed = yaml.load(value, Loader=_UniqueKeyLoader) if value.strip() else None
     except yaml.YAMLError as error:
         problem = getattr(error, "problem", None) or "invalid syntax"
         raise ConfigError(
-            f"--set {text!r}: the value is not plain YAML ({problem}); quote strings that "
+            f"{option} {text!r}: the value is not plain YAML ({problem}); quote strings that "
             "contain ':', '#', '[' or '{'."
         ) from None
     return key, parsed
@@ -310,10 +358,11 @@ _UniqueKeyLoader.add_constructor(
 )
 
 
-def read_yaml_mapping(path: Path) -> dict[str, Any]:
+def read_yaml_mapping(path: Path, what: str = "config file") -> dict[str, Any]:
     """Read a YAML file that must hold a mapping, with the safe loader only.
 
-    An empty file (or one with only comments) is the empty mapping.
+    An empty file (or one with only comments) is the empty mapping. ``what`` names the
+    kind of file in messages ("config file", "sweep file", "tune file").
 
     Raises:
         ConfigError: the file is missing, unreadable, not YAML, not a mapping, or uses a
@@ -322,13 +371,15 @@ def read_yaml_mapping(path: Path) -> dict[str, Any]:
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
+        if what != "config file":
+            raise ConfigError(f"{path}: {what} not found.") from None
         names = ", ".join(shipped_configs())
         raise ConfigError(
             f"{path}: config file not found; give a YAML file or the name of a shipped "
             f"config ({names}; see `cartpole-q configs`)."
         ) from None
     except IsADirectoryError:
-        raise ConfigError(f"{path}: is a directory, not a config file.") from None
+        raise ConfigError(f"{path}: is a directory, not a {what}.") from None
     except UnicodeDecodeError:
         raise ConfigError(f"{path}: is not a UTF-8 text file.") from None
     except OSError as error:
@@ -490,6 +541,10 @@ class _Reader:
         number = _as_number(value)
         if number is None or not math.isfinite(number) or number != int(number):
             raise self.error(field, f"must be an integer, got {_shown(value)}.")
+        if not isinstance(value, int) and abs(number) >= EXACT_INTEGER:
+            raise self.error(
+                field, f"must be an integer written out in digits, got {_shown(value)}."
+            )
         integer = int(value) if isinstance(value, int) else int(number)
         if integer < minimum:
             raise self.error(field, f"must be at least {minimum}, got {integer}.")
@@ -605,6 +660,14 @@ class _Reader:
             raise self.error(
                 field, f"must be a mapping of argument names to values, got {_shown(value)}."
             )
+        steps = value.get("max_episode_steps")
+        if "max_episode_steps" in value and (
+            isinstance(steps, bool) or not isinstance(steps, int) or steps < 1
+        ):
+            raise self.error(
+                f"{field}.max_episode_steps",
+                f"the time limit must be a positive whole number of steps, got {_shown(steps)}.",
+            )
         return MappingProxyType(copy.deepcopy(value))
 
     # -- the whole config -------------------------------------------------------------
@@ -626,7 +689,7 @@ class _Reader:
         discretization = self._discretization()
         return Config(
             name=name,
-            seed=self.integer("seed", minimum=0),
+            seed=self.integer("seed", minimum=0, maximum=MAX_SEED),
             engine=self.choice("engine", ENGINES),
             env=self._env(),
             discretization=discretization,
@@ -653,7 +716,7 @@ class _Reader:
             ),
             eval=EvalConfig(
                 episodes=self.integer("eval.episodes", minimum=1, maximum=MAX_EPISODES),
-                seed=self.integer("eval.seed", minimum=0),
+                seed=self.integer("eval.seed", minimum=0, maximum=MAX_SEED),
             ),
         )
 
@@ -693,12 +756,8 @@ class _Reader:
             field = f"env.physics.{key}"
             if key == "kinematics_integrator":
                 physics[key] = self.choice_value(field, value[key], INTEGRATORS)
-            elif key == "gravity":
-                physics[key] = self.number(field, value[key])
             else:
-                physics[key] = self.number(
-                    field, value[key], low=0.0, low_open=True, interval="(0, inf)"
-                )
+                physics[key] = self.number(field, value[key], **_physics_bounds(key))
         return MappingProxyType(physics)
 
     def _randomize(self, env_id: str) -> Mapping[str, tuple[float, float]]:
@@ -711,11 +770,8 @@ class _Reader:
             pair = value[key]
             if not isinstance(pair, list) or len(pair) != 2:
                 raise self.error(field, f"must be [low, high], got {_shown(pair)}.")
-            bounded = {"low": -math.inf} if key == "gravity" else {
-                "low": 0.0, "low_open": True, "interval": "(0, inf)"
-            }  # fmt: skip
-            low = self.number(f"{field}[0]", pair[0], **bounded)
-            high = self.number(f"{field}[1]", pair[1], **bounded)
+            low = self.number(f"{field}[0]", pair[0], **_physics_bounds(key))
+            high = self.number(f"{field}[1]", pair[1], **_physics_bounds(key))
             if low > high:
                 raise self.error(field, f"low ({low}) must not be above high ({high}).")
             ranges[key] = (low, high)
@@ -748,6 +804,13 @@ class _Reader:
         return DiscretizationConfig(bins=bins, low=low, high=high)
 
 
+def _physics_bounds(key: str) -> dict[str, Any]:
+    """The :meth:`_Reader.number` bounds of a physics key (see ``PHYSICS_RANGES``)."""
+    low, low_open, high = PHYSICS_RANGES[key]
+    interval = f"{'(' if low_open else '['}{low:g}, {high:g}]"
+    return {"low": low, "low_open": low_open, "high": high, "interval": interval}
+
+
 def config_differences(old: Config, new: Config) -> list[tuple[str, Any, Any]]:
     """The dotted keys whose values differ between two configs, in file order.
 
@@ -757,7 +820,16 @@ def config_differences(old: Config, new: Config) -> list[tuple[str, Any, Any]]:
     >>> config_differences(load_config(), load_config(overrides={"agent.gamma": 0.9}))
     [('agent.gamma', 0.995, 0.9)]
     """
-    return _differences(old.to_dict(), new.to_dict(), "")
+    return mapping_differences(old.to_dict(), new.to_dict())
+
+
+def mapping_differences(old: Any, new: Any) -> list[tuple[str, Any, Any]]:
+    """The dotted keys whose values differ between two nested mappings, in key order.
+
+    >>> mapping_differences({"a": {"b": 1, "c": 2}}, {"a": {"b": 1, "c": 3}, "d": 4})
+    [('a.c', 2, 3), ('d', '(not set)', 4)]
+    """
+    return _differences(old, new, "")
 
 
 NOT_SET = "(not set)"
@@ -825,6 +897,8 @@ def parse_seeds(value: Any) -> tuple[int, ...]:
         raise ValueError(f"must be seeds like '0-99' or [0, 1, 2], got {_shown(value)}.")
     if any(seed < 0 for seed in seeds):
         raise ValueError("seeds must be non-negative.")
+    if any(seed > MAX_SEED for seed in seeds):
+        raise ValueError(f"seeds must be at most {MAX_SEED:,}.")
     unique = sorted(set(seeds))
     if len(unique) > MAX_SEEDS:
         raise ValueError(f"at most {MAX_SEEDS} seeds, got {len(unique)}.")

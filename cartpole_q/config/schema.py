@@ -32,6 +32,20 @@ PHYSICS_KEYS = (
     "x_threshold",
 )
 """``env.physics`` keys: ``CartPoleEnv`` attributes (``length`` is half the pole)"""
+PHYSICS_RANGES: dict[str, tuple[float, bool, float]] = {
+    "gravity": (0.0, False, 1000.0),
+    "masscart": (0.0, True, 1000.0),
+    "masspole": (0.0, True, 1000.0),
+    "length": (0.0, True, 100.0),
+    "force_mag": (0.0, True, 10_000.0),
+    "tau": (0.0, True, 1.0),
+    "theta_threshold_radians": (0.0, True, 3.141592653589793),
+    "x_threshold": (0.0, True, 1000.0),
+}
+"""each numeric ``env.physics`` key's ``(low, low excluded, high)``. Gravity may be 0
+(weightless: the pole only moves when pushed) but not negative, which would pull the pole
+upright and make balancing a different task; the upper ends keep the state finite (a
+force of 1e308 overflows float64 at the first step)"""
 RANDOMIZED_KEYS = ("gravity", "masscart", "masspole", "length", "force_mag", "tau")
 """``env.randomize`` keys, in the order of their draws"""
 INTEGRATORS = ("euler", "semi-implicit euler")
@@ -42,6 +56,10 @@ MAX_EPISODES = 10_000_000
 """the most episodes a run (or an evaluation) may ask for"""
 MAX_SEEDS = 10_000
 """the most seeds one command may run"""
+MAX_SEED = 2**32 - 1
+"""the largest seed (``seed``, ``eval.seed``, ``--seed``, ``--seeds``)"""
+EXACT_INTEGER = 2**53
+"""an integer given as a float (``1e6``) must be below this, where floats are exact"""
 
 
 @dataclass(frozen=True)

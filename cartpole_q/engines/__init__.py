@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from cartpole_q.config import Config, ConfigError
+from cartpole_q.config import Config, ConfigError, Provenance, blame
 from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
 
-def resolve_engine(config: Config, env_info: EnvInfo, source: str = "config") -> str:
+def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance = "config") -> str:
     """Return the engine that will run: ``auto`` becomes numba where a twin exists.
 
     Raises:
@@ -32,7 +32,7 @@ def resolve_engine(config: Config, env_info: EnvInfo, source: str = "config") ->
         return "numba"
     if config.engine == "numba":
         raise ConfigError(
-            f"{source}: engine: numba cannot run this config: {settings}. Use engine: "
+            f"{blame(source, 'engine')}: engine: numba cannot run this config: {settings}. Use engine: "
             "gymnasium (or auto, which falls back to it)."
         )
     return "gymnasium"

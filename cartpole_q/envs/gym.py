@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from cartpole_q.config import Config, ConfigError, EnvConfig
+from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
 
 SOLVE_WINDOW = 100
 """episodes in the moving average of training returns compared with the reward threshold"""
@@ -48,12 +48,15 @@ class EnvInfo:
         return self.index_starts is not None
 
 
-def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "config") -> Any:
+def make_env(
+    env: EnvConfig, render_mode: str | None = None, source: str | Provenance = "config"
+) -> Any:
     """Return ``gymnasium.make(env.id, **env.kwargs)``, optionally with a render mode.
 
     Raises:
-        ConfigError: ``env.id`` is ``"module:Env-v0"`` and the module (or something it
-            imports) cannot be imported.
+        ConfigError: the environment cannot be made: an unknown id, a module that cannot be
+            imported, a missing package, or an argument it refuses (naming ``env.id`` or the
+            ``env.kwargs`` key, never with a traceback).
     """
     import gymnasium
 
@@ -69,12 +72,54 @@ def make_env(env: EnvConfig, render_mode: str | None = None, source: str = "conf
         module = env.id.partition(":")[0] if ":" in env.id else (error.name or "a module")
         detail = str(error).split(". ")[0]
         raise ConfigError(
-            f"{source}: env.id: cannot make {env.id!r}: the module {module!r} cannot be "
-            f"imported ({detail}); install it, or check the part of env.id before ':'."
+            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: the module {module!r} "
+            f"cannot be imported ({detail}); install it, or check the part of env.id before ':'."
         ) from None
+    except gymnasium.error.DependencyNotInstalled as error:
+        raise ConfigError(
+            f"{blame(source, 'env.id')}: env.id: {env.id!r} needs a package that is not "
+            f"installed ({error})."
+        ) from None
+    except gymnasium.error.Error as error:
+        raise ConfigError(
+            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: {error}"
+        ) from None
+    except Exception as error:  # whatever the environment raises for arguments it refuses
+        raise kwargs_error(env, error, source) from None
     if env.physics:
         set_physics(made, env.physics)
     return made
+
+
+def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> ConfigError:
+    """The config error for an environment that refused its arguments, naming the key.
+
+    The key is the one the error names (an unexpected keyword, a value it could not look
+    up), else the only one given; else all of them.
+
+    >>> from cartpole_q.config import load_config
+    >>> env = load_config(overrides={"env.kwargs.map_name": "9x9"}).env
+    >>> str(kwargs_error(env, KeyError("9x9"), "a.yaml")).split(":")[:2]
+    ['a.yaml', ' env.kwargs.map_name']
+    """
+    kwargs = dict(env.kwargs)
+    text = str(error)
+    named = [key for key in kwargs if f"'{key}'" in text or f"`{key}`" in text]
+    if not named and isinstance(error, KeyError) and error.args:
+        named = [key for key, value in kwargs.items() if value == error.args[0]]
+    if not named and len(kwargs) == 1:
+        named = list(kwargs)
+    field = f"env.kwargs.{named[0]}" if len(named) == 1 else "env.kwargs"
+    shown = (
+        f"{named[0]}={kwargs[named[0]]!r}"
+        if len(named) == 1
+        else ", ".join(f"{key}={value!r}" for key, value in kwargs.items())
+    )
+    detail = f"{type(error).__name__}: {text}" if text else type(error).__name__
+    return ConfigError(
+        f"{blame(source, field)}: {field}: {env.id!r} cannot be made with {shown or 'no arguments'} "
+        f"({detail}); check the value against the environment's documentation."
+    )
 
 
 def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
@@ -91,7 +136,7 @@ def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
     cartpole.polemass_length = cartpole.masspole * cartpole.length
 
 
-def inspect_env(config: Config, source: str = "config") -> EnvInfo:
+def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
     """Make the config's environment once and check that the config can train on it.
 
     Args:
@@ -105,31 +150,23 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
             of Discrete spaces, a Box has no grid or one of another dimension, a Discrete
             observation is given a grid, or the Q-table would exceed the size limit.
     """
-    import gymnasium
     from gymnasium import spaces
     from gymnasium.envs.classic_control import CartPoleEnv
 
     env_id = config.env.id
-    try:
-        env = make_env(config.env, source=source)
-    except gymnasium.error.DependencyNotInstalled as error:
-        raise ConfigError(
-            f"{source}: env.id: {env_id!r} needs a package that is not installed ({error})."
-        ) from None
-    except gymnasium.error.Error as error:
-        raise ConfigError(f"{source}: env.id: cannot make {env_id!r}: {error}") from None
-    except TypeError as error:
-        raise ConfigError(
-            f"{source}: env.kwargs: {env_id!r} does not accept these arguments ({error})."
-        ) from None
+    env = make_env(config.env, source=source)
     try:
         observation_space, action_space, spec = env.observation_space, env.action_space, env.spec
         is_cartpole = isinstance(env.unwrapped, CartPoleEnv)
+        try:  # some arguments are only used, and refused, at the first reset
+            env.reset(seed=0)
+        except Exception as error:
+            raise kwargs_error(config.env, error, source) from None
     finally:
         env.close()
     if not isinstance(action_space, spaces.Discrete) or int(action_space.start) != 0:
         raise ConfigError(
-            f"{source}: env.id: {env_id!r} has action space {action_space}; tabular "
+            f"{blame(source, 'env.id')}: env.id: {env_id!r} has action space {action_space}; tabular "
             "Q-learning here needs Discrete actions numbered from 0."
         )
     index_starts = _index_starts(observation_space)
@@ -143,7 +180,7 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
         observation_dim = len(state_shape)
         if config.discretization is not None:
             raise ConfigError(
-                f"{source}: discretization: {env_id!r} has observation space "
+                f"{blame(source, 'discretization')}: discretization: {env_id!r} has observation space "
                 f"{observation_space}, whose observations index the Q-table directly (shape "
                 f"{(*state_shape, int(action_space.n))}); a grid bins only Box observations, "
                 "so leave discretization out (or set it to null)."
@@ -153,21 +190,21 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
         observation_dim = int(observation_space.shape[0])
         if config.discretization is None:
             raise ConfigError(
-                f"{source}: discretization: {env_id!r} has observation space "
+                f"{blame(source, 'discretization')}: discretization: {env_id!r} has observation space "
                 f"{observation_space}, which needs a grid: give discretization.bins, low "
                 f"and high, one entry per dimension ({observation_dim})."
             )
         state_shape = config.discretization.bins
         if len(state_shape) != observation_dim:
             raise ConfigError(
-                f"{source}: discretization.bins: has {len(state_shape)} entries but "
+                f"{blame(source, 'discretization.bins')}: discretization.bins: has {len(state_shape)} entries but "
                 f"{env_id!r} observations have {observation_dim} dimensions; give bins, low "
                 "and high one entry per dimension."
             )
         field = "discretization.bins"
     else:
         raise ConfigError(
-            f"{source}: env.id: {env_id!r} has observation space {observation_space}; "
+            f"{blame(source, 'env.id')}: env.id: {env_id!r} has observation space {observation_space}; "
             "tabular learning here needs a 1-D Box (binned by discretization), a Discrete, "
             "or a Tuple of Discrete spaces."
         )
@@ -177,7 +214,7 @@ def inspect_env(config: Config, source: str = "config") -> EnvInfo:
     if table_bytes > limit:
         fewer = "use fewer bins" if index_starts is None else "use a smaller environment"
         raise ConfigError(
-            f"{source}: {field}: the Q-table would hold {math.prod(state_shape):,} "
+            f"{blame(source, field)}: {field}: the Q-table would hold {math.prod(state_shape):,} "
             f"states x {n_actions} actions = {_size(table_bytes)}, above the limit of "
             f"{_size(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
         )

@@ -22,6 +22,7 @@ from typing import Any
 from cartpole_q.config import (
     Config,
     ConfigError,
+    Provenance,
     config_differences,
     load_config,
     shown_value,
@@ -48,6 +49,7 @@ class Prepared:
     env_info: EnvInfo
     engine: str
     source: str
+    """the config's file (or another label), for messages"""
 
 
 @dataclass(frozen=True)
@@ -103,7 +105,7 @@ class StopRequest:
         self._previous.clear()
 
 
-def prepare(config: Config, source: str) -> Prepared:
+def prepare(config: Config, source: str | Provenance) -> Prepared:
     """Check a config against its environment and pick its engine (no files touched).
 
     Raises:
@@ -112,7 +114,8 @@ def prepare(config: Config, source: str) -> Prepared:
     from cartpole_q.engines import resolve_engine
 
     env_info = inspect_env(config, source)
-    return Prepared(config, env_info, resolve_engine(config, env_info, source), source)
+    engine = resolve_engine(config, env_info, source)
+    return Prepared(config, env_info, engine, str(source))
 
 
 def start_run(prepared: Prepared, out: Path | None) -> Path:

@@ -111,7 +111,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
         base_dir = Path()
         default_name = "sweep"
     else:
-        raw = read_yaml_mapping(source)
+        raw = read_yaml_mapping(source, "sweep file")
         where = label or str(source)
         base_dir = source.parent
         default_name = safe_name(source.stem)
@@ -272,7 +272,8 @@ def _expand(
         overrides = {"name": f"{name}-{index:0{width}d}", **values}
         shown = ", ".join(f"{key}={axis_cell(value)}" for key, value in values.items())
         label = f"{where}: point {index:0{width}d}" + (f" ({shown})" if shown else "")
-        config = load_config(base, overrides, source=f"{where}: base", override_source=label)
+        # The base was checked alone: whatever is wrong now comes with the point's values.
+        config = load_config(base, overrides, source=label, override_source=label)
         points.append(Point(index, values, config))
     return tuple(points)
 

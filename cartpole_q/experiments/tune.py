@@ -16,6 +16,7 @@ so among equally good trials the faster learner wins.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import io
 import math
@@ -23,15 +24,15 @@ import os
 import socket
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError
-from cartpole_q.errors import RunError
+from cartpole_q.config import ConfigError, mapping_differences, shown_value
+from cartpole_q.errors import RunError, WriteError
 from cartpole_q.experiments.statistics import iqm, summarize_point
 from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, run_task
 from cartpole_q.experiments.sweep_spec import axis_cell
@@ -39,6 +40,7 @@ from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
 from cartpole_q.experiments.workers import InProcess, chunk_size, execute
 from cartpole_q.progress import NullReporter
 from cartpole_q.store import tunedir
+from cartpole_q.store.atomic import write_failure
 from cartpole_q.store.sweepdir import cell
 
 IQM_BONUS = 1e-3
@@ -66,30 +68,123 @@ def optuna_module() -> Any:
     return optuna
 
 
+SEARCH_ATTR = "cartpole_q_search"
+"""the study's user attribute holding its search: everything of the tune file but
+``name`` and ``trials``, recorded when the study is created"""
+
+
 def storage_for(directory: Path, url: str | None) -> Any:
-    """The study's storage: Optuna's journal file in the tune directory, or ``url``."""
+    """The study's storage: a journal file, or the Optuna storage at ``url``.
+
+    The journal file is the tune directory's, or ``url`` when it is a path; any other
+    ``url`` is an Optuna storage URL (``sqlite:///...``, ``postgresql://...``).
+
+    A journal's last record, cut by a full disk or a kill in the middle of a write, is
+    removed first (see :func:`repair_journal`).
+
+    Raises:
+        ConfigError: the URL cannot be opened.
+    """
     optuna = optuna_module()
-    if url is None:
+    if url is None or "://" not in url:
         from optuna.storages import JournalStorage
         from optuna.storages.journal import JournalFileBackend
 
-        return JournalStorage(JournalFileBackend(str(directory / tunedir.JOURNAL_FILE)))
+        path = directory / tunedir.JOURNAL_FILE if url is None else Path(url)
+        with storage_errors(path):
+            repair_journal(path)
+            return JournalStorage(JournalFileBackend(str(path)))
     try:
         return optuna.storages.get_storage(url)
     except Exception as error:  # Optuna raises many kinds for a bad URL
         raise ConfigError(f"--storage {url}: cannot open this Optuna storage ({error}).") from None
 
 
-def absolute_url(url: str | None) -> str | None:
-    """A storage URL that names the same database from any directory (SQLite paths made absolute).
+def repair_journal(path: Path) -> bool:
+    """Cut a half-written record from the end of an Optuna journal file; say whether one was.
 
-    >>> absolute_url("sqlite:////tmp/study.db"), absolute_url(None)
-    ('sqlite:////tmp/study.db', None)
+    Optuna appends one JSON record per line. A write that a full disk (or a kill) cut
+    short leaves a last line without its newline; the next record would be appended to
+    it and make the whole journal unreadable. The cut record was never complete, so no
+    reader ever saw it: dropping it loses nothing. Done under the journal's own lock, so
+    another process's record in progress is never taken for a cut one.
+    """
+    if not path.is_file() or path.stat().st_size == 0:
+        return False
+    from optuna.storages.journal import JournalFileSymlinkLock
+
+    lock = JournalFileSymlinkLock(str(path))
+    lock.acquire()
+    try:
+        with path.open("rb+") as journal:
+            size = journal.seek(0, os.SEEK_END)
+            journal.seek(size - 1)
+            if journal.read(1) == b"\n":
+                return False
+            end = size
+            while end > 0:  # back to the last newline, a block at a time
+                start = max(0, end - 65536)
+                journal.seek(start)
+                block = journal.read(end - start)
+                newline = block.rfind(b"\n")
+                if newline >= 0:
+                    end = start + newline + 1
+                    break
+                end = start
+            journal.truncate(end)
+            return True
+    finally:
+        lock.release()
+
+
+@contextlib.contextmanager
+def storage_errors(where: Path | str) -> Iterator[None]:
+    """Turn a storage that cannot be written (a full disk, say) into an error naming it.
+
+    The study in the storage stays usable: what a failed write cut short is removed when
+    the storage is opened again, and the trial that was running is marked failed by the
+    next ``tune --resume``. So a full disk costs at most the trial in flight.
+    """
+    try:
+        yield
+    except OSError as error:
+        path = Path(getattr(error, "filename", None) or where)
+        raise WriteError(
+            f"{path}: cannot be written: {write_failure(path, error)}. The study is kept, "
+            "less the trial in flight; make room, then go on with `cartpole-q tune --resume "
+            "DIR`."
+        ) from None
+    except Exception as error:
+        if type(error).__module__.split(".")[0] not in ("sqlalchemy", "optuna"):
+            raise
+        if "disk" not in str(error).lower() and "OperationalError" not in type(error).__name__:
+            raise
+        raise WriteError(
+            f"--storage {where}: the database could not be written ({error}). The study is "
+            "kept, less the trial in flight; fix the database, then go on with `cartpole-q "
+            "tune --resume DIR`."
+        ) from None
+
+
+def absolute_url(url: str | None) -> str | None:
+    """A storage that names the same place from any directory (SQLite, journal paths absolute).
+
+    >>> absolute_url("sqlite:////tmp/study.db"), absolute_url(None), absolute_url("/a/s.journal")
+    ('sqlite:////tmp/study.db', None, '/a/s.journal')
     """
     prefix = "sqlite:///"
-    if url is None or not url.startswith(prefix) or url.startswith(prefix + "/"):
+    if url is None:
+        return None
+    if "://" not in url:
+        return str(Path(url).resolve())
+    if not url.startswith(prefix) or url.startswith(prefix + "/"):
         return url
     return prefix + str(Path(url[len(prefix) :]).resolve())
+
+
+def search_of(spec: TuneSpec) -> dict[str, Any]:
+    """What makes trials comparable: the tune file but its ``name`` and ``trials``."""
+    return {key: value for key, value in spec.to_dict().items() if key not in ("name", "trials")}
 
 
 def sampler_for(spec: TuneSpec, trial_number: int = 0) -> Any:
@@ -107,8 +202,75 @@ def sampler_for(spec: TuneSpec, trial_number: int = 0) -> Any:
     return optuna.samplers.TPESampler(seed=seed)
 
 
+def check_storage(spec: TuneSpec, storage_url: str | None, join: bool, where: str) -> None:
+    """Before anything is written: refuse to join a study unasked, or one searched differently.
+
+    Args:
+        spec: the tune file.
+        storage_url: ``--storage`` (``None``: the new tune directory's own journal).
+        join: ``--join`` was given: add trials to the study of that name in the storage.
+        where: the tune file, for messages.
+
+    Raises:
+        ConfigError: the storage already holds a study of this name and ``join`` is not
+            set; ``join`` without a study (or without ``--storage``) to join; or the
+            study's search differs from the file's (naming the key and both values).
+    """
+    if storage_url is None:
+        if join:
+            raise ConfigError(
+                "--join adds trials to a study in a shared storage: give its --storage too."
+            )
+        return
+    optuna = optuna_module()
+    storage = storage_for(Path(), storage_url)
+    with storage_errors(storage_url):
+        exists = spec.name in optuna.get_all_study_names(storage)
+    if exists and not join:
+        raise ConfigError(
+            f"{where}: --storage {storage_url} already holds a study named {spec.name!r}; pass "
+            "--join to add trials to it (its search must be this file's), or give this study "
+            "another `name:`."
+        )
+    if join and not exists:
+        raise ConfigError(
+            f"--join: --storage {storage_url} holds no study named {spec.name!r} to join; leave "
+            "--join out to start it."
+        )
+    if exists:
+        with storage_errors(storage_url):
+            the_study = optuna.load_study(study_name=spec.name, storage=storage)
+        check_search(the_study, spec, f"{where}: the study {spec.name!r} in {storage_url}")
+
+
+def check_search(the_study: Any, spec: TuneSpec, where: str) -> None:
+    """Refuse a tune file whose search is not the one the study started with.
+
+    A study created before the search was recorded gets the file's recorded now.
+
+    Raises:
+        RunError: naming the first key that differs, with both values.
+    """
+    recorded = the_study.user_attrs.get(SEARCH_ATTR)
+    search = search_of(spec)
+    if recorded is None:
+        the_study.set_user_attr(SEARCH_ATTR, search)
+        return
+    differences = mapping_differences(recorded, search)
+    if differences:
+        key, old, new = differences[0]
+        raise RunError(
+            f"{where}: {key}: the study was started with {shown_value(old)}, the tune file now "
+            f"says {shown_value(new)}. A study's trials must all be scored alike, so only "
+            "`trials` may change; put it back, or start a new study (another `name:`)."
+        )
+
+
 def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
-    """Create the tune directory, write ``tune.yaml`` and create the study."""
+    """Create the tune directory, write ``tune.yaml``, and create (or join) the study.
+
+    Call :func:`check_storage` first: it refuses what this would do wrong.
+    """
     directory = tunedir.create_tune_dir(spec.name, out)
     tunedir.write_tune(directory, spec.to_dict(), storage_url)
     study(spec, directory, storage_url, create=True)
@@ -122,25 +284,35 @@ def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:
 
 
 def study(spec: TuneSpec, directory: Path, storage_url: str | None, *, create: bool = False) -> Any:
-    """The study of this tune directory (created by :func:`start_tune`, loaded after).
+    """The study of this tune directory: created (or joined) by :func:`start_tune`, loaded after.
+
+    A loaded study's search must be the tune file's (:func:`check_search`).
 
     Raises:
-        RunError: the storage has no such study (e.g. a moved database file).
+        RunError: the storage has no such study (e.g. a moved database file), or its
+            search is not the tune file's.
     """
     optuna = optuna_module()
     storage = storage_for(directory, storage_url)
-    if create:
-        return optuna.create_study(
-            study_name=spec.name, storage=storage, sampler=sampler_for(spec),
-            direction="maximize", load_if_exists=True,
-        )  # fmt: skip
-    try:
-        return optuna.load_study(study_name=spec.name, storage=storage, sampler=sampler_for(spec))
-    except KeyError:
-        where = storage_url or directory / tunedir.JOURNAL_FILE
-        raise RunError(
-            f"{directory}: its study {spec.name!r} is not in {where}; was the storage moved?"
-        ) from None
+    where = storage_url or directory / tunedir.JOURNAL_FILE
+    with storage_errors(where):
+        if create and spec.name not in optuna.get_all_study_names(storage):
+            the_study = optuna.create_study(
+                study_name=spec.name, storage=storage, sampler=sampler_for(spec),
+                direction="maximize",
+            )  # fmt: skip
+            the_study.set_user_attr(SEARCH_ATTR, search_of(spec))
+            return the_study
+        try:
+            the_study = optuna.load_study(
+                study_name=spec.name, storage=storage, sampler=sampler_for(spec)
+            )
+        except KeyError:
+            raise RunError(
+                f"{directory}: its study {spec.name!r} is not in {where}; was the storage moved?"
+            ) from None
+        check_search(the_study, spec, str(directory / tunedir.TUNE_FILE))
+    return the_study
 
 
 @dataclass
@@ -230,9 +402,23 @@ def run_tune(
 
     Raises:
         ConfigError: Optuna is missing, or the storage cannot be opened.
+        WriteError: the storage cannot be written (a full disk): the study keeps every
+            finished trial, and ``tune --resume`` goes on with it.
     """
+    where = storage_url or directory / tunedir.JOURNAL_FILE
+    with storage_errors(where):
+        return _run_trials(
+            spec, directory, storage_url, trials or spec.trials, workers, backend, address,
+            should_stop, on_trial,
+        )  # fmt: skip
+
+
+def _run_trials(
+    spec: TuneSpec, directory: Path, storage_url: str | None, total: int, workers: int,
+    backend: str, address: str | None, should_stop: Callable[[], bool] | None,
+    on_trial: Callable[[dict[str, Any]], None] | None,
+) -> TuneOutcome:  # fmt: skip
     optuna = optuna_module()
-    total = trials or spec.trials
     the_study = study(spec, directory, storage_url)
     fail_abandoned(the_study)
     owner = f"{socket.gethostname()}:{os.getpid()}"
@@ -253,7 +439,8 @@ def run_tune(
                 spec, trial, values, the_study, workers, backend, address, should_stop
             )
         except BaseException:
-            the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
+            with contextlib.suppress(OSError):  # a full disk: resume fails the trial instead
+                the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
             raise
         if rows is None:  # pruned: it could not beat the best trial
             the_study.tell(trial, state=optuna.trial.TrialState.PRUNED)
@@ -366,7 +553,7 @@ def trial_figures(
     steps = [float(row["env_steps_to_solve"] or UNSOLVED_STEPS) for row in rows]
     tie_break = float(np.median(steps))
     figures = {name: value for name, value in stats.as_row().items() if value is not None}
-    figures["median_env_steps"] = tie_break
+    figures["tie_break_env_steps"] = tie_break
     if spec.objective == "success_rate":
         # Among trials with the same success rate (all at 0 early on), the higher IQM eval
         # return wins: a bounded bonus below one seed's share, so the sampler has a slope.
@@ -382,7 +569,7 @@ def trial_figures(
 TRIAL_COLUMNS = (
     "success_rate", "success_rate_low", "success_rate_high", "iqm_eval_return",
     "iqm_eval_return_low", "iqm_eval_return_high", "median_solved_episode",
-    "median_env_steps_to_solve", "median_env_steps", "seconds",
+    "median_env_steps_to_solve", "tie_break_env_steps", "seconds",
 )  # fmt: skip
 
 
@@ -402,16 +589,26 @@ def write_outputs(spec: TuneSpec, directory: Path, the_study: Any) -> dict[str, 
             "state": trial.state.name.lower(),
             **{key: cell(trial.params.get(key)) if not isinstance(trial.params.get(key), str) else trial.params[key] for key in keys},
             "objective": cell(trial.value),
-            **{name: cell(trial.user_attrs.get(name)) for name in TRIAL_COLUMNS},
+            **{name: cell(_attribute(trial, name)) for name in TRIAL_COLUMNS},
         })  # fmt: skip
     tunedir.write_trials(directory, header, rows)
     best_trial = the_study.best_trial
     values = {d.key: _param_value(d, best_trial.params[d.key]) for d in spec.space}
-    best_config = spec.config_for(values, f"trial {best_trial.number}")
+    best_config = spec.config_for(
+        {**values, "name": f"{spec.name[:59]}-best"}, f"trial {best_trial.number}"
+    )
     tunedir.write_best(directory, best_config, best_trial.number)
     tunedir.write_figures(directory, *_figures(the_study))
     return {"number": best_trial.number, "values": values, "objective": best_trial.value,
             **best_trial.user_attrs}  # fmt: skip
+
+
+def _attribute(trial: Any, name: str) -> Any:
+    """A trial's figure (``tie_break_env_steps`` was ``median_env_steps`` before)."""
+    value = trial.user_attrs.get(name)
+    if value is None and name == "tie_break_env_steps":
+        value = trial.user_attrs.get("median_env_steps")
+    return value
 
 
 def _param_value(dimension: Dimension, value: Any) -> Any:

@@ -122,7 +122,7 @@ def load_tune(source: Path | Mapping[str, Any], *, label: str | None = None) -> 
         raw: Mapping[str, Any] = source
         where, base_dir, default_name = label or "tune mapping", Path(), "tune"
     else:
-        raw = read_yaml_mapping(source)
+        raw = read_yaml_mapping(source, "tune file")
         where, base_dir, default_name = label or str(source), source.parent, safe_name(source.stem)
     check_top_keys(raw, TUNE_KEYS, where)
     name = checked_name(raw, default_name, where)
@@ -184,6 +184,7 @@ def _space(value: Any, where: str, base: dict[str, Any]) -> tuple[Dimension, ...
             "space: {agent.alpha: {low: 0.01, high: 1.0, log: true}}."
         )
     dimensions = []
+    checked: set[str] = set()
     for key, spec in value.items():
         label = f"{where}: space.{key}"
         if not isinstance(key, str) or key in FORBIDDEN_AXES or key.startswith("train.seeds"):
@@ -201,15 +202,30 @@ def _space(value: Any, where: str, base: dict[str, Any]) -> tuple[Dimension, ...
             dimension = _range(key, spec, label)
             tried = dimension.probes()
         for candidate in tried:
-            load_config(
-                base,
-                {key: candidate},
-                source=f"{where}: base",
-                override_source=f"{label} ({axis_cell(candidate)})",
+            source = f"{label} ({axis_cell(candidate)})"
+            config = load_config(
+                base, {key: candidate}, source=f"{where}: base", override_source=source
             )
+            check_environment(config, source, checked)
         dimensions.append(dimension)
     check_overlaps([dimension.key for dimension in dimensions], where)
     return tuple(dimensions)
+
+
+def check_environment(config: Config, source: str, checked: set[str]) -> None:
+    """Check a config against its environment (an id, bins of the wrong length, ...).
+
+    ``checked`` remembers what was checked already (the same environment and grid).
+
+    Raises:
+        ConfigError: naming ``source`` (the file, the key and the value) and the field.
+    """
+    from cartpole_q.experiments.run import prepare
+
+    part = repr((config.env, config.discretization, config.engine, config.agent))
+    if part not in checked:
+        prepare(config, source)
+        checked.add(part)
 
 
 def _choices(key: str, spec: Mapping[str, Any], label: str) -> Dimension:
@@ -255,6 +271,14 @@ def _range(key: str, spec: Mapping[str, Any], label: str) -> Dimension:
         raise ConfigError(f"{label}: an int range needs whole low and high.")
     if integer and step is not None and step != int(step):
         raise ConfigError(f"{label}: an int range needs a whole step, got {step:g}.")
+    if step is not None:
+        steps = (high - low) / step
+        if step > high - low or abs(steps - round(steps)) > 1e-9 * max(1.0, steps):
+            fitted = low + math.floor(steps + 1e-9) * step
+            raise ConfigError(
+                f"{label}: step {step:g} does not divide the range {low:g} to {high:g} (Optuna "
+                f"would quietly end it at {fitted:g}); give a high of low + k * step."
+            )
     return Dimension(key, low, high, log, step, integer)
 
 

@@ -60,20 +60,23 @@ NPY_MAGIC = b"\x93NUMPY"
 # -- creating a run directory ---------------------------------------------------------
 
 
-def create_run_dir(name: str, out: Path | None, runs_root: Path = Path("runs")) -> Path:
-    """Create the directory a new run writes to, never reusing a non-empty one.
+def create_run_dir(
+    name: str, out: Path | None, runs_root: Path = Path("runs"), kind: str = "run"
+) -> Path:
+    """Create the directory a new run (or sweep, or study) writes to, never a non-empty one.
 
     Args:
         name: the config's run-name prefix.
         out: the directory asked for with ``--out``; it must not exist, or be empty.
         runs_root: where ``<name>-<YYYYmmdd-HHMMSS>`` goes when ``out`` is ``None``.
+        kind: what the directory holds, for messages ("run", "sweep", "tune").
 
     Raises:
         RunError: ``out`` is a file or a non-empty directory.
     """
     try:
         if out is not None:
-            check_output_dir(out)
+            check_output_dir(out, runs_root, kind)
             out.mkdir(parents=True, exist_ok=True)
             return out
         stamp = time.strftime("%Y%m%d-%H%M%S")
@@ -87,11 +90,11 @@ def create_run_dir(name: str, out: Path | None, runs_root: Path = Path("runs")) 
             return path
     except OSError as error:
         where = out if out is not None else runs_root
-        raise RunError(f"{where}: cannot create the run directory ({error.strerror}).") from None
-    raise RunError(f"{runs_root}: could not find a free run directory name for {name!r}.")
+        raise RunError(f"{where}: cannot create the {kind} directory ({error.strerror}).") from None
+    raise RunError(f"{runs_root}: could not find a free {kind} directory name for {name!r}.")
 
 
-def check_output_dir(out: Path) -> None:
+def check_output_dir(out: Path, runs_root: Path = Path("runs"), kind: str = "run") -> None:
     """Refuse an output path that is a file or a non-empty directory.
 
     Raises:
@@ -101,8 +104,9 @@ def check_output_dir(out: Path) -> None:
         raise RunError(f"{out}: --out must be a directory, but this is a file.")
     if out.is_dir() and any(out.iterdir()):
         raise RunError(
-            f"{out}: --out points at a non-empty directory; cartpole-q never overwrites a "
-            "run. Choose a new directory (or leave --out out for a fresh one under runs/)."
+            f"{out}: --out points at a non-empty directory; cartpole-q never writes a new "
+            f"{kind} into one. Choose a new directory (or leave --out out for a fresh one "
+            f"under {runs_root}/)."
         )
 
 

@@ -52,7 +52,7 @@ def create_sweep_dir(name: str, out: Path | None) -> Path:
     Raises:
         RunError: ``out`` is a file or a non-empty directory, or cannot be created.
     """
-    return create_run_dir(name, out, runs_root=SWEEPS_ROOT)
+    return create_run_dir(name, out, runs_root=SWEEPS_ROOT, kind="sweep")
 
 
 def write_sweep(
@@ -204,6 +204,12 @@ def point_results(point_dir: Path) -> list[dict[str, str]] | None:
     sweep = point_dir.parent.parent
     if point_dir.parent.name != POINTS_DIR or not (sweep / SWEEP_FILE).is_file():
         return None
+    if point_dir.name not in point_ids(sweep):
+        known = point_ids(sweep)
+        shown = f"{known[0]} to {known[-1]}" if known else "none"
+        raise RunError(
+            f"{point_dir}: is not a point of the sweep {sweep} (its points are {shown})."
+        )
     path = sweep / RESULTS_FILE
     rows = []
     if path.is_file():

@@ -32,7 +32,7 @@ TUNES_ROOT = Path("tunes")
 
 def create_tune_dir(name: str, out: Path | None) -> Path:
     """Create the tune directory: ``out`` (new or empty), else ``tunes/<name>-<stamp>/``."""
-    return create_run_dir(name, out, runs_root=TUNES_ROOT)
+    return create_run_dir(name, out, runs_root=TUNES_ROOT, kind="tune")
 
 
 def write_tune(directory: Path, resolved: Mapping[str, Any], storage: str | None) -> None:
