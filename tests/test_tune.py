@@ -203,24 +203,43 @@ def _read_or_empty(directory: Path) -> list[Any]:
 
 @pytest.mark.slow
 def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path) -> None:
+    """Two tune directories, one study in a shared journal file: the second one joins."""
     path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 16, "seeds": "0-9"})
-    out = tmp_path / "out"
-    first = _start(tmp_path, path, "--out", out, "--workers", 1)
+    journal = tmp_path / "shared.journal"
+    first = _start(tmp_path, path, "--out", tmp_path / "one", "--storage", journal, "--workers", 1)
     deadline = time.monotonic() + 120
-    while not _read_or_empty(out):
+    while not _storage_trials(journal, "small"):
         assert first.poll() is None
         assert time.monotonic() < deadline
         time.sleep(0.05)
-    second = _start(tmp_path, "--resume", out, "--workers", 1)
+    second = _start(
+        tmp_path, path, "--out", tmp_path / "two", "--storage", journal, "--join", "--workers", 1
+    )
     for process in (first, second):
         assert process.wait(timeout=300) == 0, process.stderr.read() if process.stderr else ""
-    trials = _journal_trials(out)
+    trials = _storage_trials(journal, "small")
     complete = [t for t in trials if t.state.name == "COMPLETE"]
     assert len(complete) == 16
     assert len({t.number for t in complete}) == 16
     owners = {t.user_attrs["owner"] for t in complete}
     assert len(owners) == 2, "both processes ran trials"
     assert not [t for t in trials if t.state.name == "RUNNING"]
+    assert _trials(tmp_path / "one")[:1] == _trials(tmp_path / "two")[:1]
+
+
+def _storage_trials(storage: Path | str, name: str) -> list[Any]:
+    import optuna
+
+    if isinstance(storage, Path):
+        if not storage.is_file():
+            return []
+        storage = optuna.storages.JournalStorage(
+            optuna.storages.journal.JournalFileBackend(str(storage))
+        )
+    try:
+        return optuna.load_study(study_name=name, storage=storage).get_trials()
+    except KeyError:  # not created yet
+        return []
 
 
 @pytest.mark.slow
@@ -301,3 +320,246 @@ def test_trials_on_a_local_ray_cluster_are_the_same(reference: Path, tmp_path: P
         ray.shutdown()
     assert outcome.complete
     assert _trials(directory) == _trials(reference)
+
+
+# -- a study never mixes results ---------------------------------------------------------------
+
+
+TUNE_EDITS = [
+    pytest.param(
+        lambda d: d.update({"objective": "iqm_eval_return"}),
+        'objective: the study was started with "success_rate", the tune file now says '
+        '"iqm_eval_return"',
+        id="objective",
+    ),
+    pytest.param(
+        lambda d: d.update({"seeds": "0-9"}),
+        'seeds: the study was started with "0-3", the tune file now says "0-9"',
+        id="seeds",
+    ),
+    pytest.param(
+        lambda d: d["space"]["agent.q_init"].update({"high": 500}),
+        "space.agent.q_init.high: the study was started with 300.0, the tune file now says 500.0",
+        id="a range",
+    ),
+    pytest.param(
+        lambda d: d["base"]["train"].update({"episodes": 61}),
+        "base.train.episodes: the study was started with 60, the tune file now says 61",
+        id="a base key",
+    ),
+]
+
+
+@pytest.mark.parametrize(("edit", "message"), TUNE_EDITS)
+def test_resume_refuses_a_tune_yaml_edited_since_the_start(
+    tmp_path: Path, edit: Any, message: str
+) -> None:
+    import yaml
+
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
+    out = tmp_path / "out"
+    assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
+    before = _trials(out)
+    tune_yaml = out / tunedir.TUNE_FILE
+    data = yaml.safe_load(tune_yaml.read_text())
+    edit(data)
+    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    result = invoke("tune", "--resume", out, "--trials", 2, "-q")
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert str(tune_yaml) in result.output
+    assert _trials(out) == before
+
+
+def test_resume_may_raise_the_trials_in_tune_yaml(tmp_path: Path) -> None:
+    import yaml
+
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
+    out = tmp_path / "out"
+    assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
+    tune_yaml = out / tunedir.TUNE_FILE
+    data = yaml.safe_load(tune_yaml.read_text())
+    data["trials"] = 2
+    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    assert invoke("tune", "--resume", out, "-q").exit_code == 0
+    assert len(_trials(out)) == 2
+
+
+@pytest.mark.parametrize("storage", ["sqlite", "journal"])
+def test_a_study_in_a_storage_is_joined_only_when_asked_and_alike(
+    tmp_path: Path, storage: str
+) -> None:
+    url = f"sqlite:///{tmp_path / 'study.db'}" if storage == "sqlite" else str(tmp_path / "s.jl")
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
+    assert invoke("tune", path, "--out", tmp_path / "o1", "--storage", url, "-q").exit_code == 0
+    # the same name again: refused unless asked, nothing written
+    result = invoke("tune", path, "--out", tmp_path / "o2", "--storage", url, "-q")
+    assert result.exit_code == 2, result.output
+    assert "already holds a study named 'small'; pass --join" in result.output
+    assert not (tmp_path / "o2").exists()
+    # asked, but searching another space: refused, nothing written
+    other = write_yaml(
+        tmp_path / "other.yaml",
+        {**TUNE, "trials": 1, "space": {**TUNE["space"], "agent.q_init": {"low": 0, "high": 9}}},
+    )
+    result = invoke("tune", other, "--out", tmp_path / "o3", "--storage", url, "--join", "-q")
+    assert result.exit_code == 2, result.output
+    assert "space.agent.q_init.high: the study was started with 300" in result.output
+    assert not (tmp_path / "o3").exists()
+    # asked, and alike: it adds trials to the same study
+    result = invoke(
+        "tune", path, "--out", tmp_path / "o4", "--storage", url, "--join", "--trials", 2, "-q"
+    )
+    assert result.exit_code == 0, result.output
+    assert [row["trial"] for row in _trials(tmp_path / "o4")] == ["0", "1"]
+    # --join without a study to join, or without --storage
+    lonely = write_yaml(tmp_path / "lonely.yaml", {**TUNE, "name": "lonely", "trials": 1})
+    result = invoke("tune", lonely, "--out", tmp_path / "o5", "--storage", url, "--join")
+    assert result.exit_code == 2
+    assert "holds no study named 'lonely' to join" in result.output
+    assert invoke("tune", path, "--out", tmp_path / "o6", "--join").exit_code == 2
+    assert not (tmp_path / "o5").exists() and not (tmp_path / "o6").exists()
+
+
+@pytest.mark.slow
+def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 40, "seeds": "0-19"})
+    out = tmp_path / "out"
+    process = _start(tmp_path, path, "--out", out, "--workers", 1)
+    try:
+        deadline = time.monotonic() + 120
+        while not (out / ".lock").is_file() or not _read_or_empty(out):
+            assert process.poll() is None
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        result = invoke("tune", "--resume", out, "-q")
+        assert result.exit_code == 2, result.output
+        assert f"another cartpole-q process (pid {process.pid}) is writing this tune" in (
+            result.output
+        )
+    finally:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+
+
+ENV_CHOICES = [
+    pytest.param(
+        {"env.id": {"choices": ["CartPole-v1", "CartPol-v1"]}},
+        "space.env.id (CartPol-v1): env.id: cannot make 'CartPol-v1'",
+        id="env id typo",
+    ),
+    pytest.param(
+        {"discretization.bins": {"choices": [[1, 1, 6, 12], [1, 6, 12]]}},
+        "space.discretization.bins ([1, 6, 12]): discretization.low: has 4 entries",
+        id="bins of the wrong length",
+    ),
+    pytest.param(
+        {"env.kwargs.max_episode_steps": {"low": 0, "high": 500, "int": True}},
+        "space.env.kwargs.max_episode_steps (0): env.kwargs.max_episode_steps: the time "
+        "limit must be a positive whole number",
+        id="a range end",
+    ),
+    pytest.param(
+        {"agent.alpha": {"low": 0.1, "high": 0.5, "step": 0.3}},
+        "space.agent.alpha: step 0.3 does not divide the range 0.1 to 0.5",
+        id="step does not divide",
+    ),
+    pytest.param(
+        {"agent.alpha": {"low": 0.1, "high": 0.5, "step": 1.0}},
+        "space.agent.alpha: step 1 does not divide the range 0.1 to 0.5",
+        id="step above the range",
+    ),
+]
+
+
+@pytest.mark.parametrize(("space", "message"), ENV_CHOICES)
+def test_every_choice_and_range_end_is_checked_before_anything_is_written(
+    tmp_path: Path, space: dict[str, Any], message: str
+) -> None:
+    path = write_yaml(tmp_path / "t.yaml", {**TUNE, "space": space})
+    result = invoke("tune", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2, result.output
+    assert f"{path}: {message}" in result.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_study_of_too_many_runs_needs_yes(tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "t.yaml", {**TUNE, "seeds": "0-9999", "trials": 1000})
+    result = invoke("tune", path, "--out", tmp_path / "out")
+    assert result.exit_code == 2
+    assert "1,000 trials x 10,000 seeds = 10,000,000 runs, more than --max-runs" in result.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_best_yaml_is_named_after_the_study(reference: Path) -> None:
+    assert load_config(reference / tunedir.BEST_FILE).name == "small-best"
+    header = (reference / tunedir.TRIALS_FILE).read_text().splitlines()[0]
+    assert "tie_break_env_steps" in header.split(",")
+
+
+FULL_DISK = r"""
+set -u
+mount -t tmpfs -o size=512k tmpfs "$MNT"
+"$CLI" tune "$TUNE" --out "$MNT/t" --workers 1 -q > "$LOG/out1" 2> "$LOG/err1" &
+pid=$!
+# fill the disk once three trials are complete
+until [ "$(grep -o '"state":1' "$MNT/t/study.journal" 2>/dev/null | wc -l)" -ge 3 ]; do
+  kill -0 $pid 2>/dev/null || break
+  sleep 0.05
+done
+dd if=/dev/zero of="$MNT/filler" bs=4k > /dev/null 2>&1
+wait $pid; echo $? > "$LOG/rc1"
+grep -o '"state":1' "$MNT/t/study.journal" | wc -l > "$LOG/complete_before"
+rm "$MNT/filler"
+"$CLI" tune --resume "$MNT/t" --workers 1 -q > "$LOG/out2" 2> "$LOG/err2"; echo $? > "$LOG/rc2"
+cp "$MNT/t/trials.csv" "$LOG/trials.csv" 2>/dev/null
+"""
+
+
+def _in_private_mount(script: str, env: dict[str, str]) -> subprocess.CompletedProcess[bytes]:
+    """Run a shell script in its own mount namespace (root, or a user namespace)."""
+    import shutil
+
+    unshare = shutil.which("unshare")
+    if unshare is None:
+        pytest.skip("no unshare(1) here to mount a small file system")
+    options = ["-m"] if os.geteuid() == 0 else ["-r", "-m"]
+    probe = subprocess.run([unshare, *options, "true"], capture_output=True)
+    if probe.returncode != 0:
+        pytest.skip(f"cannot make a mount namespace here: {probe.stderr.decode().strip()}")
+    return subprocess.run(
+        [unshare, *options, "bash", "-c", script], env={**os.environ, **env},
+        capture_output=True, timeout=600,
+    )  # fmt: skip
+
+
+@pytest.mark.slow
+def test_a_full_disk_costs_at_most_the_trial_in_flight_and_resume_recovers(
+    tmp_path: Path,
+) -> None:
+    """A real 512 KiB file system, filled up while the study runs."""
+    path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 12, "seeds": "0-3"})
+    (tmp_path / "mnt").mkdir()
+    (tmp_path / "log").mkdir()
+    done = _in_private_mount(
+        FULL_DISK,
+        {
+            "MNT": str(tmp_path / "mnt"), "LOG": str(tmp_path / "log"), "TUNE": str(path),
+            "CLI": str(Path(sys.executable).with_name("cartpole-q")),
+        },
+    )  # fmt: skip
+    log = tmp_path / "log"
+    assert done.returncode == 0, done.stderr.decode()
+    err1 = (log / "err1").read_text()
+    assert (log / "rc1").read_text().strip() == "2", err1
+    assert "Traceback" not in err1
+    assert "study.journal: cannot be written: no space is left on the device" in err1
+    assert "cartpole-q tune --resume" in err1
+    assert (log / "rc2").read_text().strip() == "0", (log / "err2").read_text()
+    before = int((log / "complete_before").read_text())
+    with (log / "trials.csv").open(newline="") as file:
+        rows = list(csv.DictReader(file))
+    states = [row["state"] for row in rows]
+    assert states.count("complete") == 12
+    assert states.count("fail") <= 1, "at most the trial in flight is lost"
+    assert before >= 3

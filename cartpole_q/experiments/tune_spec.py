@@ -96,7 +96,7 @@ class TuneSpec:
 
     def config_for(self, values: Mapping[str, Any], where: str = "tune") -> Config:
         """The complete config of a trial: the base with the trial's values."""
-        return load_config(self.base, dict(values), source=f"{where}: base", override_source=where)
+        return load_config(self.base, dict(values), source=where, override_source=where)
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved tune file, as ``tune.yaml`` holds it."""
@@ -203,9 +203,8 @@ def _space(value: Any, where: str, base: dict[str, Any]) -> tuple[Dimension, ...
             tried = dimension.probes()
         for candidate in tried:
             source = f"{label} ({axis_cell(candidate)})"
-            config = load_config(
-                base, {key: candidate}, source=f"{where}: base", override_source=source
-            )
+            # The base was checked alone: whatever is wrong now comes with this value.
+            config = load_config(base, {key: candidate}, source=source, override_source=source)
             check_environment(config, source, checked)
         dimensions.append(dimension)
     check_overlaps([dimension.key for dimension in dimensions], where)
