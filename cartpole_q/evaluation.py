@@ -67,18 +67,24 @@ def under_conditions(
     config: Config,
     physics: Mapping[str, Any] | None = None,
     max_steps: int | None = None,
+    *,
+    source: str = "--physics",
 ) -> Config:
     """The config with other physics (merged onto its ``env.physics``) or another horizon.
 
     Checked like a config: an unknown key, a bad value, or physics on an environment that
-    is not CartPole is a ``ConfigError`` naming it (``eval --physics``, ``--max-steps``).
+    is not CartPole is a ``ConfigError`` naming it and ``source`` (the option that gave
+    the physics: ``eval --physics``, ``robustness --vary``; the horizon is ``--max-steps``).
     """
     overrides: dict[str, Any] = {}
     if physics:
         overrides["env.physics"] = {**config.env.physics, **physics}
     if max_steps is not None:
         overrides["env.kwargs.max_episode_steps"] = max_steps
-    return load_config(config.to_dict(), overrides) if overrides else config
+    if not overrides:
+        return config
+    label = source if physics else "--max-steps"
+    return load_config(config.to_dict(), overrides, source="run config", override_source=label)
 
 
 def evaluate(

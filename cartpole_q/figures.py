@@ -167,8 +167,10 @@ def _draw_reward_curves(
                 axes.axhline(own, color=colour, linestyle="--", linewidth=1.0,
                              label=f"{item.label}: reward threshold {own:g}")  # fmt: skip
     axes.set_xlabel("training episode")
-    axes.set_ylabel(_return_label(curves))
-    axes.set_title(title)
+    # A short axis label: a long one (what bold and faint mean) would be cut at the figure's
+    # edge, so that goes under the title instead.
+    axes.set_ylabel("return")
+    axes.set_title(f"{title}\n{_return_label(curves)}", fontsize="medium")
     axes.grid(alpha=0.3)
     axes.legend(loc="best", fontsize="small")
 
@@ -215,6 +217,8 @@ def policy_figure(
     names: Sequence[str],
     title: str,
     action_names: Sequence[str] | None = None,
+    value_name: str = "state value max_a Q",
+    rows_down: bool = False,
 ) -> Figure:
     """Greedy action, state value ``max_a Q`` and visit counts over two binned dimensions.
 
@@ -222,6 +226,7 @@ def policy_figure(
     state (uniformly where it never did); with one bin there, the maps are exact.
     States training never visited are shown blank. The greedy action has one colour per
     action, labelled ``"0: push left"`` and so on when ``action_names`` are given.
+    ``rows_down`` draws the first dimension downwards (a grid world's rows, as Taxi).
     """
     q_map, value_map, visit_map = project_policy(q_table, visits, dims)
     action_map = np.argmax(q_map, axis=-1).astype(float)
@@ -237,7 +242,7 @@ def policy_figure(
     visit_norm = LogNorm(vmin=1, vmax=max(float(visit_map.max()), 10.0))
     layers = (
         ("greedy action", np.ma.masked_where(unvisited, action_map), action_colours, action_norm),
-        ("state value max_a Q", np.ma.masked_where(unvisited, value_map), "viridis", None),
+        (value_name, np.ma.masked_where(unvisited, value_map), "viridis", None),
         ("training visits (log scale)", np.ma.masked_where(visit_map == 0, visit_map), "magma", visit_norm),
     )  # fmt: skip
     for axes, (name, data, cmap, norm) in zip(panels, layers, strict=True):
@@ -246,6 +251,8 @@ def policy_figure(
         axes.set_title(name)
         axes.set_xlabel(names[d_col])
         axes.set_ylabel(names[d_row])
+        if rows_down:  # a grid world's row 0 is its top row, as the world is drawn
+            axes.invert_yaxis()
         bar = figure.colorbar(image, ax=axes)
         if name == "greedy action":
             bar.set_ticks(list(range(n_actions)))
@@ -632,35 +639,124 @@ def sweep_figure(
             labels, name = axes[0].values, axes[0].name
         else:
             labels, name = list(point_ids), "point"
-        _sweep_errorbars(rate_axes, labels, name, statistics, "success_rate", "success rate")
+        # Along one axis neighbouring points are neighbours; along the point ids of three or
+        # more axes they are not, so no line joins them.
+        joined = len(axes) == 1
+        _sweep_errorbars(rate_axes, labels, name, statistics, "success_rate", "success rate",
+                         joined)  # fmt: skip
         rate_axes.set_ylim(-0.02, 1.02)
         _sweep_errorbars(solve_axes, labels, name, statistics, "median_solved_episode",
-                         "median solve episode (solved seeds)")  # fmt: skip
+                         "median solve episode (solved seeds)", joined)  # fmt: skip
     iqm = _column(statistics, "iqm_eval_return")
     order = [i for i in np.argsort(-np.nan_to_num(iqm, nan=-np.inf), kind="stable")
              if eval_means[i].size][:PROFILE_MAX_POINTS]  # fmt: skip
-    if order:
-        every = np.concatenate([eval_means[i] for i in order])
-        taus = np.linspace(float(every.min()), float(every.max()), 200)
-        colours = _colours(len(order))
-        for colour, i in zip(colours, order, strict=True):
-            fraction = (eval_means[i][:, None] >= taus[None, :]).mean(axis=0)
-            profile_axes.step(taus, fraction, where="post", color=colour,
-                              label=f"point {point_ids[i]}")  # fmt: skip
-    if threshold is not None:
-        profile_axes.axvline(
-            threshold, color="grey", linestyle="--", label=f"threshold {threshold:g}"
-        )
-    profile_axes.set_ylim(-0.02, 1.02)
-    profile_axes.set_xlabel("greedy eval mean return τ")
-    profile_axes.set_ylabel("fraction of seeds ≥ τ")
+    draw_profiles(
+        profile_axes,
+        [eval_means[i] for i in order],
+        [f"point {point_ids[i]}" for i in order],
+        threshold,
+        "greedy eval mean return τ",
+    )
     profile_axes.set_title(
         "performance profiles" + (" (best by IQM)" if len(point_ids) > len(order) else "")
     )
-    profile_axes.legend(loc="lower left", fontsize="x-small")
-    profile_axes.grid(alpha=0.3)
     figure.suptitle(f"Sweep {title}: 95% intervals (Wilson; bootstrap over seeds)")
     return figure
+
+
+def profile_thresholds(
+    scores: Sequence[np.ndarray], threshold: float | None = None, count: int = 200
+) -> np.ndarray:
+    """The thresholds ``τ`` a performance profile is drawn over.
+
+    From below the lowest score to above the highest (the threshold included), with a
+    margin, so that every step is visible, also when every seed has the same score.
+
+    >>> taus = profile_thresholds([np.array([500.0, 500.0])])
+    >>> bool(taus[0] < 500.0 < taus[-1])
+    True
+    """
+    every = np.concatenate([np.asarray(s, dtype=np.float64) for s in scores] or [np.zeros(0)])
+    points = [*every.tolist(), *([] if threshold is None else [threshold])]
+    if not points:
+        return np.linspace(0.0, 1.0, count)
+    low, high = min(points), max(points)
+    margin = 0.05 * (high - low) or max(1.0, 0.05 * abs(high))
+    return np.linspace(low - margin, high + margin, count)
+
+
+def draw_profiles(
+    axes: Axes,
+    scores: Sequence[np.ndarray],
+    labels: Sequence[str],
+    threshold: float | None,
+    xlabel: str,
+) -> None:
+    """Performance profiles: the fraction of seeds scoring at least ``τ``, per run or point."""
+    taus = profile_thresholds(scores, threshold)
+    for colour, values, label in zip(_colours(len(scores)), scores, labels, strict=True):
+        fraction = (np.asarray(values)[:, None] >= taus[None, :]).mean(axis=0)
+        axes.step(taus, fraction, where="post", color=colour, label=label)
+    if threshold is not None:
+        axes.axvline(threshold, color="grey", linestyle="--", label=f"threshold {threshold:g}")
+    axes.set_ylim(-0.02, 1.02)
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel("fraction of seeds ≥ τ")
+    axes.legend(loc="lower left", fontsize="x-small")
+    axes.grid(alpha=0.3)
+
+
+def compare_figure(data: dict[str, Any], title: str) -> Figure:
+    """The aggregate picture of several runs, as rliable draws it.
+
+    IQM and optimality gap with 95% stratified-bootstrap intervals, and performance
+    profiles.
+
+    Args:
+        data: from :func:`cartpole_q.experiments.compare.compare_figure_data`.
+        title: the figure's title.
+    """
+    gaps = [gap for gap in data["gap"] if gap is not None]
+    panels = 3 if gaps else 2
+    height = max(SWEEP_PANEL_SIZE[1], 1.0 + 0.45 * len(data["labels"]))
+    figure = Figure(figsize=(SWEEP_PANEL_SIZE[0] * panels, height), dpi=DPI,
+                    layout="constrained")  # fmt: skip
+    axes = figure.subplots(1, panels)
+    rows = np.arange(len(data["labels"]))[::-1]
+    colours = _colours(len(data["labels"]))
+    _interval_rows(axes[0], rows, data["iqm"], colours, data["labels"])
+    axes[0].set_title(
+        "IQM (higher is better)" if data["higher_is_better"] else "IQM (lower is better)"
+    )
+    axes[0].set_xlabel(data["metric"])
+    if gaps:
+        _interval_rows(axes[1], rows, data["gap"], colours, data["labels"])
+        axes[1].set_title(f"optimality gap below {data['target']:g} (lower is better)")
+        axes[1].set_xlabel("mean shortfall per seed")
+    draw_profiles(axes[-1], data["values"], data["labels"], data["target"], data["metric"] + " τ")
+    axes[-1].set_title("performance profiles")
+    figure.suptitle(f"{title}: 95% stratified-bootstrap intervals over seeds")
+    return figure
+
+
+def _interval_rows(
+    axes: Axes,
+    rows: np.ndarray,
+    figures: Sequence[tuple[float, float, float] | None],
+    colours: Sequence[tuple[float, ...]],
+    labels: Sequence[str],
+) -> None:
+    """One horizontal interval per run, its point estimate marked."""
+    for row, item, colour in zip(rows, figures, colours, strict=True):
+        if item is None or not np.isfinite(item[0]):
+            continue
+        value, low, high = item
+        axes.plot([low, high], [row, row], color=colour, linewidth=6, alpha=0.45,
+                  solid_capstyle="butt")  # fmt: skip
+        axes.plot([value], [row], marker="|", color="black", markersize=14)
+    axes.set_yticks(rows, labels, fontsize="small")
+    axes.set_ylim(-0.7, len(rows) - 0.3)
+    axes.grid(axis="x", alpha=0.3)
 
 
 def _column(statistics: Sequence[dict[str, float | int | None]], name: str) -> np.ndarray:
@@ -683,6 +779,7 @@ def _sweep_errorbars(
     statistics: Sequence[dict[str, float | int | None]],
     column: str,
     ylabel: str,
+    joined: bool = True,
 ) -> None:
     values = _column(statistics, column)
     low = _column(statistics, f"{column}_low")
@@ -690,7 +787,8 @@ def _sweep_errorbars(
     numbers = _numeric(labels)
     positions = numbers if numbers is not None else np.arange(len(labels), dtype=float)
     errors = np.vstack([np.clip(values - low, 0, None), np.clip(high - values, 0, None)])
-    axes.errorbar(positions, values, yerr=np.nan_to_num(errors), marker="o", capsize=4)
+    axes.errorbar(positions, values, yerr=np.nan_to_num(errors), marker="o", capsize=4,
+                  linestyle="-" if joined else "none")  # fmt: skip
     if numbers is None:
         axes.set_xticks(positions, labels, rotation=30, ha="right", fontsize="small")
     elif np.all(numbers > 0) and numbers.max() / numbers.min() >= 100:

@@ -144,3 +144,19 @@ def configure() -> None:
     if os.environ.get("NUMBA_CACHE_DIR"):
         return
     numba.config.CACHE_DIR = str(choose_cache_dir())  # type: ignore[attr-defined]
+
+
+def is_cached(function_name: str) -> bool:
+    """Whether numba's cache holds compiled code of a function named ``function_name``.
+
+    numba names a cached function's index ``<module>.<name>-<line>.py<version>.nbi``.
+    Used to say, before a first run compiles for seconds, that it is compiling.
+    """
+    configure()
+    import numba
+
+    root = Path(os.environ.get("NUMBA_CACHE_DIR") or numba.config.CACHE_DIR)  # type: ignore[attr-defined]
+    try:
+        return any(root.rglob(f"*.{function_name}-*.nbi"))
+    except OSError:
+        return False

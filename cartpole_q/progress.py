@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import dataclass
 from typing import IO, Any, Protocol
 
 from cartpole_q.training import Progress
@@ -246,8 +247,21 @@ class NullSweepProgress:
         """Ignore."""
 
 
+@dataclass(frozen=True)
+class Units:
+    """What a many-runs progress display counts: ``sweep: 10/100 runs, 1/10 points``."""
+
+    title: str = "sweep"
+    items: str = "runs"
+    groups: str = "points"
+
+
+ROBUSTNESS_UNITS = Units("robustness", "evaluations", "grid points")
+"""``robustness`` counts (seed, grid point) evaluations and complete grid points"""
+
+
 def sweep_line(done_runs: int, total_runs: int, done_points: int, total_points: int,
-               rate: float, eta: float | None) -> str:  # fmt: skip
+               rate: float, eta: float | None, units: Units = Units()) -> str:  # fmt: skip
     """One plain line of sweep progress.
 
     >>> sweep_line(1000, 10000, 10, 100, 171.4, 52.5)
@@ -255,15 +269,16 @@ def sweep_line(done_runs: int, total_runs: int, done_points: int, total_points: 
     """
     tail = "" if eta is None else f", eta {eta:.0f} s"
     return (
-        f"sweep: {done_runs:,}/{total_runs:,} runs, {done_points}/{total_points} points, "
-        f"{rate:,.0f} runs/s{tail}"
+        f"{units.title}: {done_runs:,}/{total_runs:,} {units.items}, {done_points}/"
+        f"{total_points} {units.groups}, {rate:,.0f} {units.items}/s{tail}"
     )
 
 
 class PlainSweepProgress:
     """A plain line every tenth of the sweep (for logs, pipes and CI)."""
 
-    def __init__(self, stream: IO[str] | None = None) -> None:
+    def __init__(self, stream: IO[str] | None = None, units: Units = Units()) -> None:
+        self._units = units
         self._stream = stream or sys.stdout
         self._total = self._points = self._first = 0
         self._next = 0
@@ -281,7 +296,7 @@ class PlainSweepProgress:
             return
         self._next = done_runs + max(1, self._total // 10)
         rate, eta = _rate_and_eta(self._started, done_runs - self._first, self._total - done_runs)
-        line = sweep_line(done_runs, self._total, done_points, self._points, rate, eta)
+        line = sweep_line(done_runs, self._total, done_points, self._points, rate, eta, self._units)
         print(line, file=self._stream, flush=True)
 
     def close(self) -> None:
@@ -297,16 +312,16 @@ def _rate_and_eta(started: float, runs: int, left: int) -> tuple[float, float | 
 class RichSweepProgress:
     """A live bar: runs done of all, points complete, runs per second, time left."""
 
-    def __init__(self, console: Any | None = None) -> None:
+    def __init__(self, console: Any | None = None, units: Units = Units()) -> None:
         from rich.console import Console
         from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeRemainingColumn
         from rich.progress import Progress as RichProgress
 
         self._progress = RichProgress(
-            TextColumn("[bold]sweep"),
+            TextColumn(f"[bold]{units.title}"),
             BarColumn(bar_width=None),
             MofNCompleteColumn(),
-            TextColumn("runs  {task.fields[points]}  {task.fields[rate]}"),
+            TextColumn(units.items + "  {task.fields[points]}  {task.fields[rate]}"),
             TextColumn("eta"),
             TimeRemainingColumn(),
             console=console or Console(),
@@ -316,13 +331,14 @@ class RichSweepProgress:
         self._task: Any = None
         self._points = self._first = 0
         self._started = 0.0
+        self._units = units
 
     def start(self, total_runs: int, done_runs: int, total_points: int, done_points: int) -> None:
         """Show the bar."""
         self._points, self._first, self._started = total_points, done_runs, time.monotonic()
         self._task = self._progress.add_task(
             "sweep", total=total_runs, completed=done_runs,
-            points=f"{done_points}/{total_points} points", rate="",
+            points=f"{done_points}/{total_points} {self._units.groups}", rate="",
         )  # fmt: skip
         self._progress.start()
         self._progress.refresh()
@@ -331,8 +347,9 @@ class RichSweepProgress:
         """Move the bar."""
         rate, _ = _rate_and_eta(self._started, done_runs - self._first, 0)
         self._progress.update(
-            self._task, completed=done_runs, points=f"{done_points}/{self._points} points",
-            rate=f"{rate:,.0f} runs/s",
+            self._task, completed=done_runs,
+            points=f"{done_points}/{self._points} {self._units.groups}",
+            rate=f"{rate:,.0f} {self._units.items}/s",
         )  # fmt: skip
         self._progress.refresh()
 
@@ -341,11 +358,15 @@ class RichSweepProgress:
         self._progress.stop()
 
 
-def make_sweep_progress(quiet: bool, stream: IO[str] | None = None) -> SweepProgress:
+def make_sweep_progress(
+    quiet: bool, stream: IO[str] | None = None, units: Units = Units()
+) -> SweepProgress:
     """The sweep's progress display: none when quiet, a bar on a terminal, else lines."""
     stream = stream or sys.stdout
     if quiet:
         return NullSweepProgress()
     if stream.isatty():
-        return RichSweepProgress()
-    return PlainSweepProgress(stream)
+        from rich.console import Console
+
+        return RichSweepProgress(Console(file=stream), units)
+    return PlainSweepProgress(stream, units)

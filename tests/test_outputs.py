@@ -218,11 +218,17 @@ def test_plot_writes_into_the_run_directory_by_default(
 ) -> None:
     run = tmp_path / "copy"
     shutil.copytree(run_dir, run)
+    (run / "reward_curve.png").unlink()
     result = invoke("plot", run)
-    assert result.exit_code == 0 and result.stdout.strip() == str(run / "reward_curves.png")
+    # the figure training draws, under the same name, redrawn in place
+    assert result.exit_code == 0 and result.stdout.strip() == str(run / "reward_curve.png")
+    assert (run / "reward_curve.png").is_file()
+    assert invoke("plot", run).exit_code == 0
     result = invoke("plot", run, "--policy")
     assert result.exit_code == 0 and result.stdout.strip() == str(run / "policy_map.png")
-    _refused(invoke("plot", run), "already exists")
+    assert invoke("plot", run, "--policy").exit_code == 0
+    # an explicit --out is never replaced without --force
+    _refused(invoke("plot", run, "--out", run / "policy_map.png"), "already exists")
     # several runs: the current directory
     result = invoke("plot", run, run_dir)
     assert result.exit_code == 0 and result.stdout.strip() == "reward_curves.png"

@@ -245,23 +245,23 @@ def test_multi_seed_eval_names_missing_and_unfinished_seeds(
     shutil.rmtree(seed_dir(parent, 1, SEEDS))
     _mark_interrupted(seed_dir(parent, 2, SEEDS))
     note = (
-        f"{parent}: 2 of 3 seeds not evaluated: seed-001 is missing; seed-002 has not "
+        f"{parent}: 2 of 3 seeds left out: seed-001 is missing; seed-002 has not "
         f"finished (finish them with `cartpole-q train --resume {parent}`)"
     )
 
     result = invoke("eval", parent, "--episodes", 2, "--workers", 1)
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
-    assert [line.split(":")[0] for line in lines[:-2]] == ["seed 0"]
-    assert lines[-2].startswith(f"{parent}: 1/1 finished seeds with greedy mean >= 475")
-    assert lines[-1] == note
+    assert [line.split(":")[0] for line in lines[:-1]] == ["seed 0"]
+    assert lines[-1].startswith(f"{parent}: 1/1 finished seeds with greedy mean >= 475")
+    assert result.stderr.strip() == f"note: {note}"
 
     result = invoke("eval", parent, "--episodes", 2, "--workers", 1, "--json")
     assert result.exit_code == 0, result.output
     report = json.loads(result.stdout)
     assert [run["run_seed"] for run in report["runs"]] == [0] and report["seeds"] == 3
     assert report["missing"] == ["seed-001"] and report["unfinished"] == ["seed-002"]
-    assert result.stderr.strip() == f"warning: {note}"
+    assert result.stderr.strip() == f"note: {note}"
 
     shutil.rmtree(seed_dir(parent, 0, SEEDS))
     result = invoke("eval", parent, "--episodes", 2)

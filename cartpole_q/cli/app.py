@@ -12,7 +12,7 @@ from __future__ import annotations
 import dataclasses
 import json
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated, Any
@@ -280,6 +280,7 @@ def train(
             resolve_config_path,
         )
         from cartpole_q.experiments import run as runner
+        from cartpole_q.store.lock import directory_lock
 
         if resume is not None:
             given = {
@@ -292,9 +293,13 @@ def train(
                     f"--resume continues a run exactly as it was configured, so it cannot be "
                     f"combined with {', '.join(clashing)} (only --episodes, to extend it)."
                 )
-            prepared = runner.prepare_resume(resume, episodes)
-            _check_viewing(prepared.config.train.seeds, watch, video_every)
-            run_dir = resume
+            # One writer per run directory; a path that is none gets prepare_resume's message.
+            locked = directory_lock(resume, "run") if resume.is_dir() else nullcontext()
+            with locked:
+                prepared = runner.prepare_resume(resume, episodes)
+                _check_viewing(prepared.config.train.seeds, watch, video_every)
+                _train_into(resume, prepared, True, workers, quiet, watch, video_every, seed_plots)
+            return
         else:
             if seed is not None and seeds is not None:
                 raise UserError("give either --seed (one run) or --seeds (several), not both.")
@@ -312,9 +317,19 @@ def train(
             file = str(resolve_config_path(config)) if config else "default config"
             prepared = runner.prepare(loaded, Provenance(file, tuple(overrides)))
             run_dir = runner.start_run(prepared, out)
-        _train_into(
-            run_dir, prepared, resume is not None, workers, quiet, watch, video_every, seed_plots
-        )
+        with directory_lock(run_dir, "run"):
+            _train_into(run_dir, prepared, False, workers, quiet, watch, video_every, seed_plots)
+
+
+def _say_if_compiling(config: Any) -> None:
+    """Tell the user when the first run will compile the training loop (seconds, once)."""
+    from cartpole_q.engines import compile_notice, resolve_engine
+    from cartpole_q.envs.gym import inspect_env
+
+    info = inspect_env(config)
+    notice = compile_notice(config, info, resolve_engine(config, info))
+    if notice is not None:
+        typer.echo(notice, err=True)
 
 
 def _check_viewing(seeds: Any, watch: int, video_every: int) -> None:
@@ -347,6 +362,8 @@ def _train_into(
     from cartpole_q.progress import make_reporter
 
     seeds = prepared.config.train.seeds
+    if not quiet:
+        _say_if_compiling(prepared.config)
     reporter = make_reporter(quiet)
     resume_hint = f"resume with `cartpole-q train --resume {run_dir}`"
     stopped_at_once = False
@@ -471,18 +488,22 @@ def eval_command(
     with _exit_codes():
         from cartpole_q.cli.report import eval_line
         from cartpole_q.config import parse_assignment
-        from cartpole_q.store import rundir
+        from cartpole_q.experiments.multiseed import conditions_of
+        from cartpole_q.store.runsets import load_run_set
 
         changed = dict(parse_assignment(text, "--physics") for text in physics or [])
-        if rundir.is_multi_seed(run_dir):
+        run_set = load_run_set(run_dir)
+        for note in run_set.notes:
+            typer.echo(f"note: {note}", err=True)
+        if run_set.kind != "run":
             if video is not None or render:
                 raise UserError(
-                    f"{run_dir}: is a multi-seed run; --video and --render take one seed's "
-                    "run directory (one of its seed-* subdirectories)."
+                    f"{run_dir}: is a {run_set.kind}; --video and --render play one run: give "
+                    "one seed's run directory (a multi-seed run's seed-* subdirectory)."
                 )
-            _eval_seeds(run_dir, episodes, seed, json_output, workers, changed, max_steps)
+            _eval_seeds(run_set, episodes, seed, json_output, workers, changed, max_steps)
             return
-        run = rundir.load_run(run_dir)
+        run = run_set.runs[0]
         threshold = run.summary.get("reward_threshold")
         if changed or max_steps is not None:
             from cartpole_q.envs.gym import inspect_env
@@ -507,10 +528,13 @@ def eval_command(
 
         exact = exact_report(run.config, run.q_table)  # a sentence when there is no model
         extra = {} if isinstance(exact, str) else {"exact": exact.to_dict()}
+        conditions = conditions_of(changed, max_steps)
+        if conditions:
+            extra["conditions"] = conditions
         if json_output:
             typer.echo(json.dumps({**report.to_dict(), **extra}))
         else:
-            typer.echo(eval_line(run_dir, report.to_dict(), threshold))
+            typer.echo(eval_line(run_dir, report.to_dict(), threshold, conditions))
             for line in exact_lines(extra["exact"]) if extra else []:
                 typer.echo(line)
             if video is not None:
@@ -547,7 +571,7 @@ def _evaluate_run(
 
 
 def _eval_seeds(
-    parent: Path,
+    run_set: Any,
     episodes: int | None,
     seed: int | None,
     json_output: bool,
@@ -559,14 +583,13 @@ def _eval_seeds(
     from cartpole_q.experiments.multiseed import evaluate_seeds
 
     result = evaluate_seeds(
-        parent, episodes=episodes, seed=seed, workers=workers, physics=physics, max_steps=max_steps
-    )
+        run_set, episodes=episodes, seed=seed, workers=workers, physics=physics,
+        max_steps=max_steps,
+    )  # fmt: skip
     if json_output:
         typer.echo(json.dumps(result))
-        if result["note"]:
-            typer.echo(f"warning: {result['note']}", err=True)
     else:
-        typer.echo(eval_seeds_text(parent, result))
+        typer.echo(eval_seeds_text(run_set.path, result))
         if "exact" in result:
             from cartpole_q.cli.exact_text import exact_seeds_line
 
@@ -588,8 +611,9 @@ def plot(
         typer.Option(
             metavar="FILE",
             help="The figure to write: .png, .svg or .pdf, as its extension says.",
-            show_default="RUN_DIR/reward_curves.png, or RUN_DIR/policy_map.png with --policy; "
-            "with several run directories, reward_curves.png in the current directory",
+            show_default="RUN_DIR/reward_curve.png, or RUN_DIR/policy_map.png with --policy "
+            "(both redrawn in place); with several run directories, reward_curves.png in the "
+            "current directory",
         ),
     ] = None,
     force: Annotated[bool, typer.Option("--force", help="Replace the file if it exists.")] = False,
@@ -608,22 +632,40 @@ def plot(
             show_default="the two with the most bins (pole angle, angular velocity)",
         ),
     ] = None,
+    seed: Annotated[
+        int | None,
+        typer.Option(
+            metavar="N",
+            min=0,
+            max=MAX_SEED,
+            help="With --policy on several seeds: draw this seed's policy.",
+            show_default="the seeds' majority action and their agreement",
+        ),
+    ] = None,
 ) -> None:
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with _exit_codes():
         from cartpole_q.experiments.plots import plot_policy, plot_rewards
+        from cartpole_q.store.rundir import CURVE_FILE
+
+        def note(text: str) -> None:
+            typer.echo(f"note: {text}", err=True)
 
         if policy:
             if len(run_dirs) != 1:
                 raise UserError("--policy draws one run: give exactly one run directory.")
-            path = plot_policy(run_dirs[0], out or run_dirs[0] / "policy_map.png", dims, force)
+            default = run_dirs[0] / "policy_map.png"
+            path = plot_policy(
+                run_dirs[0], out or default, dims, force or out is None, seed, on_note=note
+            )
         else:
-            if dims is not None:
-                raise UserError("--dims only applies to --policy.")
-            default = Path("reward_curves.png")
-            if len(run_dirs) == 1:
-                default = run_dirs[0] / default
-            path = plot_rewards(run_dirs, out or default, force)
+            if dims is not None or seed is not None:
+                raise UserError("--dims and --seed only apply to --policy.")
+            # One directory: its own reward_curve.png (the figure training draws, from the
+            # same files); several: one figure of them all here.
+            default = run_dirs[0] / CURVE_FILE if len(run_dirs) == 1 else Path("reward_curves.png")
+            replace = force or (out is None and len(run_dirs) == 1)
+            path = plot_rewards(run_dirs, out or default, replace, on_note=note)
         typer.echo(str(path))
 
 
@@ -677,25 +719,46 @@ def robustness_command(
             metavar="N", min=1, help="Play with this time limit instead of the run's own."
         ),
     ] = None,
+    yes: Annotated[
+        bool,
+        typer.Option(
+            "--yes", "-y", help="Play however many greedy episodes it takes (above 5,000,000)."
+        ),
+    ] = False,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="Print nothing but the two files' paths.")
+    ] = False,
 ) -> None:
     """The greedy policy's mean return as CartPole's physics vary: a CSV and a plot."""
     with _exit_codes():
+        import sys
+
         from cartpole_q.experiments.robustness import parse_vary, preset_axes, robustness
+        from cartpole_q.progress import ROBUSTNESS_UNITS, make_sweep_progress
 
         if (preset is None) == (not vary):
             raise UserError("give --vary KEY=START:STOP:N (once or twice) or --preset NAME.")
         axes = preset_axes(preset, points) if preset else [parse_vary(text) for text in vary or []]
         figure, table = robustness(
-            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force, max_steps
-        )
+            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force, max_steps,
+            yes=yes, progress=make_sweep_progress(quiet, sys.stderr, ROBUSTNESS_UNITS),
+            on_note=lambda note: typer.echo(f"note: {note}", err=True),
+        )  # fmt: skip
         typer.echo(str(table))
         typer.echo(str(figure))
 
 
 @app.command("compare", cls=_Command)
 def compare_command(
-    dir_a: Annotated[Path, typer.Argument(metavar="DIR_A", help="A run or multi-seed run.")],
-    dir_b: Annotated[Path, typer.Argument(metavar="DIR_B", help="Another one.")],
+    runs: Annotated[
+        list[Path],
+        typer.Argument(
+            metavar="RUN",
+            help="Two or more runs to compare: run directories, multi-seed runs or sweep "
+            "points (SWEEP_DIR/points/NNN).",
+            show_default=False,
+        ),
+    ],
     metric: Annotated[
         str,
         typer.Option(
@@ -703,16 +766,43 @@ def compare_command(
             help="eval_mean (higher is better) or solved_episode (lower is better).",
         ),
     ] = "eval_mean",
+    out: Annotated[
+        Path | None,
+        typer.Option(
+            metavar="FILE",
+            help="Also draw IQM and optimality gap with intervals, and performance profiles, "
+            "as FILE (.png, .svg or .pdf).",
+        ),
+    ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(
+            "--force",
+            help="Compare runs of different environments or thresholds anyway; with --out, "
+            "replace the file.",
+        ),
+    ] = False,
     json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
 ) -> None:
-    """The probability that a seed of DIR_A beats a seed of DIR_B, with a 95% interval."""
+    """The probability that a seed of one run beats a seed of another, for every pair, with 95% intervals."""
     with _exit_codes():
         from cartpole_q.experiments.compare import compare, summary_text
 
-        result = compare(dir_a, dir_b, metric)
-        typer.echo(
-            json.dumps(result.to_dict()) if json_output else summary_text(dir_a, dir_b, result)
-        )
+        if len(runs) < 2:
+            raise UserError("compare needs at least two runs.")
+        if out is not None:
+            from cartpole_q.figures import FIGURE_FORMATS
+            from cartpole_q.store.atomic import check_output_file
+
+            check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+        result = compare(runs, metric, force=force)
+        for note in result.notes:
+            typer.echo(f"note: {note}", err=True)
+        typer.echo(json.dumps(result.to_dict()) if json_output else summary_text(result))
+        if out is not None:
+            from cartpole_q.experiments.plots import write_compare_figure
+
+            typer.echo(str(write_compare_figure(result, out)))
 
 
 class BackendChoice(StrEnum):
@@ -874,6 +964,8 @@ def _run_sweep(
     from cartpole_q.experiments.workers import default_workers
     from cartpole_q.progress import make_sweep_progress
 
+    if not quiet:
+        _say_if_compiling(spec.points[0].config)
     progress = make_sweep_progress(quiet)
     hint = f"finish it with `cartpole-q sweep --resume {directory}`"
     with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
@@ -913,7 +1005,8 @@ def optimum_command(
             metavar="G",
             min=0.0,
             max=1.0,
-            help="Also give the optimal discounted return with this discount (no time limit).",
+            help="Also give the optimal discounted return with this discount in [0, 1) (no time "
+            "limit, so it must be below 1).",
         ),
     ] = None,
     json_output: Annotated[bool, typer.Option("--json", help="Print one JSON object.")] = False,
@@ -926,6 +1019,12 @@ def optimum_command(
         from cartpole_q.envs.models import grid_layout
         from cartpole_q.evaluation import exact_report
 
+        if gamma is not None and gamma >= 1.0:
+            raise UserError(
+                "--gamma 1: the discounted optimum needs a discount below 1 (with no time limit, "
+                "undiscounted returns may not converge); the undiscounted optimum within the "
+                "time limit is printed without --gamma."
+            )
         overrides: dict[str, Any] = {"env.id": env_id}
         for key, value in map(parse_assignment, set_values or []):
             if key != "env" and not key.startswith("env."):
@@ -1102,6 +1201,8 @@ def _tune(
             typer.echo(f"trial {trial['number']}: {rate_text}IQM {iqm:.1f} ({shown})")
 
     hint = f"go on with `cartpole-q tune --resume {directory}`"
+    if not quiet:
+        _say_if_compiling(spec.config_for({}))
     with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
         try:
             outcome = tuning.run_tune(

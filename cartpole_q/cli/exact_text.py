@@ -26,15 +26,24 @@ def exact_lines(exact: dict[str, Any]) -> list[str]:
         return lines
     lines = [
         f"exact ({exact['note']}): greedy {greedy['return']:.6g}, optimum "
-        f"{optimum['return']:.6g}, gap {gap['return']:.4g}"
+        f"{optimum['return']:.6g}, gap {_gap(gap['return'])}"
     ]
     if "discounted" in greedy:
         lines.append(
             f"exact, discounted (gamma {optimum['gamma']:g}, no time limit): greedy "
             f"{greedy['discounted']:.6g}, optimum {optimum['discounted']:.6g}, gap "
-            f"{gap['discounted']:.4g}"
+            f"{_gap(gap['discounted'])}"
         )
     return lines
+
+
+def _gap(value: float) -> str:
+    """A gap as text: rounding noise (a greedy value 1e-11 above the optimum) shows as 0.
+
+    >>> _gap(-1.641e-11), _gap(0.0041), _gap(2e-12)
+    ('0', '0.0041', '0')
+    """
+    return "0" if abs(value) < 1e-9 else f"{value:.4g}"
 
 
 def exact_seeds_line(summary: dict[str, Any]) -> str:

@@ -136,12 +136,20 @@ def print_multi_summary(run_dir: Path, summary: dict[str, Any]) -> None:
     _print_rows("Multi-seed summary", _rows_multi(run_dir, summary))
 
 
-def eval_line(run_dir: Path, report: dict[str, Any], threshold: float | None) -> str:
-    """One line reporting a greedy evaluation.
+def eval_line(
+    run_dir: Path,
+    report: dict[str, Any],
+    threshold: float | None,
+    conditions: dict[str, Any] | None = None,
+) -> str:
+    """One line reporting a greedy evaluation (and the conditions it played under).
 
     >>> eval_line(Path("runs/a"), {"mean": 500.0, "std": 0.0, "min": 500.0, "max": 500.0,
     ...     "episodes": 100, "seed": 7}, 475.0)
     'runs/a: greedy mean 500.00 +/- 0.00 (min 500, max 500) over 100 episodes from seed 7 [>= 475: yes]'
+    >>> eval_line(Path("a"), {"mean": 9.0, "std": 0.0, "min": 9, "max": 9, "episodes": 1,
+    ...     "seed": 0}, None, {"physics": {"length": 0.75}, "max_steps": 1000})
+    'a: greedy mean 9.00 +/- 0.00 (min 9, max 9) over 1 episodes from seed 0, under physics length=0.75, time limit 1000'
     """
     verdict = ""
     if threshold is not None:
@@ -149,33 +157,52 @@ def eval_line(run_dir: Path, report: dict[str, Any], threshold: float | None) ->
     return (
         f"{run_dir}: greedy mean {report['mean']:.2f} +/- {report['std']:.2f} "
         f"(min {report['min']:g}, max {report['max']:g}) over {report['episodes']} episodes "
-        f"from seed {report['seed']}{verdict}"
+        f"from seed {report['seed']}{conditions_text(conditions)}{verdict}"
     )
 
 
-def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
-    """Lines reporting the greedy evaluation of every seed of a multi-seed run.
+def conditions_text(conditions: dict[str, Any] | None) -> str:
+    """``, under physics length=0.75, time limit 1000`` (empty without changed conditions)."""
+    if not conditions:
+        return ""
+    parts = []
+    if conditions.get("physics"):
+        shown = ", ".join(f"{key}={value:g}" if isinstance(value, float) else f"{key}={value}"
+                          for key, value in conditions["physics"].items())  # fmt: skip
+        parts.append(f"physics {shown}")
+    if conditions.get("max_steps") is not None:
+        parts.append(f"time limit {conditions['max_steps']}")
+    return ", under " + ", ".join(parts)
 
-    The last line, when some seeds were left out, names them (``result["note"]``).
+
+def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
+    """Lines reporting the greedy evaluation of every seed of a multi-seed run or sweep point.
+
+    Where the environment's exact optimum is known, the headline counts the seeds within
+    0.01 of it instead of a reward threshold no policy may reach.
     """
     lines = [
         f"seed {run['run_seed']}: mean {run['mean']:.2f} +/- {run['std']:.2f} (min {run['min']:g}, max {run['max']:g})"
         for run in result["runs"]
     ]
-    note = result.get("note")
+    finished = "finished " if result.get("note") else ""
+    count = len(result["runs"])
     threshold = result["reward_threshold"]
-    reached = (
-        f"{result['successes']}/{len(result['runs'])} {'finished ' if note else ''}"
-        f"seeds with greedy mean >= {threshold:g}"
-        if threshold is not None
-        else f"{len(result['runs'])} {'finished ' if note else ''}seeds (no reward threshold)"
-    )
+    exact = result.get("exact")
+    if exact is not None:
+        reached = (
+            f"{exact['within_0.01']}/{count} {finished}seeds within 0.01 of the optimum "
+            f"{exact['optimum']:.4g} (exact)"
+        )
+    elif threshold is not None:
+        reached = f"{result['successes']}/{count} {finished}seeds with greedy mean >= {threshold:g}"
+    else:
+        reached = f"{count} {finished}seeds (no reward threshold)"
     lines.append(
-        f"{parent}: {reached} over {result['episodes']} episodes each in gymnasium.make; "
-        f"mean of means {result['mean']:.2f}, lowest {result['min']:.2f}"
+        f"{parent}: {reached} over {result['episodes']} episodes each in gymnasium.make"
+        f"{conditions_text(result.get('conditions'))}; mean of means {result['mean']:.2f}, "
+        f"lowest {result['min']:.2f}"
     )
-    if note:
-        lines.append(note)
     return "\n".join(lines)
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from cartpole_q.config import Config, ConfigError, Provenance, blame
+from cartpole_q.config import ALGORITHMS, Config, ConfigError, Provenance, blame
 from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
@@ -64,3 +64,33 @@ def make_engine(
 
     step_cap = None if env_info.max_episode_steps else GREEDY_STEP_CAP
     return GymnasiumEngine(config, params, env_seed, env_rng_state, step_cap)
+
+
+def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None:
+    """What to tell a user before a run whose compiled loop is not in numba's cache yet.
+
+    Returns:
+        A sentence (the first run on a machine compiles for several seconds), or ``None``
+        when the loop is cached.
+    """
+    from cartpole_q.numba_cache import is_cached
+
+    algorithm = ALGORITHMS.index(config.agent.algorithm)
+    if engine == "numba":
+        from cartpole_q.envs.registry import TwinSettings, twin_settings
+
+        settings = twin_settings(
+            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
+        )
+        assert isinstance(settings, TwinSettings)
+        name = f"train_episodes_{algorithm}_{settings.code}"
+        seconds = "about 10 s"
+    else:
+        name = f"next_step_{algorithm}"
+        seconds = "a few seconds"
+    if is_cached(name):
+        return None
+    return (
+        f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "
+        f"({engine} engine): once per machine and version, {seconds}..."
+    )

@@ -31,12 +31,7 @@ from cartpole_q.experiments.workers import (
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import write_json
-
-
-def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
-    """The subdirectory of one seed: ``seed-007`` when the largest seed has up to 3 digits."""
-    width = max(3, len(str(max(seeds))))
-    return parent / f"seed-{seed:0{width}d}"
+from cartpole_q.store.runsets import RunSet, seed_dir
 
 
 def run_seeds(
@@ -229,90 +224,24 @@ def aggregate(
     }
 
 
-def load_seed_runs(parent: Path) -> list[rundir.Run]:
-    """Load every seed run of a multi-seed parent directory that has a result.
-
-    Raises:
-        RunError: no seed run of ``parent`` is complete.
-    """
-    config = load_config(parent / rundir.CONFIG_FILE)
-    seeds = config.train.seeds
-    assert seeds is not None
-    runs = [
-        rundir.load_run(seed_dir(parent, seed, seeds))
-        for seed in seeds
-        if (seed_dir(parent, seed, seeds) / rundir.SUMMARY_FILE).is_file()
-    ]
-    if not runs:
-        raise RunError(f"{parent}: none of its seed runs has finished.")
-    return runs
-
-
-@dataclasses.dataclass(frozen=True)
-class SeedStatus:
-    """Which seeds of a multi-seed run have finished, and why the others have not."""
-
-    finished: list[tuple[int, Path]]
-    missing: list[tuple[int, Path]]  # no directory
-    unfinished: list[tuple[int, Path]]  # not started, interrupted or killed
-
-    def note(self, parent: Path) -> str | None:
-        """One line naming the seeds left out, or None when every seed finished."""
-        if not self.missing and not self.unfinished:
-            return None
-        total = len(self.finished) + len(self.missing) + len(self.unfinished)
-        parts = []
-        if self.missing:
-            parts.append(
-                f"{_names(self.missing)} {'is' if len(self.missing) == 1 else 'are'} missing"
-            )
-        if self.unfinished:
-            verb = "has" if len(self.unfinished) == 1 else "have"
-            parts.append(f"{_names(self.unfinished)} {verb} not finished")
-        return (
-            f"{parent}: {len(self.missing) + len(self.unfinished)} of {total} seeds not evaluated: "
-            f"{'; '.join(parts)} (finish them with `cartpole-q train --resume {parent}`)"
-        )
-
-
-def _names(items: list[tuple[int, Path]], limit: int = 8) -> str:
-    names = [path.name for _, path in items]
-    shown = ", ".join(names[:limit])
-    return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
-
-
-def seed_status(parent: Path) -> SeedStatus:
-    """Sort the seeds of a multi-seed run into finished, missing and unfinished."""
-    config = load_config(parent / rundir.CONFIG_FILE)
-    seeds = config.train.seeds
-    assert seeds is not None
-    status = SeedStatus([], [], [])
-    for seed in seeds:
-        child = seed_dir(parent, seed, seeds)
-        if not child.is_dir():
-            status.missing.append((seed, child))
-        elif _finished(child):
-            status.finished.append((seed, child))
-        else:
-            status.unfinished.append((seed, child))
-    return status
-
-
 def _evaluate_one(
     handle: JobHandle | None,
-    path: str,
+    name: str,
+    config_mapping: dict[str, Any],
+    q_table: np.ndarray,
     episodes: int | None,
     seed: int | None,
     physics: dict[str, Any] | None = None,
     max_steps: int | None = None,
 ) -> dict[str, Any]:
+    """Job: one seed's greedy evaluation in ``gymnasium.make`` (and its exact figures)."""
     from cartpole_q.evaluation import evaluate, exact_report, under_conditions
 
-    run = rundir.load_run(path)
-    config = under_conditions(run.config, physics, max_steps)
-    report = evaluate(run.q_table, config, episodes=episodes, seed=seed)
-    result = {"run_seed": run.config.seed, "path": run.path.name, **report.to_dict()}
-    exact = exact_report(config, run.q_table)
+    trained = load_config(config_mapping)
+    config = under_conditions(trained, physics, max_steps)
+    report = evaluate(q_table, config, episodes=episodes, seed=seed)
+    result = {"run_seed": trained.seed, "path": name, **report.to_dict()}
+    exact = exact_report(config, q_table)
     if not isinstance(exact, str):
         result["exact"] = exact.to_dict()
     return result
@@ -345,7 +274,7 @@ def exact_summary(results: list[dict[str, Any]]) -> dict[str, Any] | None:
 
 
 def evaluate_seeds(
-    parent: Path,
+    run_set: RunSet,
     *,
     episodes: int | None = None,
     seed: int | None = None,
@@ -353,7 +282,7 @@ def evaluate_seeds(
     physics: dict[str, Any] | None = None,
     max_steps: int | None = None,
 ) -> dict[str, Any]:
-    """Evaluate every finished seed of a multi-seed run in ``gymnasium.make``, in parallel.
+    """Evaluate every finished seed of a multi-seed run or sweep point, in parallel.
 
     ``physics`` and ``max_steps`` play under other conditions (see ``under_conditions``).
 
@@ -361,29 +290,23 @@ def evaluate_seeds(
         ``runs`` (one ``eval --json`` object per finished seed, with ``run_seed`` and
         ``path``), ``successes`` (means at or above the threshold), ``reward_threshold``,
         ``episodes``, the ``mean`` and ``min`` of the seeds' means, ``seeds`` (how many
-        the run has), the seed directories left out (``missing``: absent, ``unfinished``:
-        interrupted or not started) and ``note``, a line naming them (None if none).
-
-    Raises:
-        RunError: a finished seed's directory is damaged, or no seed has finished.
+        the run has), ``missing`` and ``unfinished`` (seeds left out), ``conditions`` (the physics and time limit played under, when changed),
+        ``notes`` (what was left out or is unfinished) and ``note`` (them as one line, or
+        None).
     """
-    status = seed_status(parent)
-    if not status.finished:
-        raise RunError(f"{parent}: none of its seed runs has finished; {status.note(parent)}")
-    paths = [str(path) for _, path in status.finished]
-    # Loading every seed first refuses a damaged one before any work starts.
-    for path in paths:
-        rundir.load_run(path)
-    workers = workers or default_workers(len(paths))
-    jobs = [(path, episodes, seed, physics, max_steps) for path in paths]
-    results = map_jobs(_evaluate_one, jobs, workers)
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.evaluation import under_conditions
 
-    first = rundir.load_run(paths[0])
-    reward_threshold = first.summary.get("reward_threshold")
+    runs = run_set.runs
+    workers = workers or default_workers(len(runs))
+    jobs = [
+        (run.path.name, run.config.to_dict(), run.q_table, episodes, seed, physics, max_steps)
+        for run in runs
+    ]
+    results = map_jobs(_evaluate_one, jobs, workers)
+    reward_threshold = run_set.reward_threshold
     if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
-        conditions = under_conditions(first.config, physics, max_steps)
+        conditions = under_conditions(run_set.config, physics, max_steps)
         reward_threshold = inspect_env(conditions).reward_threshold
     means = [result["mean"] for result in results]
     exact = exact_summary(results)
@@ -397,8 +320,24 @@ def evaluate_seeds(
         "episodes": results[0]["episodes"],
         "mean": float(np.mean(means)),
         "min": float(np.min(means)),
-        "seeds": len(status.finished) + len(status.missing) + len(status.unfinished),
-        "missing": [path.name for _, path in status.missing],
-        "unfinished": [path.name for _, path in status.unfinished],
-        "note": status.note(parent),
+        "seeds": run_set.seeds,
+        "missing": list(run_set.missing),
+        "unfinished": list(run_set.unfinished),
+        "conditions": conditions_of(physics, max_steps),
+        "notes": list(run_set.notes),
+        "note": " ".join(run_set.notes) or None,
     }
+
+
+def conditions_of(physics: dict[str, Any] | None, max_steps: int | None) -> dict[str, Any]:
+    """The changed conditions an evaluation played under, as ``eval --json`` echoes them.
+
+    >>> conditions_of({"length": 0.75}, None), conditions_of(None, None)
+    ({'physics': {'length': 0.75}}, {})
+    """
+    conditions: dict[str, Any] = {}
+    if physics:
+        conditions["physics"] = dict(physics)
+    if max_steps is not None:
+        conditions["max_steps"] = max_steps
+    return conditions

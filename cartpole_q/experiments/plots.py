@@ -5,14 +5,14 @@ Nothing is drawn before the output file is known to be writable.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.errors import UserError
-from cartpole_q.experiments.multiseed import load_seed_runs
+from cartpole_q.config import Config, format_seeds
+from cartpole_q.errors import RunError, UserError
 from cartpole_q.figures import (
     FIGURE_FORMATS,
     Curve,
@@ -30,41 +30,56 @@ from cartpole_q.figures import (
 )
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
+from cartpole_q.store.runsets import load_run_set
 
 
-def plot_rewards(run_dirs: Sequence[Path], out: Path, force: bool = False) -> Path:
-    """Draw the reward curves of single and multi-seed runs on one figure; write ``out``.
+def plot_rewards(
+    run_dirs: Sequence[Path],
+    out: Path,
+    force: bool = False,
+    on_note: Callable[[str], None] | None = None,
+) -> Path:
+    """Draw the reward curves of runs, multi-seed runs and sweep points on one figure.
 
     Args:
-        run_dirs: run directories, single or multi-seed.
+        run_dirs: run directories, multi-seed runs or sweep points.
         out: a ``.png``, ``.svg`` or ``.pdf`` file.
         force: replace ``out`` if it exists.
+        on_note: told what is unfinished or left out.
 
     Raises:
-        RunError: a directory is not a complete run.
+        RunError: a directory is not a complete run, or a sweep point kept no curves.
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     items: list[Curve | SeedBand] = []
     first_runs: list[rundir.Run] = []
     for path in run_dirs:
-        if rundir.is_multi_seed(path):
-            runs = load_seed_runs(path)
-            first_runs.append(runs[0])
-            thresholds = {run.summary.get("reward_threshold") for run in runs}
-            items.append(SeedBand(
-                path.name, [run.metrics.returns for run in runs],
-                [run.summary.get("solved_episode") for run in runs],
-                threshold=thresholds.pop() if len(thresholds) == 1 else None,
-                interrupted=sum(bool(run.summary.get("interrupted")) for run in runs),
-            ))  # fmt: skip
-        else:
-            run = rundir.load_run(path)
-            first_runs.append(run)
+        run_set = load_run_set(path)
+        for note in run_set.notes:
+            if on_note is not None:
+                on_note(note)
+        runs = run_set.runs
+        first_runs.append(runs[0])
+        if run_set.kind == "sweep point" and not any(run.metrics.returns.size for run in runs):
+            raise RunError(
+                f"{path}: this sweep kept no learning curves (its sweep file says curves: "
+                "false, or it predates them); there is nothing to draw."
+            )
+        if run_set.kind == "run":
+            run = runs[0]
             items.append(Curve(
                 path.name, run.metrics.returns, run.summary.get("solved_episode"),
                 threshold=run.summary.get("reward_threshold"),
                 interrupted=bool(run.summary.get("interrupted")),
             ))  # fmt: skip
+            continue
+        name = path.name if run_set.kind == "multi-seed run" else f"point {path.name}"
+        items.append(SeedBand(
+            name, [run.metrics.returns for run in runs],
+            [run.summary.get("solved_episode") for run in runs],
+            threshold=run_set.reward_threshold,
+            interrupted=sum(bool(run.summary.get("interrupted")) for run in runs),
+        ))  # fmt: skip
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
     if len(items) == 1 and isinstance(items[0], Curve) and items[0].interrupted:
@@ -103,6 +118,16 @@ def _greedy_paths(
     return grid, paths
 
 
+def write_compare_figure(result: Any, out: Path) -> Path:
+    """Draw a comparison's aggregate figure (``compare --out``) and write ``out``."""
+    from cartpole_q.experiments.compare import compare_figure_data
+    from cartpole_q.figures import compare_figure
+
+    figure = compare_figure(compare_figure_data(result), f"{len(result.sides)} runs compared")
+    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[out.suffix.lower()]))
+    return out
+
+
 def follow(model: Any, policy: np.ndarray, limit: int = 1000) -> tuple[list[int], bool]:
     """The states a deterministic model visits under ``policy`` from its start.
 
@@ -123,36 +148,88 @@ def follow(model: Any, policy: np.ndarray, limit: int = 1000) -> tuple[list[int]
     return states, False
 
 
-def plot_policy(run_dir: Path, out: Path, dims_text: str | None, force: bool = False) -> Path:
-    """Draw one run's policy map over two binned dimensions; write ``out``.
+def plot_policy(
+    run_dir: Path,
+    out: Path,
+    dims_text: str | None,
+    force: bool = False,
+    seed: int | None = None,
+    on_note: Callable[[str], None] | None = None,
+) -> Path:
+    """Draw a policy map: one run's, one seed's (``seed``), or the seeds' agreement.
+
+    For several seeds without ``seed``, the map shows each state's majority greedy action
+    and the fraction of seeds that choose it (the agreement) in place of the state value.
 
     Raises:
-        RunError: the directory is not a complete run.
+        RunError: the directory is not a complete run, or ``seed`` is not one of its seeds.
         UserError: ``dims_text`` does not name two distinct dimensions of the grid.
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
-    run = rundir.load_run(run_dir)
-    env_id = run.config.env.id
-    title = f"Policy of {run_dir.name}"
-    if run.summary.get("interrupted"):
+    run_set = load_run_set(run_dir)
+    for note in run_set.notes:
+        if on_note is not None:
+            on_note(note)
+    runs = run_set.runs
+    if seed is not None:
+        chosen = [run for run in runs if run.config.seed == seed]
+        if not chosen:
+            shown = format_seeds(run.config.seed for run in runs)
+            raise RunError(f"{run_dir}: --seed {seed}: it has no finished seed {seed} ({shown}).")
+        runs = chosen
+    run = runs[0]
+    title = f"Policy of {run_dir.name}" + (f", seed {seed}" if seed is not None else "")
+    value_name = "state value max_a Q"
+    q_table, visits = run.q_table, run.visits
+    if len(runs) > 1:
+        q_table, visits = agreement_table(runs)
+        title = f"Policy of {run_dir.name}: majority of {len(runs)} seeds"
+        value_name = "agreement (fraction of seeds)"
+    elif run.summary.get("interrupted"):
         title += f" (training interrupted at episode {run.summary.get('episodes')})"
+    env_id = run.config.env.id
     grid = run.config.discretization
     if grid is None:
         if dims_text is not None:
             raise UserError(
                 "--dims: this run's observations are Discrete: there are no binned dimensions to pick."
             )
-        return _plot_discrete_policy(run, out, title, force)
+        return _plot_discrete_policy(run.config, q_table, visits, out, title, force)
     bins = grid.bins
     dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     figure = policy_figure(
-        run.q_table, run.visits, dims, grid.low, grid.high,
+        q_table, visits, dims, grid.low, grid.high,
         dimension_names(env_id, len(bins)), title,
-        action_names=action_names(env_id, run.q_table.shape[-1]),
+        action_names=action_names(env_id, q_table.shape[-1]), value_name=value_name,
     )  # fmt: skip
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
+
+
+def agreement_table(runs: Sequence[rundir.Run]) -> tuple[np.ndarray, np.ndarray | None]:
+    """The seeds' votes: ``[..., a]`` is the fraction of seeds whose greedy action is ``a``.
+
+    Its argmax is the majority action (lowest on ties) and its max the agreement; the
+    visits are summed over the seeds (``None`` when a seed has none, as sweep points).
+
+    >>> from types import SimpleNamespace as S
+    >>> runs = [S(q_table=np.array([[1.0, 0.0]]), visits=None),
+    ...         S(q_table=np.array([[0.0, 1.0]]), visits=None),
+    ...         S(q_table=np.array([[2.0, 0.0]]), visits=None)]
+    >>> votes, _ = agreement_table(runs)
+    >>> votes.round(3).tolist()
+    [[0.667, 0.333]]
+    """
+    n_actions = runs[0].q_table.shape[-1]
+    votes = np.zeros(runs[0].q_table.shape, dtype=np.float64)
+    for run in runs:
+        votes += np.eye(n_actions)[np.argmax(run.q_table, axis=-1)]
+    votes /= len(runs)
+    counts = [run.visits for run in runs if run.visits is not None]
+    if len(counts) < len(runs):
+        return votes, None
+    return votes, np.sum(counts, axis=0)
 
 
 TAXI_SHAPE = (5, 5, 5, 4)
@@ -160,13 +237,14 @@ TAXI_SHAPE = (5, 5, 5, 4)
 TAXI_ACTIONS = ("south", "north", "east", "west", "pickup", "drop off")
 
 
-def _plot_discrete_policy(run: rundir.Run, out: Path, title: str, force: bool) -> Path:
+def _plot_discrete_policy(
+    config: Config, q: np.ndarray, visits: np.ndarray | None, out: Path, title: str, force: bool
+) -> Path:
     """Grid worlds as grids, Blackjack as two panels, Taxi over the taxi's position."""
     from cartpole_q.envs.models import grid_layout
 
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    q, visits = run.q_table, run.visits
-    layout = grid_layout(run.config.env)
+    layout = grid_layout(config.env)
     if layout is not None:
         grid = GridMap(layout.rows, layout.columns, layout.cells, layout.moves)
         figure = grid_policy_figure(q, visits, grid, title)
@@ -187,7 +265,7 @@ def _plot_discrete_policy(run: rundir.Run, out: Path, title: str, force: bool) -
             )
         else:
             raise UserError(
-                f"--policy: no map for {run.config.env.id!r}: its observation is one Discrete "
+                f"--policy: no map for {config.env.id!r}: its observation is one Discrete "
                 "of unknown layout (maps exist for FrozenLake, CliffWalking, Taxi, Blackjack "
                 "and Tuple observations)."
             )
@@ -195,7 +273,10 @@ def _plot_discrete_policy(run: rundir.Run, out: Path, title: str, force: bool) -
         counts = None if visits is None else visits.reshape(*shape, q.shape[-1])
         low = [-0.5] * len(shape)
         high = [size - 0.5 for size in shape]
-        figure = policy_figure(table, counts, (0, 1), low, high, names, title, action_names=actions)
+        figure = policy_figure(
+            table, counts, (0, 1), low, high, names, title, action_names=actions,
+            rows_down=shape == TAXI_SHAPE,
+        )  # fmt: skip
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 

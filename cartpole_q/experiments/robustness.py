@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import itertools
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,10 +23,10 @@ from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.twins import cartpole
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import under_conditions
-from cartpole_q.experiments.multiseed import load_seed_runs
 from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, robustness_figure
-from cartpole_q.store import rundir
+from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, check_output_file
+from cartpole_q.store.runsets import RunSet, load_run_set
 
 PRESETS = {
     "rl-generalization": {"force_mag": (5.0, 15.0), "length": (0.25, 0.75), "masspole": (0.05, 0.5)},
@@ -77,7 +78,7 @@ def parse_vary(text: str) -> Axis:
         ) from None
     if not 1 <= count <= 1000:
         raise UserError(f"--vary {text!r}: N must be between 1 and 1000.")
-    return Axis(key, np.linspace(start, stop, count))
+    return Axis(key, grid_values(start, stop, count))
 
 
 def preset_axes(name: str, points: int) -> list[Axis]:
@@ -85,11 +86,31 @@ def preset_axes(name: str, points: int) -> list[Axis]:
     if name not in PRESETS:
         raise UserError(f"--preset {name!r}: unknown; choose one of {', '.join(PRESETS)}.")
     ranges = list(PRESETS[name].items())[:2]
-    return [Axis(key, np.linspace(low, high, points)) for key, (low, high) in ranges]
+    return [Axis(key, grid_values(low, high, points)) for key, (low, high) in ranges]
+
+
+def grid_values(start: float, stop: float, count: int) -> np.ndarray:
+    """``count`` values from ``start`` to ``stop``, rounded to 12 significant digits.
+
+    ``np.linspace(0.1, 0.5, 5)`` gives ``0.30000000000000004``; the value meant is 0.3.
+
+    >>> grid_values(0.1, 0.5, 5).tolist()
+    [0.1, 0.2, 0.3, 0.4, 0.5]
+    """
+    return np.array([float(f"{value:.12g}") for value in np.linspace(start, stop, count)])
+
+
+MAX_EVALUATIONS = 5_000_000
+"""``robustness`` asks for ``--yes`` above this many greedy episodes (seeds x points x episodes)"""
 
 
 def measure(
-    run_dir: Path, axes: list[Axis], episodes: int, seed: int, max_steps: int | None = None
+    run_set: RunSet,
+    axes: list[Axis],
+    episodes: int,
+    seed: int,
+    max_steps: int | None = None,
+    progress: SweepProgress | None = None,
 ) -> tuple[np.ndarray, list[float], float | None]:
     """Each seed's greedy mean return at each grid point.
 
@@ -97,29 +118,45 @@ def measure(
         ``(means, trained, threshold)``: means of shape ``(seeds, *grid)``; each key's
         training value; the threshold at the horizon played (``max_steps``, else the run's).
     """
-    runs = load_seed_runs(run_dir) if rundir.is_multi_seed(run_dir) else [rundir.load_run(run_dir)]
-    config = runs[0].config
+    progress = progress or NullSweepProgress()
+    runs = run_set.runs
+    config = run_set.config
     if config.env.id not in cartpole.ENV_IDS:
         raise UserError(
-            f"{run_dir}: robustness varies CartPole's physics; this run is on {config.env.id!r}."
+            f"{run_set.path}: robustness varies CartPole's physics; this run is on "
+            f"{config.env.id!r}."
         )
     info = inspect_env(config)
     grid = list(itertools.product(*(axis.values for axis in axes)))
     shape = (len(runs), *(len(axis.values) for axis in axes))
     means = np.empty((len(runs), len(grid)))
-    engines = []
-    for point in grid:
-        physics = {axis.key: float(value) for axis, value in zip(axes, point, strict=True)}
-        engines.append(
-            make_engine("numba", under_conditions(config, physics, max_steps), info, env_seed=0)
-        )
-    for r, run in enumerate(runs):
-        table = run.q_table.reshape(-1, info.n_actions)
-        for p, engine in enumerate(engines):
-            means[r, p] = float(np.mean(engine.evaluate(table, episodes, seed)))
+    tables = [run.q_table.reshape(-1, info.n_actions) for run in runs]
+    progress.start(len(runs) * len(grid), 0, len(grid), 0)
+    try:
+        for p, point in enumerate(grid):
+            physics = {axis.key: float(value) for axis, value in zip(axes, point, strict=True)}
+            conditions = under_conditions(config, physics, max_steps, source="--vary")
+            engine = make_engine("numba", conditions, info, env_seed=0)
+            for r, table in enumerate(tables):
+                means[r, p] = float(np.mean(engine.evaluate(table, episodes, seed)))
+            progress.advance(len(runs) * (p + 1), p + 1)
+    finally:
+        progress.close()
     trained = [float(config.env.physics.get(axis.key, DEFAULTS[axis.key])) for axis in axes]
     threshold = inspect_env(under_conditions(config, None, max_steps)).reward_threshold
     return means.reshape(shape), trained, threshold
+
+
+def check_size(run_set: RunSet, axes: list[Axis], episodes: int, yes: bool) -> None:
+    """Refuse more than :data:`MAX_EVALUATIONS` greedy episodes without ``--yes``."""
+    points = int(np.prod([len(axis.values) for axis in axes]))
+    total = len(run_set.runs) * points * episodes
+    if total > MAX_EVALUATIONS and not yes:
+        raise UserError(
+            f"{run_set.path}: {len(run_set.runs):,} seeds x {points:,} grid points x "
+            f"{episodes:,} episodes = {total:,} greedy episodes, more than "
+            f"{MAX_EVALUATIONS:,}; pass --yes to play them all (or use fewer points or episodes)."
+        )
 
 
 def robustness(
@@ -130,20 +167,31 @@ def robustness(
     out: Path,
     force: bool = False,
     max_steps: int | None = None,
+    *,
+    yes: bool = False,
+    progress: SweepProgress | None = None,
+    on_note: Callable[[str], None] | None = None,
 ) -> tuple[Path, Path]:
     """Measure, then write the figure ``out`` and ``out`` with ``.csv``; return both paths.
 
     Raises:
-        UserError: bad axes (one or two keys, no repeat), or the run is not CartPole's.
+        UserError: bad axes (one or two keys, no repeat), the run is not CartPole's, or
+            more greedy episodes than :data:`MAX_EVALUATIONS` without ``yes``.
         WriteError: the files cannot be written (checked before measuring).
     """
     if not 1 <= len(axes) <= 2 or len({axis.key for axis in axes}) != len(axes):
         raise UserError("--vary: give one key (a curve) or two different keys (a heatmap).")
+    run_set = load_run_set(run_dir)
+    check_size(run_set, axes, episodes, yes)
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     table_path = out.with_suffix(".csv")
     check_output_file(table_path, "--out (its .csv)", (".csv",), force)
-    means, trained, threshold = measure(run_dir, axes, episodes, seed, max_steps)
-    atomic_write_text(table_path, _csv(axes, means))
+    for note in run_set.notes:
+        if on_note is not None:
+            on_note(note)
+    means, trained, threshold = measure(run_set, axes, episodes, seed, max_steps, progress)
+    seeds = [run.config.seed for run in run_set.runs]
+    atomic_write_text(table_path, _csv(axes, means, seeds))
     horizon = "" if max_steps is None else f" of {max_steps} steps"
     title = f"Robustness of {run_dir.name}: greedy mean over {episodes} episodes{horizon}"
     figure = robustness_figure([(a.key, a.values) for a in axes], means, trained, threshold, title)
@@ -151,13 +199,13 @@ def robustness(
     return out, table_path
 
 
-def _csv(axes: list[Axis], means: np.ndarray) -> str:
-    """One row per grid point and seed index: the keys' values, ``seed_index``, ``mean``."""
+def _csv(axes: list[Axis], means: np.ndarray, seeds: list[int]) -> str:
+    """One row per grid point and seed: the keys' values, the run's ``seed``, ``mean``."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*(axis.key for axis in axes), "seed_index", "mean"])
+    writer.writerow([*(axis.key for axis in axes), "seed", "mean"])
     for index in np.ndindex(*means.shape):
         seed_index, *point = index
         values = [repr(float(axis.values[i])) for axis, i in zip(axes, point, strict=True)]
-        writer.writerow([*values, seed_index, repr(float(means[index]))])
+        writer.writerow([*values, seeds[seed_index], repr(float(means[index]))])
     return buffer.getvalue()

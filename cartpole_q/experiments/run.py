@@ -331,7 +331,7 @@ def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
 
 def _check_seed_configs(parent: Path, config: Config) -> None:
     """Refuse a multi-seed resume whose seeds were started with another config."""
-    from cartpole_q.experiments.multiseed import seed_dir
+    from cartpole_q.store.runsets import seed_dir
 
     seeds = config.train.seeds
     assert seeds is not None

@@ -54,6 +54,11 @@ def saved_text(directory: Path, saved: int, total: int) -> str:
     return f"{saved:,} of {total:,} runs are saved in {results}"
 
 
+FinishedRun = tuple[int, int, dict[str, str], np.ndarray, tuple[np.ndarray, np.ndarray]]
+"""a run as :func:`run_task` yields it: point, seed, ``results.csv`` cells, kept table,
+and the learning curve (returns, lengths)"""
+
+
 class SweepInterrupted(KeyboardInterrupt):
     """A sweep stopped at once (a second signal), with how many runs ``results.csv`` holds."""
 
@@ -80,7 +85,7 @@ class SweepOutcome:
 
 def run_task(
     handle: JobHandle, task: Sequence[tuple[int, dict[str, Any], Sequence[int]]]
-) -> Iterator[tuple[int, int, dict[str, str], np.ndarray]]:
+) -> Iterator[FinishedRun]:
     """Job: train and evaluate each (point, seed) of a task, as ``cartpole-q train`` would.
 
     Args:
@@ -88,8 +93,8 @@ def run_task(
         task: (point index, the point's config as a mapping, its seeds) groups.
 
     Yields:
-        ``(point, seed, cells, q_table)`` as each run ends, ``cells`` keyed by
-        :data:`~cartpole_q.store.sweepdir.RESULT_COLUMNS`.
+        ``(point, seed, cells, q_table, (returns, lengths))`` as each run ends, ``cells``
+        keyed by :data:`~cartpole_q.store.sweepdir.RESULT_COLUMNS`.
     """
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.training import train
@@ -101,7 +106,8 @@ def run_task(
             if handle.should_stop():
                 return
             result = train(config.for_seed(seed), env_info=env_info)
-            yield point, seed, result_cells(result, seed), result.q_table
+            curve = (result.returns, result.lengths)
+            yield point, seed, result_cells(result, seed), result.q_table, curve
 
 
 def result_cells(result: Any, seed: int) -> dict[str, str]:
@@ -166,13 +172,14 @@ def start_sweep(spec: SweepSpec, out: Path | None) -> Path:
 
 
 def load_sweep_dir(directory: Path) -> SweepSpec:
-    """The sweep of an existing sweep directory, for ``--resume``.
+    """The sweep of an existing sweep directory, for ``--resume`` (hold its lock).
 
     Raises:
         RunError: ``directory`` is not a sweep directory.
         ConfigError: its ``sweep.yaml`` is invalid.
     """
     path = sweepdir.sweep_file(directory)
+    sweepdir.remove_temporaries(directory)  # the caller holds the lock: none is in use
     spec = load_sweep(path)
     check_unchanged(spec, directory)
     check_points(spec, str(path))
@@ -259,7 +266,7 @@ def run_sweep(
     progress.start(spec.runs, len(book.rows), len(spec.points), book.points_done())
     tasks = plan_tasks(spec, missing, workers)
 
-    def on_item(index: int, finished: tuple[int, int, dict[str, str], np.ndarray]) -> None:
+    def on_item(index: int, finished: FinishedRun) -> None:
         book.add([finished])
         progress.advance(len(book.rows), book.points_done())
 
@@ -336,6 +343,7 @@ class _Book:
         for point, _ in self.rows:
             self._per_point[point] += 1
         self._tables: dict[int, dict[str, np.ndarray]] = {}
+        self._curves: dict[int, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
         self._dirty: set[int] = set()
         self._last_flush = -math.inf  # the first results are saved at once
         self.saved = len(self.rows)
@@ -367,10 +375,15 @@ class _Book:
 
     def add(self, finished: list[Any]) -> None:
         spec = self._spec
-        for point, seed, cells, q_table in finished:
+        for point, seed, cells, q_table, curve in finished:
             if point not in self._tables:
-                self._tables[point] = sweepdir.read_tables(self._directory, spec.point_id(point))
+                point_id = spec.point_id(point)
+                self._tables[point] = sweepdir.read_tables(self._directory, point_id)
+                if spec.curves:
+                    self._curves[point] = sweepdir.read_curves(self._directory, point_id)
             self._tables[point][spec.seed_key(seed)] = q_table
+            if spec.curves:
+                self._curves[point][spec.seed_key(seed)] = curve
             values = spec.points[point].values
             self.rows[(point, seed)] = {
                 "point": spec.point_id(point),
@@ -386,14 +399,18 @@ class _Book:
         if not self._dirty or (not force and time.monotonic() - self._last_flush < FLUSH_SECONDS):
             return
         for point in sorted(self._dirty):
-            sweepdir.write_tables(self._directory, self._spec.point_id(point), self._tables[point])
+            point_id = self._spec.point_id(point)
+            sweepdir.write_tables(self._directory, point_id, self._tables[point])
+            if self._spec.curves:
+                sweepdir.write_curves(self._directory, point_id, self._curves[point])
         rows = self.sorted_rows()
         sweepdir.write_results(self._directory, self._header, rows)
         self.saved = len(rows)
         # Only once both are written: an interruption above leaves everything to save again.
         for point in self._dirty:
             if self._per_point[point] == len(self._spec.seeds):
-                del self._tables[point]  # complete: its file holds every seed
+                del self._tables[point]  # complete: its files hold every seed
+                self._curves.pop(point, None)
         self._dirty.clear()
         self._last_flush = time.monotonic()
 

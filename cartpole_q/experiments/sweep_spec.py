@@ -27,8 +27,9 @@ from cartpole_q.config import (
     parse_seeds,
     read_yaml_mapping,
 )
+from cartpole_q.store import sweepdir
 
-SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip")
+SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip", "curves")
 """the keys a sweep file may have"""
 FORBIDDEN_AXES = ("seed", "train.seeds")
 """config keys a sweep cannot vary: its ``seeds`` say which seeds every point runs"""
@@ -59,6 +60,8 @@ class SweepSpec:
     grid: dict[str, list[Any]]
     zip: dict[str, list[Any]]
     points: tuple[Point, ...]
+    curves: bool = True
+    """keep every run's per-episode returns and lengths in ``points/<p>/curves.npz``"""
 
     @property
     def axes(self) -> list[str]:
@@ -76,7 +79,7 @@ class SweepSpec:
 
     def seed_key(self, seed: int) -> str:
         """The key of a seed's table in ``q_tables.npz``, padded like ``train --seeds``."""
-        return f"seed-{seed:0{max(3, len(str(max(self.seeds))))}d}"
+        return sweepdir.seed_key(seed, self.seeds)
 
     def to_dict(self) -> dict[str, Any]:
         """The resolved sweep, as ``sweep.yaml`` holds it (loading it gives this sweep back)."""
@@ -88,6 +91,8 @@ class SweepSpec:
         }
         if self.zip:
             resolved["zip"] = self.zip
+        if not self.curves:
+            resolved["curves"] = False
         return resolved
 
 
@@ -115,9 +120,20 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
         where = label or str(source)
         base_dir = source.parent
         default_name = safe_name(source.stem)
+    if not raw:
+        raise ConfigError(
+            f"{where}: is empty; a sweep file gives `grid` (or `zip`) axes over config keys, "
+            "and usually `base` and `seeds` (see the README's sweep section)."
+        )
     check_top_keys(raw, SWEEP_KEYS, where)
     name = checked_name(raw, default_name, where)
     base = load_base(raw.get("base"), where, base_dir)
+    curves = raw.get("curves", True)
+    if not isinstance(curves, bool):
+        raise ConfigError(
+            f"{where}: curves: must be true (keep every run's learning curve) or false, got "
+            f"{json.dumps(curves, default=str)}."
+        )
     try:
         seeds = parse_seeds(raw.get("seeds", base.seed))
     except ValueError as error:
@@ -139,7 +155,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     check_overlaps([*grid, *zipped], where)
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
-    return SweepSpec(name, base_mapping, seeds, grid, zipped, points)
+    return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves)
 
 
 def check_top_keys(raw: Mapping[str, Any], valid: tuple[str, ...], where: str) -> None:
@@ -248,6 +264,12 @@ def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
         if not values:
             raise ConfigError(
                 f"{where}: {section}.{key}: is empty; an axis needs at least one value."
+            )
+        cells = [axis_cell(value) for value in values]
+        twice = next((cell for cell in cells if cells.count(cell) > 1), None)
+        if twice is not None:
+            raise ConfigError(
+                f"{where}: {section}.{key}: has the value {twice} twice; each point must differ."
             )
         checked[key] = values
     return checked

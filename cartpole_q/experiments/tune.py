@@ -34,13 +34,13 @@ import numpy as np
 from cartpole_q.config import ConfigError, mapping_differences, shown_value
 from cartpole_q.errors import RunError, WriteError
 from cartpole_q.experiments.statistics import iqm, summarize_point
-from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, run_task
+from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, FinishedRun, run_task
 from cartpole_q.experiments.sweep_spec import axis_cell
 from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
 from cartpole_q.experiments.workers import InProcess, chunk_size, execute
 from cartpole_q.progress import NullReporter
 from cartpole_q.store import tunedir
-from cartpole_q.store.atomic import write_failure
+from cartpole_q.store.atomic import remove_stale_temporaries, write_failure
 from cartpole_q.store.sweepdir import cell
 
 IQM_BONUS = 1e-3
@@ -278,8 +278,9 @@ def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Pat
 
 
 def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:
-    """The tune file and storage URL of a tune directory (``--resume``)."""
+    """The tune file and storage URL of a tune directory (``--resume``; hold its lock)."""
     data, storage_url = tunedir.tune_file(directory)
+    remove_stale_temporaries(directory)  # the caller holds the lock: none is in use
     return load_tune(data, label=str(directory / tunedir.TUNE_FILE)), storage_url
 
 
@@ -487,8 +488,8 @@ def evaluate_trial(
     seeds = list(spec.seeds)
     rows: list[dict[str, str]] = []
 
-    def collect(index: int, finished: tuple[int, int, dict[str, str], Any]) -> None:
-        _, seed, cells, _ = finished
+    def collect(index: int, finished: FinishedRun) -> None:
+        _, seed, cells, _, _ = finished
         rows.append({**cells, "seed": str(seed)})
 
     here = InProcess(should_stop, NullReporter())

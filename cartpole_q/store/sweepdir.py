@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from cartpole_q.config import parse_seeds, read_yaml_mapping
 from cartpole_q.errors import RunError
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
 from cartpole_q.store.rundir import CONFIG_FILE, create_run_dir, write_config
@@ -28,6 +29,9 @@ RESULTS_FILE = "results.csv"
 POINTS_FILE = "points.csv"
 POINTS_DIR = "points"
 TABLES_FILE = "q_tables.npz"
+CURVES_FILE = "curves.npz"
+"""a point's learning curves: ``seed-NNN.returns`` (float64) and ``seed-NNN.lengths``
+(int64) per finished seed, one value per training episode, compressed"""
 FIGURE_FILE = "sweep.png"
 SWEEPS_ROOT = Path("sweeps")
 RESULT_COLUMNS = (
@@ -80,8 +84,14 @@ def sweep_file(directory: Path) -> Path:
     path = directory / SWEEP_FILE
     if not path.is_file():
         raise RunError(f"{directory}: is not a sweep directory (it has no {SWEEP_FILE}).")
-    remove_stale_temporaries(directory)
     return path
+
+
+def remove_temporaries(directory: Path) -> None:
+    """Delete the temporary files a killed sweep left (call it holding the sweep's lock)."""
+    remove_stale_temporaries(directory)
+    for point_dir in (directory / POINTS_DIR).glob("*"):
+        remove_stale_temporaries(point_dir)
 
 
 def point_config_path(directory: Path, point_id: str) -> Path:
@@ -151,6 +161,67 @@ def read_results(directory: Path, header: Sequence[str]) -> list[dict[str, str]]
                 "was changed by hand. Start a new sweep."
             )
         return [dict(row) for row in reader]
+
+
+def seed_key(seed: int, seeds: Sequence[int]) -> str:
+    """The key of a seed in ``q_tables.npz``, padded like ``train --seeds`` directories.
+
+    >>> seed_key(7, range(100)), seed_key(7, [7, 1000])
+    ('seed-007', 'seed-0007')
+    """
+    return f"seed-{seed:0{max(3, len(str(max(seeds))))}d}"
+
+
+def sweep_seeds(directory: Path) -> tuple[int, ...]:
+    """The seeds ``sweep.yaml`` gives every point.
+
+    Raises:
+        RunError: ``sweep.yaml`` is missing or its seeds are not readable.
+    """
+    data = read_yaml_mapping(sweep_file(directory), "sweep file")
+    try:
+        return parse_seeds(data.get("seeds"))
+    except ValueError as error:
+        raise RunError(f"{directory / SWEEP_FILE}: seeds: {error}") from None
+
+
+def curves_path(directory: Path, point_id: str) -> Path:
+    """Where a point's ``curves.npz`` goes."""
+    return directory / POINTS_DIR / point_id / CURVES_FILE
+
+
+def write_curves(
+    directory: Path, point_id: str, curves: Mapping[str, tuple[np.ndarray, np.ndarray]]
+) -> None:
+    """Rewrite a point's ``curves.npz`` whole: each seed's returns and lengths, compressed."""
+    arrays: dict[str, Any] = {}
+    for key in sorted(curves):
+        returns, lengths = curves[key]
+        arrays[f"{key}.returns"] = np.asarray(returns, dtype=np.float64)
+        arrays[f"{key}.lengths"] = np.asarray(lengths, dtype=np.int64)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)
+    atomic_write_bytes(curves_path(directory, point_id), buffer.getvalue())
+
+
+def read_curves(directory: Path, point_id: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """A point's kept learning curves by seed key (none if it kept none).
+
+    Raises:
+        RunError: the file is damaged.
+    """
+    path = curves_path(directory, point_id)
+    if not path.is_file():
+        return {}
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            names = archive.files
+            keys = sorted({name.rpartition(".")[0] for name in names})
+            return {key: (archive[f"{key}.returns"], archive[f"{key}.lengths"]) for key in keys}
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as error:
+        raise RunError(
+            f"{path}: cannot be read ({error}); the sweep directory is damaged."
+        ) from None
 
 
 def tables_path(directory: Path, point_id: str) -> Path:

@@ -17,7 +17,7 @@ import yaml
 
 from cartpole_q.config import Config, ConfigError, read_yaml_mapping
 from cartpole_q.errors import RunError
-from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
+from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text
 from cartpole_q.store.rundir import create_run_dir
 from cartpole_q.store.sweepdir import csv_text
 
@@ -55,8 +55,7 @@ def tune_file(directory: Path) -> tuple[dict[str, Any], str | None]:
     path = directory / TUNE_FILE
     if not path.is_file():
         raise RunError(f"{directory}: is not a tune directory (it has no {TUNE_FILE}).")
-    remove_stale_temporaries(directory)
-    data = read_yaml_mapping(path)
+    data = read_yaml_mapping(path, "tune file")
     storage = data.pop("storage", None)
     if storage is not None and not isinstance(storage, str):
         raise ConfigError(f"{path}: storage: must be an Optuna storage URL or null.")

@@ -1,0 +1,219 @@
+"""The runs behind a path: one run, the seeds of a multi-seed run, or the seeds of a sweep point.
+
+``eval``, ``plot`` and ``compare`` take any of the three. A multi-seed run's seeds are its
+``seed-NNN`` directories; a sweep point's (``<sweep>/points/<p>``) are its rows of
+``results.csv``, its tables in ``q_tables.npz`` and its learning curves in
+``curves.npz``. Either way the seeds come back as :class:`~cartpole_q.store.rundir.Run`
+records, so that the commands treat them alike, with notes naming what is unfinished
+(interrupted, not started) so that no command uses it without saying so.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import Config, ConfigError, load_config
+from cartpole_q.engines.base import EpisodeMetrics
+from cartpole_q.errors import RunError
+from cartpole_q.store import rundir, sweepdir
+
+
+def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
+    """The subdirectory of one seed: ``seed-007`` when the largest seed has up to 3 digits."""
+    width = max(3, len(str(max(seeds))))
+    return parent / f"seed-{seed:0{width}d}"
+
+
+@dataclass(frozen=True)
+class RunSet:
+    """The finished runs behind a path, and what was left out."""
+
+    path: Path
+    kind: str
+    """``run``, ``multi-seed run`` or ``sweep point``"""
+    runs: list[rundir.Run]
+    """one per seed with a result, in seed order"""
+    notes: list[str] = field(default_factory=list)
+    """sentences naming unfinished or missing seeds (empty when every seed finished)"""
+    missing: list[str] = field(default_factory=list)
+    """the seeds left out because they have no result (``seed-001``, ...)"""
+    unfinished: list[str] = field(default_factory=list)
+    """the seeds left out because their training was interrupted"""
+
+    @property
+    def seeds(self) -> int:
+        """How many seeds the run has, left out ones included."""
+        return len(self.runs) + len(self.missing) + len(self.unfinished)
+
+    @property
+    def config(self) -> Config:
+        """The config of the first seed (the seeds differ only in their seed)."""
+        return self.runs[0].config
+
+    @property
+    def reward_threshold(self) -> float | None:
+        """The threshold the seeds were judged by (``None`` without one)."""
+        value = self.runs[0].summary.get("reward_threshold")
+        return None if value is None else float(value)
+
+
+def load_run_set(path: Path) -> RunSet:
+    """Load a run directory, a multi-seed run or a sweep point.
+
+    Raises:
+        RunError: ``path`` is none of them, or none of its seeds has a result.
+    """
+    path = Path(path)
+    point = sweepdir.point_results(path)
+    if point is not None:
+        return _sweep_point(path, point)
+    if rundir.is_multi_seed(path):
+        return _multi_seed(path)
+    run = rundir.load_run(path)
+    notes = []
+    if run.summary.get("interrupted"):
+        notes.append(
+            f"{path}: training was interrupted after episode {run.summary.get('episodes')} of "
+            f"{run.config.train.episodes}; its table at that point is used (finish it with "
+            f"`cartpole-q train --resume {path}`)."
+        )
+    return RunSet(path, "run", [run], notes)
+
+
+def _multi_seed(parent: Path) -> RunSet:
+    """A multi-seed run's finished seeds; interrupted and missing ones are named, left out."""
+    config = load_config(parent / rundir.CONFIG_FILE)
+    seeds = config.train.seeds
+    assert seeds is not None
+    runs: list[rundir.Run] = []
+    missing: list[str] = []
+    unfinished: list[str] = []
+    for seed in seeds:
+        child = seed_dir(parent, seed, seeds)
+        summary = rundir.read_summary(child)
+        if summary is None:
+            (unfinished if child.is_dir() else missing).append(child.name)
+        elif summary.get("interrupted", True):
+            unfinished.append(child.name)
+        else:
+            runs.append(rundir.load_run(child))
+    note = _left_out(parent, len(seeds), missing, unfinished)
+    if not runs:
+        raise RunError(f"{parent}: none of its seed runs has finished; {note}")
+    return RunSet(parent, "multi-seed run", runs, [note] if note else [], missing, unfinished)
+
+
+def _left_out(parent: Path, total: int, missing: list[str], unfinished: list[str]) -> str:
+    """``PARENT: 2 of 3 seeds left out: seed-001 is missing; seed-002 has not finished (...)``."""
+    if not missing and not unfinished:
+        return ""
+    parts = []
+    if missing:
+        parts.append(f"{_names(missing)} {'is' if len(missing) == 1 else 'are'} missing")
+    if unfinished:
+        verb = "has" if len(unfinished) == 1 else "have"
+        parts.append(f"{_names(unfinished)} {verb} not finished")
+    return (
+        f"{parent}: {len(missing) + len(unfinished)} of {total} seeds left out: "
+        f"{'; '.join(parts)} (finish them with `cartpole-q train --resume {parent}`)"
+    )
+
+
+def _names(names: list[str], limit: int = 8) -> str:
+    shown = ", ".join(names[:limit])
+    return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
+
+
+def _sweep_point(point_dir: Path, rows: list[dict[str, str]]) -> RunSet:
+    """A sweep point's seeds as runs: rows, tables and (when kept) learning curves."""
+    sweep = point_dir.parent.parent
+    try:
+        config = load_config(point_dir / rundir.CONFIG_FILE)
+    except ConfigError as error:
+        raise RunError(
+            f"{point_dir}: its {rundir.CONFIG_FILE} is not a valid config ({error})."
+        ) from None
+    tables = sweepdir.read_tables(sweep, point_dir.name)
+    curves = sweepdir.read_curves(sweep, point_dir.name)
+    threshold = _threshold(config)
+    seeds = sweepdir.sweep_seeds(sweep)
+    runs = []
+    for row in rows:
+        seed = int(row["seed"])
+        key = sweepdir.seed_key(seed, seeds)
+        if key not in tables:
+            raise RunError(
+                f"{sweepdir.tables_path(sweep, point_dir.name)}: has no table {key} for the "
+                f"finished run of seed {seed}; the sweep directory is damaged."
+            )
+        seed_config = config.for_seed(seed)
+        returns, lengths = curves.get(key, (np.zeros(0), np.zeros(0, dtype=np.int64)))
+        runs.append(
+            rundir.Run(
+                path=point_dir / key,
+                config=seed_config,
+                q_table=tables[key],
+                visits=None,
+                metrics=_metrics(seed_config, returns, lengths),
+                summary=_summary_of_row(row, threshold),
+            )
+        )
+    total = len(seeds)
+    notes = []
+    if len(runs) < total:
+        notes.append(
+            f"{point_dir}: {len(runs)} of its {total} seeds have finished; the others are left "
+            f"out (finish the sweep with `cartpole-q sweep --resume {sweep}`)."
+        )
+    return RunSet(point_dir, "sweep point", runs, notes)
+
+
+def _threshold(config: Config) -> float | None:
+    from cartpole_q.envs.gym import inspect_env
+
+    return inspect_env(config).reward_threshold
+
+
+def _metrics(config: Config, returns: np.ndarray, lengths: np.ndarray) -> EpisodeMetrics:
+    """Per-episode metrics from a kept curve; epsilon and alpha from the config's schedules."""
+    from cartpole_q.rl.schedules import schedule_value
+
+    def rates(schedule: Any) -> np.ndarray:
+        code, start, end, rate = schedule.code, schedule.start, schedule.end, schedule.rate
+        return np.array(
+            [schedule_value(code, start, end, rate, e) for e in range(len(returns))],
+            dtype=np.float64,
+        )
+
+    return EpisodeMetrics(
+        np.asarray(returns, dtype=np.float64),
+        np.asarray(lengths, dtype=np.int64),
+        rates(config.agent.epsilon),
+        rates(config.agent.alpha),
+    )
+
+
+def _summary_of_row(row: dict[str, str], threshold: float | None) -> dict[str, Any]:
+    """The ``summary.json`` fields a sweep row holds."""
+
+    def number(name: str) -> float | None:
+        return float(row[name]) if row.get(name) else None
+
+    solved = number("solved_episode")
+    first = number("first_greedy_success_env_steps")
+    steps_to_solve = number("env_steps_to_solve")
+    mean = number("eval_mean")
+    return {
+        "episodes": int(row["episodes"]),
+        "env_steps": int(row["env_steps"]),
+        "solved_episode": None if solved is None else int(solved),
+        "env_steps_to_solve": None if steps_to_solve is None else int(steps_to_solve),
+        "first_greedy_success": None if first is None else {"env_steps": int(first)},
+        "eval": None if mean is None else {"mean": mean},
+        "reward_threshold": threshold,
+        "interrupted": False,
+    }
