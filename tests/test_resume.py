@@ -23,6 +23,7 @@ from cartpole_q.config import load_config
 from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.store import rundir
 from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
+from cartpole_q.store.lock import LOCK_FILE
 from tests.conftest import write_yaml
 
 RESULT_FILES = ("q_table.npy", "visits.npy", "metrics.csv", "evaluations.csv")
@@ -299,6 +300,8 @@ def _check_every_file_loads(run: Path) -> int:
     for path in sorted(run.iterdir()):
         if path.name.startswith(".") and path.name.endswith(".tmp"):
             continue  # a temporary file a kill interrupted: never a contract file, removed on resume
+        if path.name == LOCK_FILE:
+            continue  # the one-writer lock (empty or a process id), not a result
         if path.suffix == ".yaml":
             load_config(path)
         elif path.name == rundir.CHECKPOINT_FILE:

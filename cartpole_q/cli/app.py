@@ -535,7 +535,7 @@ def eval_command(
             typer.echo(json.dumps({**report.to_dict(), **extra}))
         else:
             typer.echo(eval_line(run_dir, report.to_dict(), threshold, conditions))
-            for line in exact_lines(extra["exact"]) if extra else []:
+            for line in exact_lines(extra["exact"]) if "exact" in extra else []:
                 typer.echo(line)
             if video is not None:
                 typer.echo(f"video: {video}")
@@ -927,6 +927,12 @@ def _sweep(
         if sweep_file is None:
             raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
         spec = sweeping.prepare_sweep(sweep_file)
+        if not spec.axes:
+            typer.echo(
+                f"note: {sweep_file} has no grid or zip axes: every seed runs the base config "
+                "(one point).",
+                err=True,
+            )
         if spec.runs > max_runs and not yes:
             raise UserError(
                 f"{sweep_file}: {len(spec.points)} points x {len(spec.seeds)} seeds = "
