@@ -6,8 +6,9 @@ cache would silently run old code, and the two engines would no longer agree. So
 version of the compiled modules gets its own directory,
 ``$XDG_CACHE_HOME/cartpole-q/numba-<hash of the compiled modules>`` (``~/.cache`` by
 default), unless the user chose one with ``NUMBA_CACHE_DIR``. Only the modules numba
-compiles are hashed (:data:`COMPILED_MODULES`): editing the command line costs no
-recompilation. Directories of older sources are removed.
+compiles are hashed (:func:`compiled_modules`): editing the command line costs no
+recompilation. Directories of older sources are removed. An algorithm registered from
+outside the package is cached under a name holding a digest of its module's source.
 
 numba's cache files are pickles, which numba loads and runs. A cache directory must
 therefore belong to the current user and be writable by nobody else: when the home cache
@@ -30,25 +31,21 @@ from pathlib import Path
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
-COMPILED_MODULES = (
-    "config/schema.py",
-    "engines/base.py",
-    "engines/gymnasium_engine.py",
-    "engines/kernel.py",
-    "engines/rng_handle.py",
-    "envs/registry.py",
-    "envs/twins/__init__.py",
-    "envs/twins/acrobot.py",
-    "envs/twins/cartpole.py",
-    "envs/twins/mountaincar.py",
-    "rl/algorithms.py",
-    "rl/binning.py",
-    "rl/policy.py",
-    "rl/schedules.py",
-    "rl/solve.py",
-)
-"""the modules whose functions numba compiles, or whose constants and functions they inline
-(a test checks that every module defining compiled functions is listed)"""
+COMPILED_PACKAGES = ("rl", "envs", "engines")
+"""the subpackages whose functions numba compiles, or whose constants and functions the
+compiled code inlines: every module in them is hashed (and ``config/schema.py``)"""
+
+
+def compiled_modules() -> tuple[str, ...]:
+    """The modules, relative to the package, whose sources key the cache directory."""
+    found = ["config/schema.py"]
+    for package in COMPILED_PACKAGES:
+        found.extend(
+            str(path.relative_to(PACKAGE_DIR))
+            for path in sorted((PACKAGE_DIR / package).rglob("*.py"))
+        )
+    return tuple(found)
+
 
 _PREFIX = "numba-"
 
@@ -57,7 +54,7 @@ _PREFIX = "numba-"
 def source_digest() -> str:
     """A short hash of the modules numba compiles."""
     digest = hashlib.sha256()
-    for name in COMPILED_MODULES:
+    for name in compiled_modules():
         digest.update(name.encode())
         digest.update((PACKAGE_DIR / name).read_bytes())
     return digest.hexdigest()[:16]

@@ -24,6 +24,7 @@ from cartpole_q.config import Config
 from cartpole_q.engines import make_engine, resolve_engine
 from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingState
 from cartpole_q.envs.gym import EnvInfo, inspect_env
+from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
@@ -83,7 +84,7 @@ class Checkpoint:
     episode: int
     env_steps: int
     tables: Tables
-    """the live tables (Double Q-learning's ``q_b`` included)"""
+    """the live tables and the algorithm's memory"""
     metrics: EpisodeMetrics
     """the metrics of the finished episodes (views of the live arrays)"""
     agent_rng_state: dict[str, Any]
@@ -354,10 +355,22 @@ def _run(
 
 def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     episode = checkpoint.episode
-    for live, saved in zip(state.tables, checkpoint.tables, strict=True):
-        live[...] = saved
-    for column, saved in zip(state.metrics, checkpoint.metrics, strict=True):
-        column[:episode] = saved
+    live, saved = state.tables, checkpoint.tables
+    if len(live.memory) != len(saved.memory) or any(
+        a.shape != b.shape for a, b in zip(live.memory, saved.memory, strict=False)
+    ):
+        raise RunError(
+            f"the checkpoint holds {len(saved.memory)} memory arrays of "
+            f"{state.algorithm.name} shaped {[array.shape for array in saved.memory]}, the "
+            f"config asks for {[array.shape for array in live.memory]}; it was written by "
+            "another algorithm or grid."
+        )
+    live.q[...] = saved.q
+    live.visits[...] = saved.visits
+    for array, kept in zip(live.memory, saved.memory, strict=True):
+        array[...] = kept
+    for column, values in zip(state.metrics, checkpoint.metrics, strict=True):
+        column[:episode] = values
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
     if checkpoint.physics_rng_state is not None:
         state.physics_rng.bit_generator.state = checkpoint.physics_rng_state

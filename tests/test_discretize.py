@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from cartpole_q.rl import policy
+from cartpole_q.engines.compile import jit
 from cartpole_q.rl.binning import bin_indices, state_index
 
 # One dimension over [-1, 1] with 4 bins has edges at -0.5, 0 and 0.5.
@@ -36,7 +36,7 @@ LOW, HIGH, BINS = -1.0, 1.0, 4
 def test_bin_edges_and_clipping(x: float, expected: int) -> None:
     assert state_index([x], [LOW], [HIGH], [BINS]) == expected
     assert (
-        policy.state_index(np.array([x]), np.array([LOW]), np.array([HIGH]), np.array([BINS]))
+        jit(state_index)(np.array([x]), np.array([LOW]), np.array([HIGH]), np.array([BINS]))
         == expected
     )
 
@@ -95,7 +95,7 @@ def test_both_implementations_follow_the_contract(
     flat = int(np.ravel_multi_index(expected, bins))
     assert state_index(observation, low, high, bins) == flat
     assert state_index(observation, low.tolist(), high.tolist(), bins.tolist()) == flat
-    assert policy.state_index(observation, low, high, bins) == flat
+    assert jit(state_index)(observation, low, high, bins) == flat
 
 
 def test_property_tests_have_no_deadline() -> None:

@@ -150,13 +150,13 @@ def test_double_q_learning_keeps_the_mean_of_its_two_tables(tmp_path) -> None:  
     saved = []
     result = train(config, on_checkpoint=saved.append, final_eval=False)
     checkpoint = saved[-1]
-    q_a, q_b = checkpoint.tables.q, checkpoint.tables.q_b
+    q_a, (q_b,) = checkpoint.tables.q, checkpoint.tables.memory
     assert q_b.shape == q_a.shape and not np.array_equal(q_a, q_b)
     expected = (0.5 * (q_a + q_b)).reshape(result.q_table.shape)
     assert result.q_table.tobytes() == expected.tobytes()
     write_checkpoint(tmp_path, checkpoint)  # both tables travel in the checkpoint
     loaded = load_checkpoint(tmp_path)
-    assert np.array_equal(loaded.tables.q, q_a) and np.array_equal(loaded.tables.q_b, q_b)
+    assert np.array_equal(loaded.tables.q, q_a) and np.array_equal(loaded.tables.memory[0], q_b)
 
 
 def test_twin_evaluation_returns_exactly_what_gymnasium_returns() -> None:

@@ -1,6 +1,8 @@
-"""The compiled RL functions with hand-computed values: schedules, epsilon-greedy, solving.
+"""The RL functions with hand-computed values: schedules, epsilon-greedy, solving.
 
-Each algorithm's update is tested in ``test_algorithms.py``.
+Every function is plain Python that the engines compile with numba; each test runs it both
+ways (``python`` and ``compiled``), which must agree to the last bit and draw. Each
+algorithm's update is tested in ``test_algorithms.py``.
 """
 
 from __future__ import annotations
@@ -10,22 +12,30 @@ import math
 import numpy as np
 import pytest
 
+from cartpole_q.engines.compile import jit
 from cartpole_q.engines.kernel import reaches_threshold
-from cartpole_q.rl.algorithms import ENDED, q_learning_step
-from cartpole_q.rl.policy import best_action, best_value, epsilon_greedy
-from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG, schedule_value
+from cartpole_q.rl import tabular
+from cartpole_q.rl.algorithms import q_learning
+from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG
+from cartpole_q.rl.schedules import schedule_value as python_schedule_value
+from cartpole_q.rl.tabular import ENDED
+
+VARIANTS = ["python", "compiled"]
 
 
-def test_learn_step_picks_the_next_action_from_the_updated_table() -> None:
+def way(function, variant: str):  # type: ignore[no-untyped-def]
+    """The function as it is, or compiled as the engines compile it."""
+    return function if variant == "python" else jit(function)
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_q_learning_picks_the_next_action_from_the_updated_table(variant: str) -> None:
+    step = way(q_learning.step, variant)
     q = np.array([[0.0, 0.0], [0.0, 0.1]])
-    visits = np.zeros((2, 2), dtype=np.int64)
-    action = q_learning_step(q, visits, 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0,
-                             np.random.default_rng(0))  # fmt: skip
+    action = step(q, (), (), 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0, np.random.default_rng(0))
     # Q(1, 1) becomes 1.0 before the greedy choice in state 1
     assert action == 1 and q[1, 1] == 1.0
-    assert visits.tolist() == [[0, 0], [0, 1]]
-    ended = q_learning_step(q, visits, 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0,
-                            np.random.default_rng(0))  # fmt: skip
+    ended = step(q, (), (), 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0, np.random.default_rng(0))
     assert ended == ENDED  # truncated: the episode ended, no next action is drawn
 
 
@@ -53,17 +63,21 @@ def test_learn_step_picks_the_next_action_from_the_updated_table() -> None:
 def test_schedule_values(
     kind: int, start: float, end: float, rate: float, episode: int, expected: float
 ) -> None:
-    assert schedule_value(kind, start, end, rate, episode) == pytest.approx(expected, rel=1e-12)
+    value = python_schedule_value(kind, start, end, rate, episode)
+    assert value == pytest.approx(expected, rel=1e-12)
+    assert jit(python_schedule_value)(kind, start, end, rate, episode) == value  # to the bit
 
 
 def test_exponential_floor_is_reached_exactly_where_the_product_drops_below_it() -> None:
-    values = [schedule_value(EXPONENTIAL, 1.0, 0.01, 0.995, e) for e in range(1000)]
+    values = [python_schedule_value(EXPONENTIAL, 1.0, 0.01, 0.995, e) for e in range(1000)]
     first_floor = values.index(0.01)
     assert first_floor == 919
     assert 0.995**918 > 0.01 > 0.995**919
 
 
-def test_epsilon_greedy_draws_one_uniform_per_greedy_choice() -> None:
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_epsilon_greedy_draws_one_uniform_per_greedy_choice(variant: str) -> None:
+    epsilon_greedy = way(tabular.epsilon_greedy, variant)
     rng, mirror = np.random.default_rng(42), np.random.default_rng(42)
     q = np.array([[0.0, 5.0, 1.0]])
     for _ in range(200):
@@ -75,7 +89,9 @@ def test_epsilon_greedy_draws_one_uniform_per_greedy_choice() -> None:
     assert rng.bit_generator.state == mirror.bit_generator.state
 
 
-def test_certain_choices_draw_nothing_they_do_not_need() -> None:
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_certain_choices_draw_nothing_they_do_not_need(variant: str) -> None:
+    epsilon_greedy = way(tabular.epsilon_greedy, variant)
     q = np.array([[0.0, 1.0, 0.5]])
     rng = np.random.default_rng(1)
     before = rng.bit_generator.state
@@ -87,7 +103,10 @@ def test_certain_choices_draw_nothing_they_do_not_need() -> None:
     assert rng.bit_generator.state == mirror.bit_generator.state
 
 
-def test_ties_go_to_the_lowest_action_as_with_numpy_argmax() -> None:
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_ties_go_to_the_lowest_action_as_with_numpy_argmax(variant: str) -> None:
+    best_action, best_value = way(tabular.best_action, variant), way(tabular.best_value, variant)
+    epsilon_greedy = way(tabular.epsilon_greedy, variant)
     q = np.array([[2.0, 2.0, 1.0], [0.0, 3.0, 3.0], [-1.0, -1.0, -1.0], [1.0, 0.0, 4.0]])
     for state in range(4):
         assert best_action(q, state) == np.argmax(q[state])

@@ -27,7 +27,6 @@ from cartpole_q.config.loading import (
     shown_value,
 )
 from cartpole_q.config.schema import (
-    ALGORITHMS,
     ENGINES,
     INTEGRATORS,
     MAX_EPISODES,
@@ -37,7 +36,6 @@ from cartpole_q.config.schema import (
     PHYSICS_KEYS,
     PHYSICS_RANGES,
     RANDOMIZED_KEYS,
-    SCHEDULE_KINDS,
     AgentConfig,
     Config,
     DiscretizationConfig,
@@ -48,9 +46,9 @@ from cartpole_q.config.schema import (
     format_seeds,
 )
 from cartpole_q.errors import ConfigError
+from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 __all__ = [
-    "ALGORITHMS",
     "ENGINES",
     "INTEGRATORS",
     "MAX_EPISODES",

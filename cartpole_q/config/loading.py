@@ -33,7 +33,6 @@ from typing import Any
 import yaml
 
 from cartpole_q.config.schema import (
-    ALGORITHMS,
     ENGINES,
     EXACT_INTEGER,
     INTEGRATORS,
@@ -44,7 +43,6 @@ from cartpole_q.config.schema import (
     PHYSICS_KEYS,
     PHYSICS_RANGES,
     RANDOMIZED_KEYS,
-    SCHEDULE_KINDS,
     AgentConfig,
     Config,
     DiscretizationConfig,
@@ -54,6 +52,11 @@ from cartpole_q.config.schema import (
     TrainConfig,
 )
 from cartpole_q.errors import ConfigError
+from cartpole_q.rl.algorithm import ParamValue
+from cartpole_q.rl.algorithms import algorithms
+from cartpole_q.rl.algorithms import get as get_algorithm
+from cartpole_q.rl.algorithms import names as algorithm_names
+from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 _NUMBER_PATTERN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
@@ -429,7 +432,17 @@ def check_known_keys(user: Mapping[Any, Any], source: str) -> None:
                 f"not a {_type_name(value)}."
             )
         names = [field.name for field in dataclasses.fields(section_type)]
+        if section == "agent":  # the algorithms' own keys, instead of the params mapping
+            names = [name for name in names if name != "params"] + algorithm_param_keys()
         _check_keys(value, names, f"{section}.", source)
+
+
+def algorithm_param_keys() -> list[str]:
+    """Every key some registered algorithm adds under ``agent`` (``n``, ``lambda``, ...)."""
+    keys: dict[str, None] = {}
+    for algorithm in algorithms():
+        keys.update(dict.fromkeys(param.key for param in algorithm.params))
+    return list(keys)
 
 
 def _check_keys(data: Mapping[Any, Any], valid: Iterable[str], prefix: str, source: str) -> None:
@@ -537,7 +550,11 @@ class _Reader:
         return number
 
     def integer(self, field: str, *, minimum: int, maximum: int | None = None) -> int:
-        value = self._value(field)
+        return self.integer_value(field, self._value(field), minimum=minimum, maximum=maximum)
+
+    def integer_value(
+        self, field: str, value: Any, *, minimum: float | None, maximum: float | None = None
+    ) -> int:
         number = _as_number(value)
         if number is None or not math.isfinite(number) or number != int(number):
             raise self.error(field, f"must be an integer, got {_shown(value)}.")
@@ -546,10 +563,10 @@ class _Reader:
                 field, f"must be an integer written out in digits, got {_shown(value)}."
             )
         integer = int(value) if isinstance(value, int) else int(number)
-        if integer < minimum:
-            raise self.error(field, f"must be at least {minimum}, got {integer}.")
+        if minimum is not None and integer < minimum:
+            raise self.error(field, f"must be at least {int(minimum)}, got {integer}.")
         if maximum is not None and integer > maximum:
-            raise self.error(field, f"must be at most {maximum}, got {integer}.")
+            raise self.error(field, f"must be at most {int(maximum)}, got {integer}.")
         return integer
 
     def boolean(self, field: str) -> bool:
@@ -694,12 +711,13 @@ class _Reader:
             env=self._env(),
             discretization=discretization,
             agent=AgentConfig(
-                algorithm=self.choice("agent.algorithm", ALGORITHMS),
+                algorithm=self.choice("agent.algorithm", algorithm_names()),
                 gamma=self.number("agent.gamma", low=0.0, high=1.0, interval="[0, 1]"),
                 alpha=self.schedule("agent.alpha", low=0.0, low_open=True, interval="(0, 1]"),
                 epsilon=self.schedule("agent.epsilon", low=0.0, low_open=False, interval="[0, 1]"),
                 q_init=self.number("agent.q_init"),
                 max_q_table_bytes=self.integer("agent.max_q_table_bytes", minimum=1),
+                params=self._algorithm_params(),
             ),
             train=TrainConfig(
                 episodes=self.integer("train.episodes", minimum=1, maximum=MAX_EPISODES),
@@ -719,6 +737,33 @@ class _Reader:
                 seed=self.integer("eval.seed", minimum=0, maximum=MAX_SEED),
             ),
         )
+
+    def _algorithm_params(self) -> Mapping[str, ParamValue]:
+        """The chosen algorithm's own keys, defaults filled; other algorithms' keys ignored.
+
+        A key of another algorithm does not apply to this one (a sweep or a study may vary
+        ``agent.algorithm`` over a base that sets ``agent.lambda``), so it is left out of the
+        config; a key of no algorithm was refused as unknown already.
+        """
+        algorithm = get_algorithm(self.string("agent.algorithm"))
+        agent = self._raw["agent"]
+        values: dict[str, ParamValue] = {}
+        for param in algorithm.params:
+            field = f"agent.{param.key}"
+            value = agent.get(param.key, param.default)
+            if param.kind == "choice":
+                values[param.key] = self.choice_value(field, value, param.choices)
+            elif param.kind == "int":
+                values[param.key] = self.integer_value(
+                    field, value, minimum=param.low, maximum=param.high
+                )
+            else:
+                values[param.key] = self.number(
+                    field, value, low=-math.inf if param.low is None else param.low,
+                    high=math.inf if param.high is None else param.high,
+                    low_open=param.low_open, interval=param.interval,
+                )  # fmt: skip
+        return MappingProxyType(values)
 
     def _env(self) -> EnvConfig:
         env_id = self.string("env.id")

@@ -14,12 +14,10 @@ from typing import Any
 
 import yaml
 
+from cartpole_q.rl.schedules import SCHEDULE_KINDS
+
 ENGINES = ("auto", "numba", "gymnasium")
 """``engine`` values"""
-SCHEDULE_KINDS = ("constant", "exponential", "log")
-"""schedule ``type`` values, in the order of the codes the compiled schedules take"""
-ALGORITHMS = ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
-"""``agent.algorithm`` values, in the order of the codes the compiled algorithms take"""
 PHYSICS_KEYS = (
     "gravity",
     "masscart",
@@ -137,7 +135,7 @@ class AgentConfig:
     """The learning algorithm and its hyperparameters."""
 
     algorithm: str
-    """one of :data:`ALGORITHMS` (``design.md``, "Algorithms", states each precisely)"""
+    """a registered algorithm's name (:func:`cartpole_q.rl.algorithms.names`)"""
     gamma: float
     """discount factor in [0, 1]"""
     alpha: Schedule
@@ -148,6 +146,9 @@ class AgentConfig:
     """initial value of every Q-table entry"""
     max_q_table_bytes: int
     """refuse to allocate a Q-table larger than this many bytes"""
+    params: Mapping[str, float | int | str] = field(default_factory=lambda: MappingProxyType({}))
+    """the algorithm's own keys (``agent.n``, ``agent.lambda``; see its module in
+    :mod:`cartpole_q.rl.algorithms`), every one it declares, defaults filled (read-only)"""
 
 
 @dataclass(frozen=True)
@@ -220,6 +221,7 @@ class Config:
             },
             "agent": {
                 "algorithm": self.agent.algorithm,
+                **_plain(self.agent.params),
                 "gamma": self.agent.gamma,
                 "alpha": self.agent.alpha.to_yaml(),
                 "epsilon": self.agent.epsilon.to_yaml(),

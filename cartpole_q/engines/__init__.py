@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from cartpole_q.config import ALGORITHMS, Config, ConfigError, Provenance, blame
+from cartpole_q.config import Config, ConfigError, Provenance, blame
 from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
@@ -74,8 +74,9 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
         when the loop is cached.
     """
     from cartpole_q.numba_cache import is_cached
+    from cartpole_q.rl.algorithms import get as get_algorithm
 
-    algorithm = ALGORITHMS.index(config.agent.algorithm)
+    algorithm = get_algorithm(config.agent.algorithm)
     if engine == "numba":
         from cartpole_q.envs.registry import TwinSettings, twin_settings
 
@@ -83,10 +84,11 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
             config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
         )
         assert isinstance(settings, TwinSettings)
-        name = f"train_episodes_{algorithm}_{settings.code}"
-        seconds = "about 10 s"
+        name = f"train_episodes__{algorithm.key}__{settings.twin.key}"
+        seconds = "a few seconds"
     else:
-        name = f"next_step_{algorithm}"
+        kind = "box" if config.discretization is not None else "discrete"
+        name = f"next_step__{algorithm.key}__{kind}"
         seconds = "a few seconds"
     if is_cached(name):
         return None

@@ -2,7 +2,8 @@
 
 The compiled code takes a few typed records (named tuples of numbers and arrays) rather
 than long lists of positional arguments: :class:`Grid`, :class:`AgentRecord`,
-:class:`Tables` and :class:`EpisodeMetrics`.
+:class:`Tables` and :class:`EpisodeMetrics`. Which algorithm runs is not a record field: the
+compiled loops are built per algorithm (see :mod:`cartpole_q.engines.kernel`).
 """
 
 from __future__ import annotations
@@ -13,8 +14,11 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from cartpole_q.config import ALGORITHMS, Config, Schedule
+from cartpole_q.config import Config, Schedule
 from cartpole_q.envs.gym import EnvInfo
+from cartpole_q.envs.models import GREEDY_STEP_CAP
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithms import get as get_algorithm
 
 
 class ScheduleRecord(NamedTuple):
@@ -32,10 +36,8 @@ class ScheduleRecord(NamedTuple):
 
 
 class AgentRecord(NamedTuple):
-    """The algorithm and its hyperparameters, as the compiled code takes them."""
+    """The hyperparameters every algorithm has, as the compiled code takes them."""
 
-    algorithm: int
-    """the code of ``agent.algorithm`` (see :mod:`cartpole_q.rl.algorithms`)"""
     gamma: float
     alpha: ScheduleRecord
     epsilon: ScheduleRecord
@@ -83,14 +85,14 @@ class Grid(NamedTuple):
 
 
 class Tables(NamedTuple):
-    """The learned tables, as 2-D ``(n_states, n_actions)`` views.
-
-    ``q_b`` is Double Q-learning's second table (``(0, n_actions)`` for the others).
-    """
+    """The learned tables, as 2-D ``(n_states, n_actions)`` views, and the algorithm's memory."""
 
     q: np.ndarray
-    q_b: np.ndarray
+    """float64: the table the algorithm learns (Double Q-learning's ``A``)"""
     visits: np.ndarray
+    """int64: how often training took each (state, action)"""
+    memory: tuple[np.ndarray, ...]
+    """the algorithm's own arrays (Double Q-learning's ``B``, traces, buffers, a model)"""
 
 
 class EpisodeMetrics(NamedTuple):
@@ -122,29 +124,29 @@ class EpisodeMetrics(NamedTuple):
 
 @dataclass(frozen=True)
 class AgentParams:
-    """A config's grid and agent settings, ready for the compiled code."""
+    """A config's algorithm, grid and agent settings, ready for the compiled code."""
 
+    algorithm: Algorithm
     grid: Grid
     agent: AgentRecord
-
-    @property
-    def double(self) -> bool:
-        """Whether the algorithm keeps two tables (Double Q-learning)."""
-        return self.agent.algorithm == ALGORITHMS.index("double_q_learning")
+    params: tuple[float, ...]
+    """the algorithm's own parameters, as its hooks take them"""
 
     @classmethod
     def from_config(cls, config: Config, env_info: EnvInfo) -> AgentParams:
         """Build the parameters of a validated config on its environment."""
         threshold = env_info.reward_threshold
+        algorithm = get_algorithm(config.agent.algorithm)
         return cls(
+            algorithm=algorithm,
             grid=Grid.of(config, env_info),
             agent=AgentRecord(
-                algorithm=ALGORITHMS.index(config.agent.algorithm),
                 gamma=config.agent.gamma,
                 alpha=ScheduleRecord.of(config.agent.alpha),
                 epsilon=ScheduleRecord.of(config.agent.epsilon),
                 threshold=math.inf if threshold is None else float(threshold),
             ),
+            params=algorithm.hook_params(config.agent.params),
         )
 
 
@@ -162,6 +164,8 @@ class TrainingState:
     metrics: EpisodeMetrics
     physics_rng: np.random.Generator
     """draws ``env.randomize``'s physics before every episode (nothing else)"""
+    algorithm: Algorithm
+    """the algorithm that learns the tables (its policy table is ``q_table.npy``)"""
     episode: int = 0
     """episodes finished"""
     env_steps: int = 0
@@ -183,27 +187,33 @@ class TrainingState:
     ) -> TrainingState:
         """Allocate the state of a run that has not started."""
         n_states = math.prod(env_info.state_shape)
-        shape = (n_states, env_info.n_actions)
-        double = config.agent.algorithm == "double_q_learning"
+        algorithm = get_algorithm(config.agent.algorithm)
+        context = MemoryContext(
+            n_states=n_states,
+            n_actions=env_info.n_actions,
+            q_init=config.agent.q_init,
+            params=dict(config.agent.params),
+            max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
+        )
         return cls(
             tables=Tables(
-                q=np.full(shape, config.agent.q_init, dtype=np.float64),
-                q_b=np.full(shape if double else (0, shape[1]), config.agent.q_init),
-                visits=np.zeros(shape, dtype=np.int64),
+                q=np.full((n_states, env_info.n_actions), config.agent.q_init, dtype=np.float64),
+                visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
+                memory=tuple(algorithm.memory(context)),
             ),
             agent_rng=agent_rng,
             metrics=EpisodeMetrics.empty(config.train.episodes),
             physics_rng=physics_rng if physics_rng is not None else np.random.default_rng(0),
+            algorithm=algorithm,
         )
 
     def policy_table(self) -> np.ndarray:
-        """The table whose greedy actions are the policy: ``Q``, or ``0.5 * (A + B)``.
+        """The table whose greedy actions are the policy (``q_table.npy``).
 
-        Halving is exact in binary floating point, so ``0.5 * (A + B)`` has the greedy
-        actions (and ties) of ``A + B``, on which Double Q-learning acts.
+        ``Q`` for most algorithms; Double Q-learning's ``0.5 * (A + B)``: halving is exact in
+        binary floating point, so it has the greedy actions (and ties) of ``A + B``.
         """
-        q, q_b = self.tables.q, self.tables.q_b
-        return 0.5 * (q + q_b) if q_b.size else q
+        return self.algorithm.policy(self.tables.q, self.tables.memory)
 
 
 class Engine(Protocol):

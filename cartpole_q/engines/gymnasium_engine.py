@@ -1,7 +1,7 @@
 """The gymnasium engine: real ``gymnasium.make`` environments, stepped from Python.
 
-Each step calls compiled code built on the same
-:func:`~cartpole_q.rl.algorithms.learn_step` as the numba engine's loop.
+Each step calls compiled code built from the same algorithm hooks as the numba engine's
+loop (see :mod:`cartpole_q.engines.kernel`).
 """
 
 from __future__ import annotations
@@ -14,46 +14,92 @@ from gymnasium import spaces
 
 from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, Tables, TrainingState
-from cartpole_q.engines.kernel import (
-    compiled,
-    episode_rates,
-    reaches_threshold,
-    record_episode,
-)
+from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
 from cartpole_q.engines.play import play_greedy
 from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
+from cartpole_q.engines.rows import ROW_RULES
 from cartpole_q.envs.gym import make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
-from cartpole_q.rl.algorithms import ENDED, first_action, learn_step
-from cartpole_q.rl.policy import observation_row
+from cartpole_q.rl.algorithm import Algorithm
+from cartpole_q.rl.tabular import ENDED, no_episode_end
 
 configure_numba_cache()  # before any cache=True function is defined
 
+# Placeholders, bound per algorithm and observation kind by specialise(); never called as
+# they are.
+ALGORITHM_START: Any = None
+ALGORITHM_STEP: Any = None
+ALGORITHM_END: Any = None
+OBSERVATION_ROW: Any = None
+
+
+def first_step(
+    handle: Any, q: np.ndarray, memory: Any, params: Any, grid: Any, observation: Any,
+    epsilon: float,
+) -> tuple[int, int]:  # fmt: skip
+    """An episode's first row and action, for the reset observation."""
+    state = OBSERVATION_ROW(observation, grid)
+    return state, ALGORITHM_START(q, memory, params, state, epsilon, handle.rng)
+
+
+def next_step(
+    handle: Any, q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, grid: Any,
+    gamma: float, state: int, action: int, reward: float, observation: Any, terminated: bool,
+    truncated: bool, alpha: float, epsilon: float,
+) -> tuple[int, int]:  # fmt: skip
+    """Learn from one step; the next row and the next action (or ``ENDED``)."""
+    row = OBSERVATION_ROW(observation, grid)
+    visits[state, action] += 1
+    chosen = ALGORITHM_STEP(
+        q, memory, params, state, action, reward, row, terminated, truncated, alpha, gamma,
+        epsilon, handle.rng,
+    )  # fmt: skip
+    return row, chosen
+
+
+def end_episode(
+    handle: Any, q: np.ndarray, memory: Any, params: Any, alpha: float, gamma: float,
+    epsilon: float,
+) -> None:  # fmt: skip
+    """Finish an episode (the algorithm's ``end``)."""
+    ALGORITHM_END(q, memory, params, alpha, gamma, epsilon, handle.rng)
+
 
 @functools.cache
-def step_functions(algorithm: int) -> tuple[Any, Any]:
-    """The compiled first and next step of one algorithm, for a Python loop.
+def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
+    """The compiled first step, next step and episode end of one algorithm, for a Python loop.
+
+    Args:
+        algorithm: the algorithm whose hooks they call.
+        kind: the observation kind (``box``, ``discrete`` or ``tuple``; see
+            :data:`~cartpole_q.engines.rows.ROW_RULES`).
 
     They take the agent's generator wrapped in a handle (see :mod:`rng_handle`) and call
-    :func:`~cartpole_q.rl.algorithms.first_action` and
-    :func:`~cartpole_q.rl.algorithms.learn_step` with the algorithm as a constant, as the
-    numba engine's loop does.
+    the algorithm's hooks as the numba engine's loop does; cached on disk under the
+    algorithm's key and the kind.
     """
+    bindings = {
+        "ALGORITHM_START": algorithm.start,
+        "ALGORITHM_STEP": algorithm.step,
+        "ALGORITHM_END": algorithm.end,
+        "OBSERVATION_ROW": ROW_RULES[kind],
+    }
+    suffix = f"{algorithm.key}__{kind}"
+    return (
+        specialise(first_step, f"first_step__{suffix}", bindings),
+        specialise(next_step, f"next_step__{suffix}", bindings),
+        specialise(end_episode, f"end_episode__{suffix}", bindings),
+    )
 
-    def first(handle, tables, grid, observation, epsilon):
-        state = observation_row(observation, grid)
-        return state, first_action(algorithm, tables.q, tables.q_b, state, epsilon, handle.rng)
 
-    def following(handle, tables, grid, gamma, state, action, reward, observation,
-                  terminated, truncated, alpha, epsilon):  # fmt: skip
-        next_state = observation_row(observation, grid)
-        next_action = learn_step(
-            algorithm, tables.q, tables.q_b, tables.visits, state, action, reward, next_state,
-            terminated, truncated, alpha, gamma, epsilon, handle.rng,
-        )  # fmt: skip
-        return next_state, next_action
-
-    return compiled(first, f"first_step_{algorithm}"), compiled(following, f"next_step_{algorithm}")
+def observation_kind(space: Any) -> str:
+    """``box``, ``discrete`` or ``tuple``: how an observation of ``space`` becomes a row."""
+    if isinstance(space, spaces.Tuple):
+        return "tuple"
+    if isinstance(space, spaces.Discrete):
+        return "discrete"
+    return "box"
 
 
 class GymnasiumEngine:
@@ -84,7 +130,9 @@ class GymnasiumEngine:
             generator.bit_generator.state = env_rng_state
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
-        self._first, self._next = step_functions(params.agent.algorithm)
+        kind = observation_kind(self._env.observation_space)
+        self._first, self._next, self._end = step_functions(params.algorithm, kind)
+        self._has_end = params.algorithm.end is not no_episode_end
         # Tuple observations as plain integers: one compiled specialisation for any env.
         self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
         self._step_cap = step_cap
@@ -100,10 +148,13 @@ class GymnasiumEngine:
 
     def run(self, state: TrainingState, stop: int, check_solved: bool) -> int | None:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`)."""
-        grid, agent = self._params.grid, self._params.agent
-        env, tables, metrics = self._env, state.tables, state.metrics
+        grid, agent, params = self._params.grid, self._params.agent, self._params.params
+        env, metrics = self._env, state.metrics
+        q, visits, memory = state.tables
+        gamma = agent.gamma
         handle = self._rng_handle(state.agent_rng)
         randomize = self._config.env.randomize
+        first, following, as_ints = self._first, self._next, self._as_ints
         for episode in range(state.episode, stop):
             epsilon, alpha = episode_rates(agent, episode)
             if randomize:  # one draw per key, in the config's (canonical) order
@@ -114,18 +165,21 @@ class GymnasiumEngine:
                 set_physics(env, drawn)
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
-            if self._as_ints:
+            if as_ints:
                 observation = tuple(map(int, observation))
-            s, a = self._first(handle, tables, grid, observation, epsilon)
+            s, a = first(handle, q, memory, params, grid, observation, epsilon)
             episode_return, length = 0.0, 0
             while a != ENDED:
                 observation, reward, terminated, truncated, _ = env.step(a)
-                if self._as_ints:
+                if as_ints:
                     observation = tuple(map(int, observation))
                 length += 1
                 episode_return += reward
-                s, a = self._next(handle, tables, grid, agent.gamma, s, a, float(reward),
-                                  observation, terminated, truncated, alpha, epsilon)  # fmt: skip
+                s, a = following(handle, q, visits, memory, params, grid, gamma, s, a,
+                                 float(reward), observation, terminated, truncated, alpha,
+                                 epsilon)  # fmt: skip
+            if self._has_end:
+                self._end(handle, q, memory, params, alpha, gamma, epsilon)
             record_episode(metrics, episode, episode_return, length, epsilon, alpha)
             state.episode = episode + 1
             state.env_steps += length
@@ -138,25 +192,23 @@ class GymnasiumEngine:
 
         The observation sits on every lower grid edge (or is every component's ``start``),
         so it maps to row 0; epsilon 0 and a terminated step draw nothing from the agent's
-        generator, except Double Q-learning's coin, which is drawn from a scratch generator
-        here.
+        generator (an algorithm's own draws, such as Double Q-learning's coin, come from a
+        scratch generator here), and the scratch memory is a copy.
         """
-        grid, agent = self._params.grid, self._params.agent
+        grid, agent, params = self._params.grid, self._params.agent, self._params.params
         space = self._env.observation_space
         observation: Any = grid.low.astype(space.dtype)
         if grid.indexed:
             starts = tuple(int(start) for start in grid.starts)
             observation = starts if isinstance(space, spaces.Tuple) else starts[0]
-        n_actions = state.tables.q.shape[1]
-        scratch = Tables(
-            np.zeros((1, n_actions)),
-            np.zeros((1 if state.tables.q_b.size else 0, n_actions)),
-            np.zeros((1, n_actions), dtype=np.int64),
-        )
+        q, visits, memory = state.tables
+        scratch = Tables(q.copy(), visits.copy(), tuple(array.copy() for array in memory))
         handle = wrap_generator(np.random.default_rng(0))
-        self._first(handle, scratch, grid, observation, 0.0)
-        self._next(handle, scratch, grid, agent.gamma, 0, 0, 0.0, observation, True, False,
-                   0.0, 0.0)  # fmt: skip
+        self._first(handle, scratch.q, scratch.memory, params, grid, observation, 0.0)
+        self._next(handle, scratch.q, scratch.visits, scratch.memory, params, grid, agent.gamma,
+                   0, 0, 0.0, observation, True, False, 0.0, 0.0)  # fmt: skip
+        if self._has_end:
+            self._end(handle, scratch.q, scratch.memory, params, 0.0, agent.gamma, 0.0)
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""

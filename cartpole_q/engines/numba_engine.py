@@ -32,8 +32,8 @@ class NumbaEngine:
         env_rng_state: dict[str, Any] | None = None,
         randomize: Mapping[str, tuple[float, float]] | None = None,
     ) -> None:
-        self._train_episodes = training_kernel(params.agent.algorithm, settings.code)
-        self._greedy_returns = greedy_kernel(settings.code)
+        self._train_episodes = training_kernel(params.algorithm, settings.twin)
+        self._greedy_returns = greedy_kernel(settings.twin)
         self._env = (
             settings.max_episode_steps,
             settings.state_size,
@@ -55,9 +55,11 @@ class NumbaEngine:
     def run(self, state: TrainingState, stop: int, check_solved: bool) -> int | None:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`)."""
         p = self._params
+        q, visits, memory = state.tables
         finished, env_steps, solved = self._train_episodes(
-            state.tables, p.grid, p.agent, state.metrics, state.agent_rng, self._env_rng,
-            self._env, state.episode, stop, check_solved, state.physics_rng, self._randomize,
+            q, visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
+            self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
+            self._randomize,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps

@@ -1,49 +1,107 @@
-"""The compiled twins and the environments they reproduce, with one compiled dispatch.
+"""The compiled twins and the environments they reproduce.
 
-A twin is chosen by an integer code, so that one compiled training loop serves every twin:
-in compiled code, :func:`twin_reset` and :func:`twin_step` with a constant code become that
-twin's functions, inlined (numba's ``overload`` picks them while typing). A new twin is one
-module added to :data:`TWINS`.
+A twin is a module of compiled functions (``reset``, ``step``, and ``randomized`` where the
+environment has physics to randomise) with its sizes and the plain function that turns
+``gymnasium.make`` arguments into its parameters; :class:`Twin` is what the engines bind into
+their compiled loops (see :mod:`cartpole_q.engines.kernel`). A new twin is one module and
+one entry in :data:`TWINS` (its environment profile names it).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import hashlib
+import inspect
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
 
-from numba import types
-from numba.extending import overload
+import numpy as np
+from numba import njit
 
 from cartpole_q.envs.twins import acrobot, cartpole, mountaincar
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-TWINS: tuple[ModuleType, ...] = (cartpole, mountaincar, acrobot)
-"""the twin modules; the index of each is its code"""
-CARTPOLE, MOUNTAINCAR, ACROBOT = range(len(TWINS))
+
+@njit(cache=True, nogil=True, inline="always")
+def unchanged(
+    params: tuple[float, ...], rng: np.random.Generator, keys: np.ndarray, lows: np.ndarray,
+    highs: np.ndarray,
+) -> tuple[float, ...]:  # fmt: skip
+    """A twin without physics to randomise: its parameters, nothing drawn."""
+    return params
+
+
+@dataclass(frozen=True)
+class Twin:
+    """A compiled twin: what the compiled loops call, and what sizes them."""
+
+    name: str
+    """the module's name (``cartpole``)"""
+    key: str
+    """the name and a digest of the module's source (compiled loops are cached under it)"""
+    env_ids: tuple[str, ...]
+    """the Gymnasium ids it reproduces"""
+    reset: Any
+    """compiled ``reset(state, observation, rng, params)``"""
+    step: Any
+    """compiled ``step(state, action, observation, params) -> (reward, terminated)``"""
+    randomize: Any
+    """compiled ``randomize(params, rng, keys, lows, highs) -> params`` (``env.randomize``)"""
+    params: Callable[..., tuple[float, ...] | str]
+    """``params(kwargs[, physics])``: the twin's parameters, or why it cannot reproduce them"""
+    state_size: int
+    observation_size: int
+
+    @classmethod
+    def of(cls, module: ModuleType) -> Twin:
+        """The twin a module defines (see :mod:`cartpole_q.envs.twins`)."""
+        name = module.__name__.rpartition(".")[2]
+        digest = hashlib.sha256(inspect.getsource(module).encode()).hexdigest()[:12]
+        return cls(
+            name=name,
+            key=f"{name}_{digest}",
+            env_ids=tuple(module.ENV_IDS),
+            reset=module.reset,
+            step=module.step,
+            randomize=getattr(module, "randomized", unchanged),
+            params=module.twin_params,
+            state_size=int(module.STATE_SIZE),
+            observation_size=int(module.OBSERVATION_SIZE),
+        )
+
+
+TWINS: tuple[Twin, ...] = tuple(Twin.of(module) for module in (cartpole, mountaincar, acrobot))
+"""every twin the package has"""
 
 
 @dataclass(frozen=True)
 class TwinSettings:
     """Everything the compiled loop needs to run one environment's twin."""
 
-    code: int
-    """the twin's code (its index in :data:`TWINS`)"""
+    twin: Twin
     max_episode_steps: int
     """the time limit (truncation), as ``gymnasium.make`` applies it"""
     params: tuple[float, ...]
     """the twin's parameters (the ``gymnasium.make`` arguments it reproduces): a tuple,
     which compiled code passes by value, without the reference counting of an array"""
-    state_size: int
-    observation_size: int
+
+    @property
+    def state_size(self) -> int:
+        """Floats in the twin's state."""
+        return self.twin.state_size
+
+    @property
+    def observation_size(self) -> int:
+        """Floats in the twin's observation."""
+        return self.twin.observation_size
 
 
 def twin_ids() -> tuple[str, ...]:
     """Every environment id a twin reproduces."""
-    return tuple(env_id for twin in TWINS for env_id in twin.ENV_IDS)
+    return tuple(env_id for twin in TWINS for env_id in twin.env_ids)
 
 
 def twin_settings(
@@ -64,80 +122,13 @@ def twin_settings(
         ``TwinSettings`` when a twin reproduces the environment exactly, else a sentence
         naming the id or key it cannot reproduce.
     """
-    code = next((code for code, twin in enumerate(TWINS) if env_id in twin.ENV_IDS), None)
-    if code is None:
+    twin = next((twin for twin in TWINS if env_id in twin.env_ids), None)
+    if twin is None:
         return f"env.id {env_id!r} has no compiled twin (only {', '.join(twin_ids())} do)"
-    twin = TWINS[code]
-    params = twin.twin_params(kwargs, physics) if physics else twin.twin_params(kwargs)
+    params = twin.params(kwargs, physics) if physics else twin.params(kwargs)
     if isinstance(params, str):
         return params
     max_steps = kwargs.get("max_episode_steps", spec_max_steps)
     if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
         return f"env.kwargs key 'max_episode_steps' must be a positive integer, got {max_steps!r}"
-    return TwinSettings(code, max_steps, params, twin.STATE_SIZE, twin.OBSERVATION_SIZE)
-
-
-def twin_reset(code, state, observation, rng, params):
-    """Reset the twin ``code``: a start state drawn from ``rng``, its observation written.
-
-    Compiled code only, with ``code`` a compile-time constant: the call becomes that twin's
-    ``reset``, inlined.
-    """
-    raise NotImplementedError("twin_reset is called from compiled code only")
-
-
-@overload(twin_reset, inline="always")
-def _twin_reset(code, state, observation, rng, params):
-    if not isinstance(code, types.IntegerLiteral):
-        return None  # numba then retries with the constant's literal type
-    reset = TWINS[code.literal_value].reset
-
-    def implementation(code, state, observation, rng, params):
-        reset(state, observation, rng, params)
-
-    return implementation
-
-
-def twin_step(code, state, action, observation, params):
-    """Step the twin ``code``; return the reward and whether the step terminated.
-
-    Compiled code only, with ``code`` a compile-time constant (as :func:`twin_reset`).
-    """
-    raise NotImplementedError("twin_step is called from compiled code only")
-
-
-@overload(twin_step, inline="always")
-def _twin_step(code, state, action, observation, params):
-    if not isinstance(code, types.IntegerLiteral):
-        return None
-    step = TWINS[code.literal_value].step
-
-    def implementation(code, state, action, observation, params):
-        return step(state, action, observation, params)
-
-    return implementation
-
-
-def twin_randomize(code, params, rng, keys, lows, highs):
-    """The twin's ``params`` with ``env.randomize``'s draws (CartPole), else ``params``.
-
-    Compiled code only, with ``code`` a compile-time constant (as :func:`twin_reset`).
-    """
-    raise NotImplementedError("twin_randomize is called from compiled code only")
-
-
-@overload(twin_randomize, inline="always")
-def _twin_randomize(code, params, rng, keys, lows, highs):
-    if not isinstance(code, types.IntegerLiteral):
-        return None
-    if code.literal_value == CARTPOLE:
-
-        def physics(code, params, rng, keys, lows, highs):
-            return cartpole.randomized(params, rng, keys, lows, highs)
-
-        return physics
-
-    def unchanged(code, params, rng, keys, lows, highs):
-        return params
-
-    return unchanged
+    return TwinSettings(twin, max_steps, params)

@@ -33,7 +33,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any
 
+from cartpole_q.rl.tabular import compilable
 
+
+@compilable
 def state_index(observation: Any, low: Any, high: Any, bins: Any) -> int:
     """The flat (C-order) Q-table row of an observation.
 

@@ -1,4 +1,4 @@
-"""Schedules of the learning and exploration rates, one value per episode, compiled.
+"""Schedules of the learning and exploration rates: one value per episode.
 
 For episode ``e`` (0 for the first), each value is computed afresh as a float64 scalar
 (never by repeated multiplication):
@@ -6,6 +6,8 @@ For episode ``e`` (0 for the first), each value is computed afresh as a float64 
 - ``CONSTANT``: ``start``;
 - ``EXPONENTIAL``: ``max(end, start * rate ** float(e))`` with ``rate`` the decay;
 - ``LOG``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the ``k``.
+
+Plain Python, compiled by the engines (see :mod:`cartpole_q.rl.tabular`).
 
 >>> schedule_value(EXPONENTIAL, 1.0, 0.01, 0.5, 3)
 0.125
@@ -17,17 +19,14 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from cartpole_q.rl.tabular import compilable
 
-from cartpole_q.config.schema import SCHEDULE_KINDS
-from cartpole_q.numba_cache import configure as configure_numba_cache
-
-configure_numba_cache()  # before any cache=True function is defined
-
+SCHEDULE_KINDS = ("constant", "exponential", "log")
+"""schedule ``type`` values, in the order of the codes :func:`schedule_value` takes"""
 CONSTANT, EXPONENTIAL, LOG = range(len(SCHEDULE_KINDS))
 
 
-@njit(cache=True, nogil=True, inline="always")
+@compilable
 def schedule_value(kind: int, start: float, end: float, rate: float, episode: int) -> float:
     """Return a schedule's value at a 0-based episode index.
 
@@ -41,5 +40,5 @@ def schedule_value(kind: int, start: float, end: float, rate: float, episode: in
     if kind == CONSTANT:
         return start
     if kind == EXPONENTIAL:
-        return max(end, start * rate ** float(episode))
-    return max(end, min(start, 1.0 - math.log10((episode + 1.0) / rate)))
+        return float(max(end, start * rate ** float(episode)))
+    return float(max(end, min(start, 1.0 - math.log10((episode + 1.0) / rate))))

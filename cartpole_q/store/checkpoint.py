@@ -1,7 +1,11 @@
 """Checkpoints: everything ``train --resume`` needs, in one atomic ``checkpoint.npz``.
 
-Arrays are stored as arrays (``allow_pickle=False``); the rest (generator states, the
-config the run was trained with, counters) as one JSON string.
+Arrays are stored as arrays (``allow_pickle=False``): ``q``, ``visits``, the algorithm's
+memory as ``memory_0``, ``memory_1``, ... (whatever it keeps: Double Q-learning's second
+table, traces, buffers, a model), the metrics, and ``solved_q``; the rest (generator states,
+the config the run was trained with, counters) as one JSON string. Checkpoints written
+before algorithms kept memory stored Double Q-learning's second table as ``q_b`` (empty for
+the others): it loads as ``memory_0``.
 """
 
 from __future__ import annotations
@@ -22,6 +26,8 @@ from cartpole_q.store.atomic import atomic_write_bytes
 from cartpole_q.training import Checkpoint
 
 CHECKPOINT_FILE = "checkpoint.npz"
+MEMORY_PREFIX = "memory_"
+"""the keys of the algorithm's memory arrays: ``memory_0``, ``memory_1``, ..."""
 
 
 def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
@@ -39,8 +45,11 @@ def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
         "wall_seconds": checkpoint.wall_seconds,
         "config": None if checkpoint.config is None else checkpoint.config.to_yaml(),
     }
+    tables = checkpoint.tables
     arrays = {
-        **checkpoint.tables._asdict(),  # q, q_b (Double Q-learning's B; empty otherwise), visits
+        "q": tables.q,
+        "visits": tables.visits,
+        **{f"{MEMORY_PREFIX}{index}": array for index, array in enumerate(tables.memory)},
         **checkpoint.metrics._asdict(),  # returns, lengths, epsilons, alphas
         "meta": np.array(json.dumps(meta)),
     }
@@ -67,12 +76,7 @@ def load_checkpoint(run_dir: Path) -> Checkpoint:
                 engine=meta["engine"],
                 episode=int(meta["episode"]),
                 env_steps=int(meta["env_steps"]),
-                tables=Tables(
-                    q=data["q"],
-                    # checkpoints older than Double Q-learning have no second table
-                    q_b=data["q_b"] if "q_b" in data.files else np.zeros((0, data["q"].shape[1])),
-                    visits=data["visits"],
-                ),
+                tables=Tables(q=data["q"], visits=data["visits"], memory=_memory(data)),
                 metrics=EpisodeMetrics(*(data[name] for name in EpisodeMetrics._fields)),
                 agent_rng_state=meta["agent_rng_state"],
                 env_rng_state=meta["env_rng_state"],
@@ -91,6 +95,16 @@ def load_checkpoint(run_dir: Path) -> Checkpoint:
         raise RunError(
             f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
         ) from None
+
+
+def _memory(data: Any) -> tuple[np.ndarray, ...]:
+    """The algorithm's memory arrays, in order (an old checkpoint's ``q_b`` as the first)."""
+    count = sum(1 for name in data.files if name.startswith(MEMORY_PREFIX))
+    if count:
+        return tuple(data[f"{MEMORY_PREFIX}{index}"] for index in range(count))
+    if "q_b" in data.files and data["q_b"].size:
+        return (data["q_b"],)
+    return ()
 
 
 def _checkpoint_config(text: Any) -> Config | None:

@@ -1,0 +1,107 @@
+"""Compiling plain functions with numba: the algorithms' hooks and the helpers they call.
+
+The algorithms (:mod:`cartpole_q.rl`) are plain Python, so that configs, docs and doctests
+use them without numba. Here they are compiled: :func:`jit` gives a numba dispatcher of a
+function whose global names that refer to other plain functions marked
+:func:`~cartpole_q.rl.tabular.compilable` (or already compiled) now refer to their compiled
+versions, recursively. The function's own module is left untouched.
+
+:func:`specialise` builds the compiled loops (:mod:`cartpole_q.engines.kernel`) the same way:
+one template function, its placeholder globals (``ALGORITHM_STEP``, ``TWIN_STEP``) bound to
+one algorithm's and one twin's compiled functions, cached on disk under a name that says
+which. numba's cache key holds a function's bytecode and closure, not its globals, so the
+name (with the algorithm's and twin's source digests in it) keeps the variants apart.
+"""
+
+from __future__ import annotations
+
+import types
+from collections.abc import Callable, Mapping
+from typing import Any
+
+from numba import njit
+from numba.core.dispatcher import Dispatcher
+
+from cartpole_q.numba_cache import configure as configure_numba_cache
+
+configure_numba_cache()  # before any cache=True function is defined
+
+_COMPILED: dict[Callable[..., Any], Dispatcher] = {}
+
+
+def is_compilable(value: Any) -> bool:
+    """Whether ``value`` is a plain function marked for compilation."""
+    return isinstance(value, types.FunctionType) and bool(getattr(value, "__compilable__", False))
+
+
+def jit(function: Callable[..., Any]) -> Dispatcher:
+    """``function`` compiled (inlined where compiled code calls it), its helpers compiled too.
+
+    Compiled once per process; numba compiles it for each argument types on first use.
+    """
+    if isinstance(function, Dispatcher):
+        return function
+    found = _COMPILED.get(function)
+    if found is not None:
+        return found
+    assert isinstance(function, types.FunctionType), function
+    namespace = _compiled_globals(function)
+    rebuilt = types.FunctionType(
+        function.__code__, namespace, function.__name__, function.__defaults__,
+        function.__closure__,
+    )  # fmt: skip
+    rebuilt.__qualname__ = function.__qualname__
+    rebuilt.__module__ = function.__module__
+    rebuilt.__doc__ = function.__doc__
+    dispatcher = njit(nogil=True, inline="always")(rebuilt)
+    _COMPILED[function] = dispatcher
+    return dispatcher
+
+
+def _compiled_globals(function: types.FunctionType) -> dict[str, Any]:
+    """The function's globals, the compilable functions it names replaced by compiled ones."""
+    namespace = dict(function.__globals__)
+    for name in _global_names(function.__code__):
+        value = namespace.get(name)
+        if isinstance(value, types.FunctionType) and is_compilable(value):
+            namespace[name] = jit(value)
+    return namespace
+
+
+def _global_names(code: types.CodeType) -> set[str]:
+    """Every name a code object (and the code objects nested in it) may look up globally."""
+    names = set(code.co_names)
+    for constant in code.co_consts:
+        if isinstance(constant, types.CodeType):
+            names |= _global_names(constant)
+    return names
+
+
+def specialise(
+    template: Callable[..., Any], name: str, bindings: Mapping[str, Any], *, inline: bool = False
+) -> Dispatcher:
+    """A compiled copy of ``template`` whose placeholder globals are ``bindings``.
+
+    Args:
+        template: a function of :mod:`cartpole_q.engines.kernel` (or alike) that calls its
+            placeholders by global name (and compilable helpers, compiled as :func:`jit`
+            does).
+        name: a name unique to the bindings (it names the on-disk cache entry).
+        bindings: placeholder name -> a compiled function, or a plain one (compiled here,
+            as :func:`jit` does: an algorithm's hooks).
+        inline: inline the copy where compiled code calls it (then it is not cached by
+            itself: its callers' cache entries hold it).
+    """
+    assert isinstance(template, types.FunctionType)
+    namespace = _compiled_globals(template)
+    namespace.update({key: jit(value) if isinstance(value, types.FunctionType) else value
+                      for key, value in bindings.items()})  # fmt: skip
+    function = types.FunctionType(
+        template.__code__, namespace, name, template.__defaults__, template.__closure__
+    )
+    function.__qualname__ = name
+    function.__module__ = template.__module__
+    function.__doc__ = template.__doc__
+    if inline:
+        return njit(nogil=True, inline="always")(function)
+    return njit(nogil=True, cache=True)(function)

@@ -1,0 +1,150 @@
+"""What an algorithm is to the rest of the package, and the registry of algorithms.
+
+An algorithm is one module that builds an :class:`Algorithm`: its name and a line on it,
+the config keys it adds (``agent.n``, ``agent.lambda``: :class:`Param`), the memory it keeps
+across steps and episodes (Double Q-learning's second table, traces, an n-step buffer, a
+learned model), and its hooks, plain functions the engines compile with numba:
+
+- ``start(q, memory, params, state, epsilon, rng) -> action``: an episode begins in
+  ``state``; return its first action (default: epsilon-greedy on ``Q``);
+- ``step(q, memory, params, state, action, reward, next_state, terminated, truncated, alpha,
+  gamma, epsilon, rng) -> next action or ENDED``: learn from one transition; return the next
+  action, or :data:`~cartpole_q.rl.tabular.ENDED` when the episode ended;
+- ``end(q, memory, params, alpha, gamma, epsilon, rng)``: the episode has ended (default:
+  nothing).
+
+``q`` is the learned table as 2-D ``(n_states, n_actions)``; ``memory`` the tuple of arrays
+:attr:`Algorithm.memory` allocated; ``params`` the algorithm's parameters as a tuple of
+floats in :attr:`Algorithm.params` order. The training loop counts ``visits[s, a] += 1``
+before every step, for every algorithm. :attr:`Algorithm.policy` says which table
+``q_table.npy`` holds (``Q`` itself by default). Checkpoints store ``q`` and every memory
+array, so resuming any algorithm is byte-identical.
+
+A new algorithm is one module and one :func:`cartpole_q.rl.algorithms.register` call;
+configs, validation, the README's table and the benchmarks read the registry there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cartpole_q.rl.tabular import first_action, no_episode_end
+
+ParamValue = float | int | str
+
+
+@dataclass(frozen=True)
+class Param:
+    """A config key an algorithm adds under ``agent`` (``agent.n``, ``agent.trace``)."""
+
+    key: str
+    """the key under ``agent``"""
+    default: ParamValue
+    """the value a config that leaves it out gets"""
+    doc: str
+    """what it means, one line"""
+    kind: str = "float"
+    """``float``, ``int`` or ``choice``"""
+    low: float | None = None
+    """the smallest value (``None``: no bound)"""
+    high: float | None = None
+    """the largest value (``None``: no bound)"""
+    low_open: bool = False
+    """``low`` itself is excluded"""
+    choices: tuple[str, ...] = ()
+    """the values of a ``choice`` (passed to the hooks as their index, a float)"""
+
+    @property
+    def interval(self) -> str:
+        """The accepted values as text: ``[0, 1]``, ``an integer >= 1``, ``a, b or c``.
+
+        >>> Param("n", 1, "", kind="int", low=1).interval
+        'an integer >= 1'
+        >>> Param("lambda", 0.9, "", low=0.0, high=1.0).interval
+        '[0, 1]'
+        """
+        if self.kind == "choice":
+            return ", ".join(self.choices[:-1]) + f" or {self.choices[-1]}"
+        if self.kind == "int":
+            parts = [f">= {self.low:g}" if self.low is not None else ""]
+            parts += [f"<= {self.high:g}" if self.high is not None else ""]
+            return "an integer " + " and ".join(part for part in parts if part)
+        low = "-inf" if self.low is None else f"{self.low:g}"
+        high = "inf" if self.high is None else f"{self.high:g}"
+        return f"{'(' if self.low_open or self.low is None else '['}{low}, {high}{']' if self.high is not None else ')'}"
+
+    def as_float(self, value: ParamValue) -> float:
+        """The value as the hooks take it (a choice as its index).
+
+        >>> Param("trace", "replacing", "", kind="choice", choices=("a", "replacing")).as_float("replacing")
+        1.0
+        """
+        if self.kind == "choice":
+            return float(self.choices.index(str(value)))
+        return float(value)
+
+
+@dataclass(frozen=True)
+class MemoryContext:
+    """What an algorithm's memory is sized by."""
+
+    n_states: int
+    n_actions: int
+    q_init: float
+    params: Mapping[str, ParamValue]
+    """the algorithm's parameters by key (defaults filled)"""
+    max_steps: int
+    """the longest an episode can be (its time limit, or the greedy cap without one)"""
+
+
+def no_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """The memory of an algorithm that keeps none."""
+    return ()
+
+
+def same_table(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
+    """The policy of most algorithms: the table ``Q`` itself."""
+    return q
+
+
+@dataclass(frozen=True)
+class Algorithm:
+    """An algorithm: its name, its config keys, its memory and its compiled hooks."""
+
+    name: str
+    """the ``agent.algorithm`` value"""
+    description: str
+    """one line: what it is and where the book has it"""
+    step: Callable[..., int]
+    """learn from one transition and return the next action (see the module docstring)"""
+    start: Callable[..., int] = first_action
+    """choose an episode's first action"""
+    end: Callable[..., None] = no_episode_end
+    """finish an episode"""
+    params: tuple[Param, ...] = ()
+    """the config keys it adds under ``agent``, in the order the hooks get them"""
+    memory: Callable[[MemoryContext], tuple[np.ndarray, ...]] = no_memory
+    """allocate the arrays it keeps across steps and episodes"""
+    policy: Callable[[np.ndarray, tuple[np.ndarray, ...]], np.ndarray] = same_table
+    """the table whose greedy actions are its policy (``q_table.npy``), from ``Q`` and memory"""
+    memory_names: tuple[str, ...] = ()
+    """a name for each memory array (checkpoints and messages)"""
+    book: str = ""
+    """where Sutton & Barto (2nd ed.) state it"""
+    key: str = field(default="", compare=False)
+    """the name and a digest of the module's source: compiled code is cached under it, so
+    an edited algorithm is compiled again (set when registered)"""
+
+    def param(self, key: str) -> Param:
+        """The parameter ``key`` (raises ``KeyError`` for another)."""
+        for param in self.params:
+            if param.key == key:
+                return param
+        raise KeyError(key)
+
+    def hook_params(self, values: Mapping[str, ParamValue]) -> tuple[float, ...]:
+        """The parameters as the hooks take them: floats, in declaration order."""
+        return tuple(param.as_float(values[param.key]) for param in self.params)

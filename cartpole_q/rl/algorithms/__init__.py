@@ -1,0 +1,86 @@
+"""The registry of algorithms: the package's, and any a user registers.
+
+Each algorithm is one module here building an :class:`~cartpole_q.rl.algorithm.Algorithm`
+(its name, config keys, memory and hooks); :data:`PACKAGE` lists them in the order the
+documentation shows. A user's algorithm, from a module anywhere, is one :func:`register`
+call away from every command: configs accept its name and parameters, both engines train
+it, checkpoints keep its memory.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import inspect
+from collections.abc import Iterator
+
+from cartpole_q.rl.algorithm import Algorithm
+from cartpole_q.rl.algorithms import double_q_learning, expected_sarsa, q_learning, sarsa
+
+PACKAGE = (q_learning, sarsa, expected_sarsa, double_q_learning)
+"""the package's algorithm modules, in the order the documentation lists them"""
+
+_REGISTRY: dict[str, Algorithm] = {}
+
+
+def register(algorithm: Algorithm) -> Algorithm:
+    """Add an algorithm to the registry (a new name, or the same module again).
+
+    Returns:
+        The registered algorithm, its :attr:`~Algorithm.key` set.
+
+    Raises:
+        ValueError: another algorithm has this name, or a parameter's name is used by a
+            config key every algorithm has.
+    """
+    reserved = {"algorithm", "gamma", "alpha", "epsilon", "q_init", "max_q_table_bytes"}
+    clash = [param.key for param in algorithm.params if param.key in reserved]
+    if clash:
+        raise ValueError(f"algorithm {algorithm.name!r}: parameter {clash[0]!r} is a base key")
+    keyed = _with_key(algorithm)
+    existing = _REGISTRY.get(algorithm.name)
+    if existing is not None and existing.step.__module__ != algorithm.step.__module__:
+        raise ValueError(f"an algorithm named {algorithm.name!r} is registered already")
+    _REGISTRY[algorithm.name] = keyed
+    return keyed
+
+
+def _with_key(algorithm: Algorithm) -> Algorithm:
+    """The algorithm with its cache key: its name and a digest of its module's source."""
+    from dataclasses import replace
+
+    module = inspect.getmodule(algorithm.step)
+    try:
+        source = inspect.getsource(module) if module is not None else algorithm.name
+    except (OSError, TypeError):
+        source = algorithm.name
+    digest = hashlib.sha256(source.encode()).hexdigest()[:12]
+    return replace(algorithm, key=f"{algorithm.name}_{digest}")
+
+
+def get(name: str) -> Algorithm:
+    """The registered algorithm ``name`` (raises ``KeyError`` when there is none)."""
+    return _REGISTRY[name]
+
+
+def names() -> tuple[str, ...]:
+    """Every registered algorithm's name: the package's first, in their order, then others."""
+    return tuple(_REGISTRY)
+
+
+def algorithms() -> Iterator[Algorithm]:
+    """Every registered algorithm."""
+    return iter(tuple(_REGISTRY.values()))
+
+
+def params_of_others(name: str) -> dict[str, list[str]]:
+    """Each parameter key of the other algorithms, and which algorithms have it."""
+    found: dict[str, list[str]] = {}
+    for algorithm in algorithms():
+        if algorithm.name != name:
+            for param in algorithm.params:
+                found.setdefault(param.key, []).append(algorithm.name)
+    return found
+
+
+for _module in PACKAGE:
+    register(_module.ALGORITHM)

@@ -1,0 +1,97 @@
+"""Double Q-learning (van Hasselt 2010; Sutton & Barto 6.7): two tables, no maximisation bias.
+
+Memory: the second table ``B`` (``Q`` is ``A``), both starting at ``q_init``. Per step a coin
+``u = rng.random()`` is drawn first; if ``u < 0.5`` table ``A`` is updated with
+``g = argmax_b A(s', b)``, ``y = r + gamma * B(s', g)``; else ``B`` with
+``g = argmax_b B(s', b)``, ``y = r + gamma * A(s', g)`` (``y = r`` when terminated). Every
+action, an episode's first included, is epsilon-greedy on ``A + B``. ``q_table.npy`` holds
+``0.5 * (A + B)`` (halving is exact: the same greedy actions and ties as ``A + B``).
+
+>>> import numpy as np
+>>> a, b = np.zeros((2, 2)), np.array([[0.0, 0.0], [1.0, 3.0]])
+>>> step(a, (b,), (), 0, 0, 1.0, 1, False, False, 1.0, 1.0, 0.0, np.random.default_rng(2))
+1
+>>> float(a[0, 0]), float(b[0, 0])  # the coin picked A: 1 + B(1, argmax A(1, .) = 0) = 2
+(2.0, 0.0)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.tabular import ENDED, best_action, compilable, update
+
+
+@compilable
+def best_action_of_sum(q_a: Any, q_b: Any, state: int) -> int:
+    """``argmax_a (A(state, a) + B(state, a))``, the lowest action on ties."""
+    best = 0
+    best_sum = q_a[state, 0] + q_b[state, 0]
+    for action in range(1, q_a.shape[1]):
+        total = q_a[state, action] + q_b[state, action]
+        if total > best_sum:
+            best, best_sum = action, total
+    return best
+
+
+@compilable
+def epsilon_greedy_on_sum(q_a: Any, q_b: Any, state: int, epsilon: float, rng: Any) -> int:
+    """Epsilon-greedy on ``A + B``, with the draws of ``epsilon_greedy``."""
+    if epsilon <= 0.0:
+        return best_action_of_sum(q_a, q_b, state)
+    if epsilon >= 1.0 or rng.random() < epsilon:
+        return int(rng.integers(0, q_a.shape[1]))
+    return best_action_of_sum(q_a, q_b, state)
+
+
+def start(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any) -> int:
+    """The first action: epsilon-greedy on ``A + B``."""
+    return epsilon_greedy_on_sum(q, memory[0], state, epsilon, rng)
+
+
+def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Any) -> int:  # fmt: skip
+    """A coin picks the table to update; the other one values the updated one's choice."""
+    q_b = memory[0]
+    # Two explicit branches rather than swapped names: an array alias costs reference
+    # counting on every step.
+    if rng.random() < 0.5:
+        target = reward
+        if not terminated:
+            target = reward + gamma * q_b[next_state, best_action(q, next_state)]
+        update(q, state, action, target, alpha)
+    else:
+        target = reward
+        if not terminated:
+            target = reward + gamma * q[next_state, best_action(q_b, next_state)]
+        update(q_b, state, action, target, alpha)
+    if terminated or truncated:
+        return ENDED
+    return epsilon_greedy_on_sum(q, q_b, next_state, epsilon, rng)
+
+
+def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """Table ``B``, at ``q_init`` like ``A``."""
+    return (np.full((context.n_states, context.n_actions), context.q_init, dtype=np.float64),)
+
+
+def policy(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
+    """``0.5 * (A + B)``."""
+    mean: np.ndarray = 0.5 * (q + memory[0])
+    return mean
+
+
+ALGORITHM = Algorithm(
+    name="double_q_learning",
+    description="Double Q-learning: two tables, a coin picks which to update; acts on A + B",
+    book="6.7",
+    step=step,
+    start=start,
+    memory=memory,
+    memory_names=("q_b",),
+    policy=policy,
+)

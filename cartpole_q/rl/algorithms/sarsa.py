@@ -1,0 +1,43 @@
+"""SARSA (Rummery and Niranjan 1994; Sutton & Barto 6.4): on-policy TD control.
+
+Per step: the next action ``a'`` is drawn epsilon-greedily for ``s'`` from the table as it
+is, first (also at truncation, where ``a'`` is not played; not when terminated); then
+``y = r + gamma * Q(s', a')`` (``y = r`` when terminated), ``Q(s, a) += alpha * (y - Q(s, a))``.
+
+>>> import numpy as np
+>>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
+>>> step(q, (), (), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+1
+>>> float(q[0, 0])  # 0 + 0.5 * (1 + 4 - 0)
+2.5
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from cartpole_q.rl.algorithm import Algorithm
+from cartpole_q.rl.tabular import ENDED, epsilon_greedy, update
+
+
+def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Any) -> int:  # fmt: skip
+    """Draw ``a'`` first, then update toward ``r + gamma * Q(s', a')``."""
+    target = reward
+    next_action = ENDED
+    if not terminated:
+        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        target = reward + gamma * q[next_state, next_action]
+    update(q, state, action, target, alpha)
+    if terminated or truncated:
+        return ENDED
+    return next_action
+
+
+ALGORITHM = Algorithm(
+    name="sarsa",
+    description="SARSA: one-step on-policy TD control, target r + gamma * Q(s', a')",
+    book="6.4",
+    step=step,
+)

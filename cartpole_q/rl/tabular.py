@@ -1,0 +1,108 @@
+"""Acting on and learning a Q-table: the small functions every algorithm is written with.
+
+Plain Python that numba compiles: the engines compile every function marked
+:func:`compilable` (and the algorithms' hooks, which call them), so this module, and the
+algorithms, import neither numba nor gymnasium, and run as they are in a doctest.
+
+The Q-table is addressed as a 2-D ``(n_states, n_actions)`` array: the C-order view of the
+``(*bins, n_actions)`` table that is saved. The functions index single entries instead of
+taking row views: a view costs two atomic reference-count updates in compiled code, and
+numba's ``np.max`` of a two-entry row costs more than a whole CartPole step. Every argmax is
+the lowest action among the maxima, as ``np.argmax``.
+
+Epsilon-greedy, stated precisely: at ``epsilon <= 0`` greedy, nothing drawn; at
+``epsilon >= 1`` ``rng.integers(0, n_actions)``; otherwise ``rng.random() < epsilon``
+decides, then ``rng.integers(0, n_actions)`` when exploring.
+
+>>> import numpy as np
+>>> q = np.array([[1.0, 3.0, 3.0]])
+>>> best_action(q, 0), best_value(q, 0)
+(1, 3.0)
+>>> update(q, 0, 0, 2.0, 0.5)
+>>> float(q[0, 0])
+1.5
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+ENDED = -1
+"""the next action a step returns when the episode has ended"""
+
+Function = TypeVar("Function", bound=Callable[..., Any])
+
+
+def compilable(function: Function) -> Function:
+    """Mark a plain function as one the engines compile with the algorithms that call it.
+
+    The engines compile an algorithm's hooks with numba; a plain function they call must
+    be compiled too, and this mark says it may be. It changes nothing else.
+    """
+    function.__compilable__ = True  # type: ignore[attr-defined]
+    return function
+
+
+@compilable
+def best_action(q: Any, state: int) -> int:
+    """``argmax_a Q(state, a)``, the lowest action on ties."""
+    best = 0
+    for action in range(1, q.shape[1]):
+        if q[state, action] > q[state, best]:
+            best = action
+    return best
+
+
+@compilable
+def best_value(q: Any, state: int) -> float:
+    """``max_a Q(state, a)``."""
+    best = q[state, 0]
+    for action in range(1, q.shape[1]):
+        if q[state, action] > best:
+            best = q[state, action]
+    return float(best)
+
+
+@compilable
+def epsilon_greedy(q: Any, state: int, epsilon: float, rng: Any) -> int:
+    """A uniform random action with probability ``epsilon``, else the greedy one."""
+    if epsilon <= 0.0:
+        return best_action(q, state)
+    if epsilon >= 1.0 or rng.random() < epsilon:
+        return int(rng.integers(0, q.shape[1]))
+    return best_action(q, state)
+
+
+@compilable
+def update(q: Any, state: int, action: int, target: float, alpha: float) -> None:
+    """``Q(s, a) += alpha * (target - Q(s, a))``."""
+    q[state, action] += alpha * (target - q[state, action])
+
+
+@compilable
+def expected_value(q: Any, state: int, epsilon: float) -> float:
+    """``(1 - epsilon) * Q(s, g) + (epsilon / n) * S``: ``Q(s, .)`` under epsilon-greedy.
+
+    ``g`` is the greedy action of ``s``, ``S = Q(s, 0) + Q(s, 1) + ...`` summed in action
+    order (Expected SARSA's and tree backup's expectation).
+    """
+    n_actions = q.shape[1]
+    total = q[state, 0]
+    for action in range(1, n_actions):
+        total += q[state, action]
+    greedy = best_action(q, state)
+    return float((1.0 - epsilon) * q[state, greedy] + (epsilon / n_actions) * total)
+
+
+@compilable
+def first_action(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any) -> int:
+    """The default first action of an episode: epsilon-greedy on ``Q``."""
+    return epsilon_greedy(q, state, epsilon, rng)
+
+
+@compilable
+def no_episode_end(
+    q: Any, memory: Any, params: Any, alpha: float, gamma: float, epsilon: float, rng: Any
+) -> None:
+    """The default end of an episode: nothing (one-step methods learn as they go)."""
