@@ -1,0 +1,72 @@
+"""Plug-ins: an algorithm defined in one file outside the package trains like a shipped one.
+
+``tests/plugin_algorithm.py`` registers it; nothing in the package names it. It must be
+accepted by configs (with its own key), train on both engines to the same bytes, keep its
+memory in checkpoints so that a resumed run matches an uninterrupted one, and run from
+the command line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cartpole_q.config import ConfigError, load_config
+from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
+from cartpole_q.training import Checkpoint, train
+from tests import plugin_algorithm
+from tests.conftest import invoke, write_yaml
+
+NAME = plugin_algorithm.ALGORITHM.name
+SETTINGS = {
+    "agent.algorithm": NAME, "agent.behaviour": 0.3, "train.episodes": 120,
+    "train.stop_when_solved": False, "train.checkpoint_every": 40,
+}  # fmt: skip
+
+
+def test_configs_take_its_name_and_its_key() -> None:
+    config = load_config(overrides=SETTINGS)
+    assert config.agent.params == {"behaviour": 0.3}
+    assert config.to_dict()["agent"]["behaviour"] == 0.3
+    assert load_config(overrides={"agent.algorithm": NAME}).agent.params == {"behaviour": 0.2}
+    with pytest.raises(ConfigError, match=r"agent.behaviour: must be in \[0, 1\], got 2"):
+        load_config(overrides={**SETTINGS, "agent.behaviour": 2})
+    # its key does not apply to other algorithms: left out, not refused
+    assert load_config(overrides={"agent.behaviour": 0.5}).agent.params == {}
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_it_trains_on_both_engines_to_the_same_bytes_and_resumes(
+    engine: str, tmp_path: Path
+) -> None:
+    config = load_config(overrides={**SETTINGS, "engine": engine})
+
+    def keep_the_first(checkpoint: Checkpoint) -> None:  # a callback must save, not keep
+        if checkpoint.episode == 40:
+            write_checkpoint(tmp_path, checkpoint)
+
+    whole = train(config, on_checkpoint=keep_the_first, final_eval=False)
+    reference = train(load_config(overrides={**SETTINGS, "engine": "numba"}), final_eval=False)
+    assert whole.q_table.tobytes() == reference.q_table.tobytes()
+    assert whole.visits.tobytes() == reference.visits.tobytes()
+    assert whole.returns.tobytes() == reference.returns.tobytes()
+    # its memory counted every update, and travels in the checkpoint file
+    first = load_checkpoint(tmp_path)
+    (updates,) = first.tables.memory
+    assert updates.sum() == first.env_steps > 0
+    # resume from the checkpoint at episode 40: the same run, byte for byte
+    resumed = train(config, resume=first, final_eval=False)
+    assert resumed.q_table.tobytes() == whole.q_table.tobytes()
+    assert resumed.visits.tobytes() == whole.visits.tobytes()
+    assert resumed.returns.tobytes() == whole.returns.tobytes()
+
+
+def test_the_command_line_trains_it(tmp_path: Path) -> None:
+    config = write_yaml(
+        tmp_path / "plugin.yaml",
+        {"agent": {"algorithm": NAME, "behaviour": 0.1}, "train": {"episodes": 30}},
+    )
+    result = invoke("train", "-c", config, "--out", tmp_path / "run", "-q")
+    assert result.exit_code == 0, result.output
+    assert f"algorithm: {NAME}" in (tmp_path / "run" / "config.yaml").read_text()
