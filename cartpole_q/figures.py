@@ -18,6 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
+from cartpole_q.profiles import profile_for
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
 DPI = 100
@@ -28,30 +29,6 @@ POLICY_SIZE = (13.5, 4.2)
 BOOTSTRAP_RESAMPLES = 1000
 FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 """the extensions ``plot --out`` writes, and matplotlib's format for each"""
-DIMENSION_NAMES = {
-    "CartPole": (
-        "cart position (m)",
-        "cart velocity (m/s)",
-        "pole angle (rad)",
-        "pole angular velocity (rad/s)",
-    ),
-    "MountainCar": ("position", "velocity"),
-    "Acrobot": (
-        "cos θ1",
-        "sin θ1",
-        "cos θ2",
-        "sin θ2",
-        "θ1 velocity (rad/s)",
-        "θ2 velocity (rad/s)",
-    ),
-}
-"""observation names of the known environments, by the id's name before ``-v``"""
-ACTION_NAMES = {
-    "CartPole": ("push left", "push right"),
-    "MountainCar": ("accelerate left", "don't accelerate", "accelerate right"),
-    "Acrobot": ("torque -1", "torque 0", "torque +1"),
-}
-"""what each action does in the known environments"""
 
 
 @dataclass(frozen=True)
@@ -341,31 +318,22 @@ def default_dims(bins: Sequence[int]) -> tuple[int, int]:
     return first, second
 
 
-def _known_environment(env_id: str) -> str:
-    """The name of a Gymnasium id without namespace and version: ``CartPole-v1`` → ``CartPole``."""
-    return env_id.rsplit("/", 1)[-1].split("-v")[0]
-
-
 def dimension_names(env_id: str, n_dims: int) -> list[str]:
-    """Axis names of the observation dimensions; ``observation N`` for unknown ones.
+    """Axis names of the observation dimensions (the profile's); ``observation N`` otherwise.
 
     >>> dimension_names("CartPole-v1", 4)[2], dimension_names("Other-v0", 2)
     ('pole angle (rad)', ['observation 0', 'observation 1'])
     """
-    names = DIMENSION_NAMES.get(_known_environment(env_id))
-    if names is not None and len(names) == n_dims:
-        return list(names)
-    return [f"observation {d}" for d in range(n_dims)]
+    return profile_for(env_id).names_observations(n_dims)
 
 
 def action_names(env_id: str, n_actions: int) -> list[str] | None:
-    """What each action does, for the known environments.
+    """What each action does, as the environment's profile says.
 
     >>> action_names("MountainCar-v0", 3)[1], action_names("Other-v0", 2)
     ("don't accelerate", None)
     """
-    names = ACTION_NAMES.get(_known_environment(env_id))
-    return list(names) if names is not None and len(names) == n_actions else None
+    return profile_for(env_id).names_actions(n_actions)
 
 
 @dataclass(frozen=True)

@@ -28,14 +28,9 @@ from cartpole_q.config.loading import (
 )
 from cartpole_q.config.schema import (
     ENGINES,
-    INTEGRATORS,
     MAX_EPISODES,
     MAX_SEED,
     MAX_SEEDS,
-    PHYSICS_ENV_IDS,
-    PHYSICS_KEYS,
-    PHYSICS_RANGES,
-    RANDOMIZED_KEYS,
     AgentConfig,
     Config,
     DiscretizationConfig,
@@ -50,16 +45,11 @@ from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 __all__ = [
     "ENGINES",
-    "INTEGRATORS",
     "MAX_EPISODES",
     "MAX_SEED",
     "MAX_SEEDS",
     "NOT_SET",
     "OVERRIDE_SOURCE",
-    "PHYSICS_ENV_IDS",
-    "PHYSICS_KEYS",
-    "PHYSICS_RANGES",
-    "RANDOMIZED_KEYS",
     "SCHEDULE_KINDS",
     "AgentConfig",
     "Config",

@@ -35,14 +35,9 @@ import yaml
 from cartpole_q.config.schema import (
     ENGINES,
     EXACT_INTEGER,
-    INTEGRATORS,
     MAX_EPISODES,
     MAX_SEED,
     MAX_SEEDS,
-    PHYSICS_ENV_IDS,
-    PHYSICS_KEYS,
-    PHYSICS_RANGES,
-    RANDOMIZED_KEYS,
     AgentConfig,
     Config,
     DiscretizationConfig,
@@ -52,6 +47,7 @@ from cartpole_q.config.schema import (
     TrainConfig,
 )
 from cartpole_q.errors import ConfigError
+from cartpole_q.profiles import PhysicsRange, all_profiles, profile_for
 from cartpole_q.rl.algorithm import ParamValue
 from cartpole_q.rl.algorithms import algorithms
 from cartpole_q.rl.algorithms import get as get_algorithm
@@ -206,7 +202,9 @@ def _without_default_grid(
         path == "discretization" or path.startswith("discretization.") for path in overridden
     )
     env = raw.get("env")
-    if given or not isinstance(env, dict) or env.get("id") in PHYSICS_ENV_IDS:
+    if given or not isinstance(env, dict) or not isinstance(env.get("id"), str):
+        return raw
+    if profile_for(env["id"]).default_grid:
         return raw
     return {**raw, "discretization": None}
 
@@ -773,50 +771,54 @@ class _Reader:
             id=env_id, kwargs=self.kwargs("env.kwargs"), physics=physics, randomize=randomize
         )
 
-    def _physics_mapping(self, field: str, env_id: str, keys: tuple[str, ...]) -> dict[str, Any]:
+    def _physics_mapping(self, field: str, env_id: str, kind: str) -> tuple[dict[str, Any], Any]:
+        """The raw ``env.physics`` or ``env.randomize`` mapping, and the env's physics."""
         value = self._value(field)
         if value is None or value == {}:
-            return {}
+            return {}, None
         if not isinstance(value, dict):
             raise self.error(field, f"must be a mapping of keys to values, got {_shown(value)}.")
-        if env_id not in PHYSICS_ENV_IDS:
+        physics = profile_for(env_id).physics
+        if physics is None:
+            with_physics = [p.ids[0] for p in all_profiles() if p.physics is not None]
             raise self.error(
                 field,
-                f"applies to CartPole only ({', '.join(PHYSICS_ENV_IDS)}), but env.id is "
-                f"{env_id!r}.",
+                f"applies to environments with physics to set ({', '.join(with_physics)}), but "
+                f"env.id is {env_id!r}.",
             )
+        keys = physics.keys if kind == "physics" else physics.randomizable
         for key in value:
             if key not in keys:
                 raise ConfigError(
                     f"{self.source_of(field)}: {_unknown_key(key, list(keys), f'{field}.')}"
                 )
-        return value
+        return value, physics
 
     def _physics(self, env_id: str) -> Mapping[str, float | str]:
-        value = self._physics_mapping("env.physics", env_id, PHYSICS_KEYS)
+        value, spec = self._physics_mapping("env.physics", env_id, "physics")
         physics: dict[str, float | str] = {}
-        for key in PHYSICS_KEYS:  # canonical order
+        for key in spec.keys if spec is not None else ():  # canonical order
             if key not in value:
                 continue
             field = f"env.physics.{key}"
-            if key == "kinematics_integrator":
-                physics[key] = self.choice_value(field, value[key], INTEGRATORS)
+            if key in spec.choices:
+                physics[key] = self.choice_value(field, value[key], spec.choices[key])
             else:
-                physics[key] = self.number(field, value[key], **_physics_bounds(key))
+                physics[key] = self.number(field, value[key], **_bounds(spec.ranges[key]))
         return MappingProxyType(physics)
 
     def _randomize(self, env_id: str) -> Mapping[str, tuple[float, float]]:
-        value = self._physics_mapping("env.randomize", env_id, RANDOMIZED_KEYS)
+        value, spec = self._physics_mapping("env.randomize", env_id, "randomize")
         ranges: dict[str, tuple[float, float]] = {}
-        for key in RANDOMIZED_KEYS:  # the order of the draws
+        for key in spec.randomizable if spec is not None else ():  # the order of the draws
             if key not in value:
                 continue
             field = f"env.randomize.{key}"
             pair = value[key]
             if not isinstance(pair, list) or len(pair) != 2:
                 raise self.error(field, f"must be [low, high], got {_shown(pair)}.")
-            low = self.number(f"{field}[0]", pair[0], **_physics_bounds(key))
-            high = self.number(f"{field}[1]", pair[1], **_physics_bounds(key))
+            low = self.number(f"{field}[0]", pair[0], **_bounds(spec.ranges[key]))
+            high = self.number(f"{field}[1]", pair[1], **_bounds(spec.ranges[key]))
             if low > high:
                 raise self.error(field, f"low ({low}) must not be above high ({high}).")
             ranges[key] = (low, high)
@@ -849,11 +851,12 @@ class _Reader:
         return DiscretizationConfig(bins=bins, low=low, high=high)
 
 
-def _physics_bounds(key: str) -> dict[str, Any]:
-    """The :meth:`_Reader.number` bounds of a physics key (see ``PHYSICS_RANGES``)."""
-    low, low_open, high = PHYSICS_RANGES[key]
-    interval = f"{'(' if low_open else '['}{low:g}, {high:g}]"
-    return {"low": low, "low_open": low_open, "high": high, "interval": interval}
+def _bounds(allowed: PhysicsRange) -> dict[str, Any]:
+    """The :meth:`_Reader.number` bounds of a physics key (its profile's range)."""
+    return {
+        "low": allowed.low, "low_open": allowed.low_open, "high": allowed.high,
+        "interval": allowed.interval,
+    }  # fmt: skip
 
 
 def config_differences(old: Config, new: Config) -> list[tuple[str, Any, Any]]:

@@ -18,38 +18,6 @@ from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 ENGINES = ("auto", "numba", "gymnasium")
 """``engine`` values"""
-PHYSICS_KEYS = (
-    "gravity",
-    "masscart",
-    "masspole",
-    "length",
-    "force_mag",
-    "tau",
-    "kinematics_integrator",
-    "theta_threshold_radians",
-    "x_threshold",
-)
-"""``env.physics`` keys: ``CartPoleEnv`` attributes (``length`` is half the pole)"""
-PHYSICS_RANGES: dict[str, tuple[float, bool, float]] = {
-    "gravity": (0.0, False, 1000.0),
-    "masscart": (0.0, True, 1000.0),
-    "masspole": (0.0, True, 1000.0),
-    "length": (0.0, True, 100.0),
-    "force_mag": (0.0, True, 10_000.0),
-    "tau": (0.0, True, 1.0),
-    "theta_threshold_radians": (0.0, True, 3.141592653589793),
-    "x_threshold": (0.0, True, 1000.0),
-}
-"""each numeric ``env.physics`` key's ``(low, low excluded, high)``. Gravity may be 0
-(weightless: the pole only moves when pushed) but not negative, which would pull the pole
-upright and make balancing a different task; the upper ends keep the state finite (a
-force of 1e308 overflows float64 at the first step)"""
-RANDOMIZED_KEYS = ("gravity", "masscart", "masspole", "length", "force_mag", "tau")
-"""``env.randomize`` keys, in the order of their draws"""
-INTEGRATORS = ("euler", "semi-implicit euler")
-"""``env.physics.kinematics_integrator`` values"""
-PHYSICS_ENV_IDS = ("CartPole-v0", "CartPole-v1")
-"""the environments ``env.physics`` and ``env.randomize`` apply to"""
 MAX_EPISODES = 10_000_000
 """the most episodes a run (or an evaluation) may ask for"""
 MAX_SEEDS = 10_000
@@ -105,13 +73,13 @@ class EnvConfig:
     kwargs: Mapping[str, Any]
     """keyword arguments forwarded to ``gymnasium.make`` (read-only mapping)"""
     physics: Mapping[str, float | str] = field(default_factory=lambda: MappingProxyType({}))
-    """CartPole only: attributes of ``CartPoleEnv`` set after ``gymnasium.make`` (see
-    :data:`PHYSICS_KEYS`); derived values are recomputed as ``CartPoleEnv.__init__`` does"""
+    """attributes set on ``env.unwrapped`` after ``gymnasium.make``: the keys and ranges the
+    environment's profile allows (CartPole's, in :mod:`cartpole_q.profiles.cartpole`)"""
     randomize: Mapping[str, tuple[float, float]] = field(
         default_factory=lambda: MappingProxyType({})
     )
-    """CartPole only: ``[low, high]`` per key of :data:`RANDOMIZED_KEYS`; one uniform draw
-    per key (in that order) before every training episode's reset"""
+    """``[low, high]`` per key the profile lets vary; one uniform draw per key (in the
+    profile's order) before every training episode's reset"""
 
 
 @dataclass(frozen=True)

@@ -12,10 +12,10 @@ from typing import Any
 import numpy as np
 from gymnasium.utils import seeding
 
-from cartpole_q.config import RANDOMIZED_KEYS
 from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.registry import TwinSettings
+from cartpole_q.profiles import profile_for
 
 
 class NumbaEngine:
@@ -42,8 +42,10 @@ class NumbaEngine:
         )
         self._params = params
         ranges = randomize or {}
+        physics = profile_for(settings.twin.env_ids[0]).physics
+        drawn = physics.randomizable if physics is not None else ()
         self._randomize = (
-            np.array([RANDOMIZED_KEYS.index(key) for key in ranges], dtype=np.int64),
+            np.array([drawn.index(key) for key in ranges], dtype=np.int64),
             np.array([low for low, _ in ranges.values()], dtype=np.float64),
             np.array([high for _, high in ranges.values()], dtype=np.float64),
         )

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
+from cartpole_q.profiles import profile_for
 
 SOLVE_WINDOW = 100
 """episodes in the moving average of training returns compared with the reward threshold"""
@@ -123,17 +124,18 @@ def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> 
 
 
 def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
-    """Set CartPole's physics on ``env.unwrapped``, derived values recomputed.
+    """Set physics on ``env.unwrapped`` as the environment's profile does it.
 
-    ``total_mass`` and ``polemass_length`` are recomputed exactly as
-    ``CartPoleEnv.__init__`` computes them; setting the attributes alone would leave them
-    stale (ray #14090).
+    CartPole's recomputes ``total_mass`` and ``polemass_length`` exactly as
+    ``CartPoleEnv.__init__`` does; setting the attributes alone would leave them stale
+    (ray #14090).
     """
-    cartpole = env.unwrapped
-    for key, value in physics.items():
-        setattr(cartpole, key, value)
-    cartpole.total_mass = cartpole.masspole + cartpole.masscart
-    cartpole.polemass_length = cartpole.masspole * cartpole.length
+    spec = getattr(env, "spec", None)
+    env_id = spec.id if spec is not None else ""
+    physics_spec = profile_for(env_id).physics
+    if physics_spec is None or physics_spec.apply is None:
+        raise ConfigError(f"env.physics: {env_id!r} has no physics to set.")
+    physics_spec.apply(env, physics)
 
 
 def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
@@ -151,13 +153,11 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
             observation is given a grid, or the Q-table would exceed the size limit.
     """
     from gymnasium import spaces
-    from gymnasium.envs.classic_control import CartPoleEnv
 
     env_id = config.env.id
     env = make_env(config.env, source=source)
     try:
         observation_space, action_space, spec = env.observation_space, env.action_space, env.spec
-        is_cartpole = isinstance(env.unwrapped, CartPoleEnv)
         try:  # some arguments are only used, and refused, at the first reset
             env.reset(seed=0)
         except Exception as error:
@@ -221,7 +221,7 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
     max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
     threshold = config.train.reward_threshold
     if threshold is None and spec is not None and spec.reward_threshold is not None:
-        threshold = _default_threshold(env_id, float(spec.reward_threshold), max_steps, is_cartpole)
+        threshold = _default_threshold(env_id, float(spec.reward_threshold), max_steps)
     return EnvInfo(
         id=env_id,
         observation_dim=observation_dim,
@@ -248,17 +248,18 @@ def _index_starts(space: Any) -> tuple[int, ...] | None:
     return None
 
 
-def _default_threshold(
-    env_id: str, registered_threshold: float, max_steps: Any, is_cartpole: bool
-) -> float:
+def _default_threshold(env_id: str, registered_threshold: float, max_steps: Any) -> float:
     """The solve threshold when the config gives none: the environment's registered one.
 
-    CartPole's scales with a changed time limit: ``threshold * max_episode_steps /
-    registered max_episode_steps`` (475 of 500 steps becomes 950 of 1000).
+    Where the profile says so (CartPole), it scales with a changed time limit:
+    ``threshold * max_episode_steps / registered max_episode_steps`` (475 of 500 steps
+    becomes 950 of 1000).
     """
     import gymnasium
 
-    if not is_cartpole or not isinstance(max_steps, int) or isinstance(max_steps, bool):
+    if not profile_for(env_id).threshold_scales:
+        return registered_threshold
+    if not isinstance(max_steps, int) or isinstance(max_steps, bool):
         return registered_threshold
     registered_steps = gymnasium.spec(env_id).max_episode_steps
     if not registered_steps or max_steps <= 0 or max_steps == registered_steps:

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import EnvConfig
+from cartpole_q.profiles import profile_for
 from cartpole_q.rl.value_iteration import TabularModel
 
 GREEDY_STEP_CAP = 10_000
@@ -64,7 +65,9 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
         limit = env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
         limit = limit if limit is not None else spec_max_steps
         horizon = int(limit) if limit else GREEDY_STEP_CAP
-        if type(unwrapped).__name__ == "BlackjackEnv":
+        # Any environment with a transition table has that model, profiled or not.
+        kind = profile_for(env.id).model or "transition_table"
+        if kind == "blackjack":
             unsupported = [key for key in env.kwargs if key not in _BLACKJACK_KWARGS]
             if unsupported:
                 return f"env.kwargs key {unsupported[0]!r} is not in the Blackjack model"
@@ -229,20 +232,23 @@ class GridLayout:
 
 
 def grid_layout(env: EnvConfig) -> GridLayout | None:
-    """The map of FrozenLake (its ``desc``) or CliffWalking (its cliff); ``None`` otherwise."""
+    """A grid world's map, as its profile says to read it; ``None`` for other environments.
+
+    FrozenLake's from its ``desc``, CliffWalking's from its cliff.
+    """
     from cartpole_q.envs.gym import make_env
 
     made = make_env(env)
     try:
         unwrapped = made.unwrapped
-        name = type(unwrapped).__name__
-        if name == "FrozenLakeEnv":
+        reader = profile_for(env.id).grid_reader
+        if reader == "frozenlake":
             desc = [[cell.decode() for cell in row] for row in unwrapped.desc]
             rows, columns = len(desc), len(desc[0])
             cells = tuple(desc[r][c] for r in range(rows) for c in range(columns))
             moves = ((0, -1), (1, 0), (0, 1), (-1, 0))  # left, down, right, up
             return GridLayout(rows, columns, cells, moves)
-        if name == "CliffWalkingEnv":
+        if reader == "cliffwalking":
             rows, columns = (int(n) for n in unwrapped.shape)
             cliff = np.asarray(unwrapped._cliff)
             start = int(unwrapped.start_state_index)

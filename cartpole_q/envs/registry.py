@@ -3,13 +3,15 @@
 A twin is a module of compiled functions (``reset``, ``step``, and ``randomized`` where the
 environment has physics to randomise) with its sizes and the plain function that turns
 ``gymnasium.make`` arguments into its parameters; :class:`Twin` is what the engines bind into
-their compiled loops (see :mod:`cartpole_q.engines.kernel`). A new twin is one module and
-one entry in :data:`TWINS` (its environment profile names it).
+their compiled loops (see :mod:`cartpole_q.engines.kernel`). An environment's profile names
+its twin's module (:attr:`cartpole_q.profiles.base.EnvProfile.twin`): a new twin is one
+module and that one line.
 """
 
 from __future__ import annotations
 
 import hashlib
+import importlib
 import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -19,8 +21,8 @@ from typing import Any
 import numpy as np
 from numba import njit
 
-from cartpole_q.envs.twins import acrobot, cartpole, mountaincar
 from cartpole_q.numba_cache import configure as configure_numba_cache
+from cartpole_q.profiles import EnvProfile, all_profiles, profile_for
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -56,14 +58,14 @@ class Twin:
     observation_size: int
 
     @classmethod
-    def of(cls, module: ModuleType) -> Twin:
-        """The twin a module defines (see :mod:`cartpole_q.envs.twins`)."""
+    def of(cls, module: ModuleType, profile: EnvProfile) -> Twin:
+        """The twin a module defines (see :mod:`cartpole_q.envs.twins`) for a profile."""
         name = module.__name__.rpartition(".")[2]
         digest = hashlib.sha256(inspect.getsource(module).encode()).hexdigest()[:12]
         return cls(
             name=name,
             key=f"{name}_{digest}",
-            env_ids=tuple(module.ENV_IDS),
+            env_ids=profile.ids,
             reset=module.reset,
             step=module.step,
             randomize=getattr(module, "randomized", unchanged),
@@ -73,8 +75,26 @@ class Twin:
         )
 
 
-TWINS: tuple[Twin, ...] = tuple(Twin.of(module) for module in (cartpole, mountaincar, acrobot))
-"""every twin the package has"""
+_LOADED: dict[str, Twin] = {}
+
+
+def _twin_of(profile: EnvProfile) -> Twin | None:
+    """The twin a profile names (its module imported, and the record made, once)."""
+    if profile.twin is None:
+        return None
+    if profile.name not in _LOADED:
+        _LOADED[profile.name] = Twin.of(importlib.import_module(profile.twin), profile)
+    return _LOADED[profile.name]
+
+
+def twin_for(env_id: str) -> Twin | None:
+    """The twin of an environment, as its profile names it (``None``: it has none)."""
+    return _twin_of(profile_for(env_id))
+
+
+def twins() -> tuple[Twin, ...]:
+    """Every twin the registered profiles name."""
+    return tuple(twin for profile in all_profiles() if (twin := _twin_of(profile)) is not None)
 
 
 @dataclass(frozen=True)
@@ -101,7 +121,7 @@ class TwinSettings:
 
 def twin_ids() -> tuple[str, ...]:
     """Every environment id a twin reproduces."""
-    return tuple(env_id for twin in TWINS for env_id in twin.env_ids)
+    return tuple(env_id for twin in twins() for env_id in twin.env_ids)
 
 
 def twin_settings(
@@ -122,7 +142,7 @@ def twin_settings(
         ``TwinSettings`` when a twin reproduces the environment exactly, else a sentence
         naming the id or key it cannot reproduce.
     """
-    twin = next((twin for twin in TWINS if env_id in twin.env_ids), None)
+    twin = twin_for(env_id)
     if twin is None:
         return f"env.id {env_id!r} has no compiled twin (only {', '.join(twin_ids())} do)"
     params = twin.params(kwargs, physics) if physics else twin.params(kwargs)

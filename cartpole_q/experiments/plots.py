@@ -5,6 +5,7 @@ Nothing is drawn before the output file is known to be writable.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -28,6 +29,7 @@ from cartpole_q.figures import (
     reward_and_paths_figure,
     reward_curve_figure,
 )
+from cartpole_q.profiles import profile_for
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
 from cartpole_q.store.runsets import load_run_set
@@ -232,42 +234,43 @@ def agreement_table(runs: Sequence[rundir.Run]) -> tuple[np.ndarray, np.ndarray 
     return votes, np.sum(counts, axis=0)
 
 
-TAXI_SHAPE = (5, 5, 5, 4)
-"""Taxi's state ``((taxi row * 5 + taxi column) * 5 + passenger location) * 4 + destination``"""
-TAXI_ACTIONS = ("south", "north", "east", "west", "pickup", "drop off")
-
-
 def _plot_discrete_policy(
     config: Config, q: np.ndarray, visits: np.ndarray | None, out: Path, title: str, force: bool
 ) -> Path:
-    """Grid worlds as grids, Blackjack as two panels, Taxi over the taxi's position."""
+    """Draw a Discrete policy as the environment's profile lays its states out.
+
+    A grid world's cells, Blackjack's two panels, a Discrete state's components (Taxi: over
+    the taxi's position), or a Tuple's components.
+    """
     from cartpole_q.envs.models import grid_layout
 
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    layout = grid_layout(config.env)
+    profile = profile_for(config.env.id)
+    layout = grid_layout(config.env) if profile.policy_map == "grid" else None
+    actions = profile.names_actions(q.shape[-1])
     if layout is not None:
         grid = GridMap(layout.rows, layout.columns, layout.cells, layout.moves)
         figure = grid_policy_figure(q, visits, grid, title)
-    elif q.shape == (32, 11, 2, 2):
+    elif profile.policy_map == "blackjack":
         figure = blackjack_policy_figure(q, visits, title)
     else:
-        if q.shape[:-1] == (500,) and q.shape[-1] == len(TAXI_ACTIONS):
-            shape, names, actions = (
-                TAXI_SHAPE,
-                ["taxi row", "taxi column", "passenger", "destination"],
-                list(TAXI_ACTIONS),
-            )
+        if profile.policy_map == "components" and math.prod(profile.state_components) == math.prod(
+            q.shape[:-1]
+        ):
+            shape, names = profile.state_components, list(profile.component_names)
         elif q.ndim >= 3:
-            shape, names, actions = (
-                q.shape[:-1],
-                [f"component {k}" for k in range(q.ndim - 1)],
-                None,
+            shape = q.shape[:-1]
+            names = profile.names_observations(q.ndim - 1)
+            names = (
+                names
+                if profile.observation_names
+                else [f"component {k}" for k in range(q.ndim - 1)]
             )
         else:
             raise UserError(
                 f"--policy: no map for {config.env.id!r}: its observation is one Discrete "
-                "of unknown layout (maps exist for FrozenLake, CliffWalking, Taxi, Blackjack "
-                "and Tuple observations)."
+                "whose layout its profile does not give (maps exist for grid worlds, "
+                "Blackjack, Taxi and Tuple observations)."
             )
         table = q.reshape(*shape, q.shape[-1])
         counts = None if visits is None else visits.reshape(*shape, q.shape[-1])
@@ -275,7 +278,7 @@ def _plot_discrete_policy(
         high = [size - 0.5 for size in shape]
         figure = policy_figure(
             table, counts, (0, 1), low, high, names, title, action_names=actions,
-            rows_down=shape == TAXI_SHAPE,
+            rows_down=profile.rows_down,
         )  # fmt: skip
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out

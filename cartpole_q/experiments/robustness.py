@@ -17,13 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
-from cartpole_q.config import RANDOMIZED_KEYS
 from cartpole_q.engines import make_engine
 from cartpole_q.envs.gym import inspect_env
-from cartpole_q.envs.twins import cartpole
+from cartpole_q.envs.registry import twin_for
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import under_conditions
 from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, robustness_figure
+from cartpole_q.profiles import Physics, profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, check_output_file
 from cartpole_q.store.runsets import RunSet, load_run_set
@@ -36,12 +36,6 @@ PRESETS = {
 }  # fmt: skip
 """the ranges of sunblaze-ucb's rl-generalization (Packer et al. 2018, "Assessing
 Generalization in Deep Reinforcement Learning"): default and extreme"""
-
-DEFAULTS = {
-    "gravity": cartpole.GRAVITY, "masscart": cartpole.MASSCART, "masspole": cartpole.MASSPOLE,
-    "length": cartpole.LENGTH, "force_mag": cartpole.FORCE_MAG, "tau": cartpole.TAU,
-}  # fmt: skip
-"""``CartPoleEnv``'s own values, marked when a run kept them"""
 
 
 @dataclass(frozen=True)
@@ -66,10 +60,8 @@ def parse_vary(text: str) -> Axis:
     parts = spec.split(":")
     if not equals or len(parts) != 3:
         raise UserError(f"--vary {text!r}: expected KEY=START:STOP:N, e.g. length=0.25:0.75:11.")
-    if key not in RANDOMIZED_KEYS:
-        raise UserError(
-            f"--vary {text!r}: {key!r} cannot vary; choose one of {', '.join(RANDOMIZED_KEYS)}."
-        )
+    if not key:
+        raise UserError(f"--vary {text!r}: expected KEY=START:STOP:N, e.g. length=0.25:0.75:11.")
     try:
         start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
     except ValueError:
@@ -121,11 +113,7 @@ def measure(
     progress = progress or NullSweepProgress()
     runs = run_set.runs
     config = run_set.config
-    if config.env.id not in cartpole.ENV_IDS:
-        raise UserError(
-            f"{run_set.path}: robustness varies CartPole's physics; this run is on "
-            f"{config.env.id!r}."
-        )
+    spec = varied_physics(run_set, axes)
     info = inspect_env(config)
     grid = list(itertools.product(*(axis.values for axis in axes)))
     shape = (len(runs), *(len(axis.values) for axis in axes))
@@ -142,9 +130,31 @@ def measure(
             progress.advance(len(runs) * (p + 1), p + 1)
     finally:
         progress.close()
-    trained = [float(config.env.physics.get(axis.key, DEFAULTS[axis.key])) for axis in axes]
+    trained = [float(config.env.physics.get(axis.key, spec.defaults[axis.key])) for axis in axes]
     threshold = inspect_env(under_conditions(config, None, max_steps)).reward_threshold
     return means.reshape(shape), trained, threshold
+
+
+def varied_physics(run_set: RunSet, axes: list[Axis]) -> Physics:
+    """The physics of the run's environment, when the axes are keys it lets vary.
+
+    Raises:
+        UserError: the environment has no physics to vary (or no twin to play them fast),
+            or an axis is not one of its keys.
+    """
+    config = run_set.config
+    physics = profile_for(config.env.id).physics
+    if physics is None or twin_for(config.env.id) is None:
+        raise UserError(
+            f"{run_set.path}: robustness varies an environment's physics on its compiled twin; "
+            f"this run's environment ({config.env.id!r}) has no physics to vary."
+        )
+    for axis in axes:
+        if axis.key not in physics.randomizable:
+            raise UserError(
+                f"--vary {axis.key}: cannot vary; choose one of {', '.join(physics.randomizable)}."
+            )
+    return physics
 
 
 def check_size(run_set: RunSet, axes: list[Axis], episodes: int, yes: bool) -> None:
@@ -182,6 +192,7 @@ def robustness(
     if not 1 <= len(axes) <= 2 or len({axis.key for axis in axes}) != len(axes):
         raise UserError("--vary: give one key (a curve) or two different keys (a heatmap).")
     run_set = load_run_set(run_dir)
+    varied_physics(run_set, axes)
     check_size(run_set, axes, episodes, yes)
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     table_path = out.with_suffix(".csv")

@@ -44,7 +44,6 @@ from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-ENV_IDS = ("Acrobot-v1",)
 MAX_EPISODE_STEPS = 500
 """the time limit ``Acrobot-v1`` is registered with"""
 STATE_SIZE = 4

@@ -25,7 +25,6 @@ from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-ENV_IDS = ("CartPole-v1", "CartPole-v0")
 STATE_SIZE = 4
 OBSERVATION_SIZE = 4
 N_ACTIONS = 2

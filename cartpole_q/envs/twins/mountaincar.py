@@ -27,7 +27,6 @@ from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-ENV_IDS = ("MountainCar-v0",)
 MAX_EPISODE_STEPS = 200
 """the time limit ``MountainCar-v0`` is registered with"""
 STATE_SIZE = 2

@@ -1,0 +1,90 @@
+"""Environment profiles: what the package knows about each environment, and their registry.
+
+:func:`profile_for` finds an id's profile by the id itself, or by the entry point the id is
+registered with (a user who registers ``MyCartPole-v0`` with CartPole's class gets CartPole's
+profile); an environment no profile describes gets :data:`~cartpole_q.profiles.base.UNKNOWN`
+and works with what its spaces say. A new environment is one profile module and one
+:func:`register_profile` call.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from cartpole_q.profiles import acrobot, cartpole, mountaincar, toy_text
+from cartpole_q.profiles.base import UNKNOWN, EnvProfile, Physics, PhysicsRange
+
+__all__ = [
+    "UNKNOWN",
+    "EnvProfile",
+    "Physics",
+    "PhysicsRange",
+    "all_profiles",
+    "profile_for",
+    "register_profile",
+]
+
+_PROFILES: list[EnvProfile] = []
+
+
+def register_profile(profile: EnvProfile) -> EnvProfile:
+    """Add a profile (its ids and entry points must be new).
+
+    Raises:
+        ValueError: an id or entry point is described by another profile already.
+    """
+    for known in _PROFILES:
+        if known.name == profile.name:
+            if known == profile:
+                return known
+            raise ValueError(f"a profile named {profile.name!r} is registered already")
+        shared = (set(known.ids) & set(profile.ids)) | (
+            set(known.entry_points) & set(profile.entry_points)
+        )
+        if shared:
+            raise ValueError(f"{sorted(shared)[0]!r} is described by {known.name!r} already")
+    _PROFILES.append(profile)
+    return profile
+
+
+def all_profiles() -> Iterator[EnvProfile]:
+    """Every registered profile, the package's first."""
+    return iter(tuple(_PROFILES))
+
+
+def profile_for(env_id: str) -> EnvProfile:
+    """The profile of ``env_id``: by id, else by its registered entry point, else UNKNOWN.
+
+    >>> profile_for("CartPole-v1").name, profile_for("NoSuchEnv-v0").name
+    ('CartPole', 'unknown')
+    """
+    for profile in _PROFILES:
+        if env_id in profile.ids:
+            return profile
+    entry_point = _entry_point(env_id)
+    if entry_point is not None:
+        for profile in _PROFILES:
+            if entry_point in profile.entry_points:
+                return profile
+    return UNKNOWN
+
+
+def _entry_point(env_id: str) -> str | None:
+    """The entry point ``env_id`` is registered with (``module:Class``), if it is."""
+    try:
+        import gymnasium
+    except ImportError:  # pragma: no cover - gymnasium is a dependency
+        return None
+    try:
+        spec = gymnasium.spec(env_id)
+    except Exception:  # an unknown or malformed id: no entry point to match
+        return None
+    entry_point = spec.entry_point
+    return entry_point if isinstance(entry_point, str) else None
+
+
+for _profile in (
+    cartpole.PROFILE, mountaincar.PROFILE, acrobot.PROFILE, toy_text.FROZENLAKE,
+    toy_text.TAXI, toy_text.CLIFFWALKING, toy_text.BLACKJACK,
+):  # fmt: skip
+    register_profile(_profile)

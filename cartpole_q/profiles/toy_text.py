@@ -1,0 +1,56 @@
+"""Gymnasium's tabular worlds: FrozenLake, Taxi, CliffWalking and Blackjack.
+
+Each has an exact model, so ``cartpole-q optimum`` and ``eval`` compute the best return:
+FrozenLake, Taxi and CliffWalking from their transition table (``env.unwrapped.P``),
+Blackjack from its rules.
+"""
+
+from __future__ import annotations
+
+from cartpole_q.profiles.base import EnvProfile
+
+FROZENLAKE = EnvProfile(
+    name="FrozenLake",
+    description="cross a frozen lake to the goal without falling in a hole (slippery or not)",
+    ids=("FrozenLake-v1", "FrozenLake8x8-v1"),
+    entry_points=("gymnasium.envs.toy_text.frozen_lake:FrozenLakeEnv",),
+    action_names=("left", "down", "right", "up"),
+    policy_map="grid",
+    grid_reader="frozenlake",
+    model="transition_table",
+)
+
+TAXI = EnvProfile(
+    name="Taxi",
+    description="pick a passenger up and drop them at their destination on a 5x5 grid",
+    ids=("Taxi-v4", "Taxi-v3"),
+    entry_points=("gymnasium.envs.toy_text.taxi:TaxiEnv",),
+    action_names=("south", "north", "east", "west", "pickup", "drop off"),
+    policy_map="components",
+    state_components=(5, 5, 5, 4),
+    component_names=("taxi row", "taxi column", "passenger", "destination"),
+    rows_down=True,
+    model="transition_table",
+)
+
+CLIFFWALKING = EnvProfile(
+    name="CliffWalking",
+    description="walk along a cliff to the goal (Sutton & Barto's Example 6.6)",
+    ids=("CliffWalking-v1", "CliffWalking-v0"),
+    entry_points=("gymnasium.envs.toy_text.cliffwalking:CliffWalkingEnv",),
+    action_names=("up", "right", "down", "left"),
+    policy_map="grid",
+    grid_reader="cliffwalking",
+    model="transition_table",
+)
+
+BLACKJACK = EnvProfile(
+    name="Blackjack",
+    description="hit or stick against the dealer (Sutton & Barto's Example 5.1)",
+    ids=("Blackjack-v1",),
+    entry_points=("gymnasium.envs.toy_text.blackjack:BlackjackEnv",),
+    observation_names=("player sum", "dealer card", "usable ace"),
+    action_names=("stick", "hit"),
+    policy_map="blackjack",
+    model="blackjack",
+)
