@@ -302,13 +302,15 @@ def test_a_first_run_says_it_is_compiling(in_tmp: Path, monkeypatch: pytest.Monk
 
 def test_is_cached_finds_the_compiled_loop() -> None:
     from cartpole_q.config import load_config
-    from cartpole_q.envs.registry import TWINS
+    from cartpole_q.envs.registry import twin_for
     from cartpole_q.numba_cache import is_cached
     from cartpole_q.rl.algorithms import get
     from cartpole_q.training import train
 
     train(load_config(overrides={"train.episodes": 1}))  # compiles or loads it
-    assert is_cached(f"train_episodes__{get('q_learning').key}__{TWINS[0].key}")
+    twin = twin_for("CartPole-v1")
+    assert twin is not None
+    assert is_cached(f"train_episodes__{get('q_learning').key}__{twin.key}")
     assert not is_cached("no_such_function_anywhere")
 
 
