@@ -70,3 +70,49 @@ def test_the_command_line_trains_it(tmp_path: Path) -> None:
     result = invoke("train", "-c", config, "--out", tmp_path / "run", "-q")
     assert result.exit_code == 0, result.output
     assert f"algorithm: {NAME}" in (tmp_path / "run" / "config.yaml").read_text()
+
+
+# -- an environment in one file: a registered corridor and its profile ---------------------------
+
+from tests import plugin_world  # noqa: E402 - registers the world and its profile
+
+WORLD = {"env": {"id": plugin_world.ENV_ID}, "agent": {"epsilon": 0.3, "q_init": 0.0},
+         "train": {"episodes": 60, "stop_when_solved": False, "checkpoint_every": 20}}  # fmt: skip
+
+
+def test_its_profile_is_found_by_id_and_names_its_actions() -> None:
+    from cartpole_q.figures import action_names
+    from cartpole_q.profiles import profile_for
+
+    assert profile_for(plugin_world.ENV_ID) is plugin_world.PROFILE
+    assert action_names(plugin_world.ENV_ID, 2) == ["left", "right"]
+
+
+def test_a_world_trains_resumes_and_has_its_optimum(tmp_path: Path) -> None:
+    config = load_config(WORLD)
+    assert config.discretization is None  # a Discrete observation needs no grid
+
+    def keep_the_first(checkpoint: Checkpoint) -> None:
+        if checkpoint.episode == 20:
+            write_checkpoint(tmp_path, checkpoint)
+
+    whole = train(config, on_checkpoint=keep_the_first, final_eval=True)
+    assert whole.engine == "gymnasium" and whole.q_table.shape == (plugin_world.LENGTH, 2)
+    resumed = train(config, resume=load_checkpoint(tmp_path), final_eval=False)
+    assert resumed.q_table.tobytes() == whole.q_table.tobytes()
+    result = invoke("optimum", plugin_world.ENV_ID, "--json")
+    assert result.exit_code == 0, result.output
+    import json
+
+    assert json.loads(result.stdout)["optimum"]["return"] == 1.0
+
+
+def test_its_policy_map_is_drawn_as_its_grid(tmp_path: Path) -> None:
+    config = write_yaml(tmp_path / "world.yaml", WORLD)
+    assert invoke("train", "-c", config, "--out", tmp_path / "run", "-q").exit_code == 0
+    result = invoke("plot", tmp_path / "run", "--policy")
+    assert result.exit_code == 0, result.output
+    from cartpole_q.envs.models import grid_layout
+
+    layout = grid_layout(load_config(WORLD).env)
+    assert layout is not None and layout.cells[-1] == "G" and layout.arrows() == "<>"

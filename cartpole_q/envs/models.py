@@ -238,29 +238,12 @@ def grid_layout(env: EnvConfig) -> GridLayout | None:
     """
     from cartpole_q.envs.gym import make_env
 
+    reader = profile_for(env.id).grid
+    if reader is None:
+        return None
     made = make_env(env)
     try:
-        unwrapped = made.unwrapped
-        reader = profile_for(env.id).grid_reader
-        if reader == "frozenlake":
-            desc = [[cell.decode() for cell in row] for row in unwrapped.desc]
-            rows, columns = len(desc), len(desc[0])
-            cells = tuple(desc[r][c] for r in range(rows) for c in range(columns))
-            moves = ((0, -1), (1, 0), (0, 1), (-1, 0))  # left, down, right, up
-            return GridLayout(rows, columns, cells, moves)
-        if reader == "cliffwalking":
-            rows, columns = (int(n) for n in unwrapped.shape)
-            cliff = np.asarray(unwrapped._cliff)
-            start = int(unwrapped.start_state_index)
-            layout = []
-            for state in range(rows * columns):
-                r, c = divmod(state, columns)
-                goal = (r, c) == (rows - 1, columns - 1)
-                layout.append(
-                    "S" if state == start else "G" if goal else "C" if cliff[r, c] else "F"
-                )
-            moves = ((-1, 0), (0, 1), (1, 0), (0, -1))  # up, right, down, left
-            return GridLayout(rows, columns, tuple(layout), moves)
-        return None
+        rows, columns, cells, moves = reader(made.unwrapped)
+        return GridLayout(rows, columns, tuple(cells), tuple(moves))
     finally:
         made.close()

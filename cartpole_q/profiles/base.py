@@ -15,6 +15,9 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+GridCells = tuple[int, int, tuple[str, ...], tuple[tuple[int, int], ...]]
+"""a grid world's map: rows, columns, a letter per cell, a move per action"""
+
 
 @dataclass(frozen=True)
 class PhysicsRange:
@@ -86,8 +89,10 @@ class EnvProfile:
     """with ``components``: a name per component"""
     rows_down: bool = False
     """the first map dimension is a grid world's rows, drawn downwards (Taxi)"""
-    grid_reader: str | None = None
-    """how a grid world's map is read from the environment (``frozenlake``, ``cliffwalking``)"""
+    grid: Callable[[Any], GridCells] | None = None
+    """a grid world's map, read from ``env.unwrapped``: ``(rows, columns, cells, moves)``, with
+    a letter per cell (``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal, row by
+    row) and a ``(row step, column step)`` per action"""
     twin: str | None = None
     """the module of its compiled twin (``cartpole_q.envs.twins.cartpole``), if any"""
     model: str | None = None

@@ -7,7 +7,31 @@ Blackjack from its rules.
 
 from __future__ import annotations
 
-from cartpole_q.profiles.base import EnvProfile
+from typing import Any
+
+from cartpole_q.profiles.base import EnvProfile, GridCells
+
+
+def frozenlake_grid(lake: Any) -> GridCells:
+    """FrozenLake's map, from its ``desc``; actions left, down, right, up."""
+    desc = [[cell.decode() for cell in row] for row in lake.desc]
+    rows, columns = len(desc), len(desc[0])
+    cells = tuple(desc[r][c] for r in range(rows) for c in range(columns))
+    return rows, columns, cells, ((0, -1), (1, 0), (0, 1), (-1, 0))
+
+
+def cliffwalking_grid(world: Any) -> GridCells:
+    """CliffWalking's map, from its cliff; actions up, right, down, left."""
+    rows, columns = (int(n) for n in world.shape)
+    start = int(world.start_state_index)
+    cells = []
+    for state in range(rows * columns):
+        r, c = divmod(state, columns)
+        goal = (r, c) == (rows - 1, columns - 1)
+        cliff = bool(world._cliff[r][c])
+        cells.append("S" if state == start else "G" if goal else "C" if cliff else "F")
+    return rows, columns, tuple(cells), ((-1, 0), (0, 1), (1, 0), (0, -1))
+
 
 FROZENLAKE = EnvProfile(
     name="FrozenLake",
@@ -16,7 +40,7 @@ FROZENLAKE = EnvProfile(
     entry_points=("gymnasium.envs.toy_text.frozen_lake:FrozenLakeEnv",),
     action_names=("left", "down", "right", "up"),
     policy_map="grid",
-    grid_reader="frozenlake",
+    grid=frozenlake_grid,
     model="transition_table",
 )
 
@@ -40,7 +64,7 @@ CLIFFWALKING = EnvProfile(
     entry_points=("gymnasium.envs.toy_text.cliffwalking:CliffWalkingEnv",),
     action_names=("up", "right", "down", "left"),
     policy_map="grid",
-    grid_reader="cliffwalking",
+    grid=cliffwalking_grid,
     model="transition_table",
 )
 
