@@ -321,13 +321,16 @@ def train(
             _train_into(run_dir, prepared, False, workers, quiet, watch, video_every, seed_plots)
 
 
-def _say_if_compiling(config: Any) -> None:
+def _say_if_compiling(config: Any, prepared: Any = None) -> None:
     """Tell the user when the first run will compile the training loop (seconds, once)."""
     from cartpole_q.engines import compile_notice, resolve_engine
     from cartpole_q.envs.gym import inspect_env
 
-    info = inspect_env(config)
-    notice = compile_notice(config, info, resolve_engine(config, info))
+    if prepared is None:
+        info = inspect_env(config)
+        notice = compile_notice(config, info, resolve_engine(config, info))
+    else:
+        notice = compile_notice(config, prepared.env_info, prepared.engine)
     if notice is not None:
         typer.echo(notice, err=True)
 
@@ -363,7 +366,7 @@ def _train_into(
 
     seeds = prepared.config.train.seeds
     if not quiet:
-        _say_if_compiling(prepared.config)
+        _say_if_compiling(prepared.config, prepared)
     reporter = make_reporter(quiet)
     resume_hint = f"resume with `cartpole-q train --resume {run_dir}`"
     stopped_at_once = False

@@ -16,6 +16,7 @@ compiled on its own, with no branch on either left in the loop, and cached on di
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -40,6 +41,8 @@ EXPLORING_EPISODE: Any = None
 GREEDY_EPISODE: Any = None
 GREEDY: bool = False
 """bound to True in the copy of :func:`twin_episode` compiled for epsilon 0"""
+RANDOMIZED: bool = False
+"""bound to True in the outer loop of a run whose ``env.randomize`` draws physics"""
 
 
 @compilable
@@ -80,10 +83,10 @@ def record_episode(
 def twin_episode(
     q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, low: np.ndarray,
     high: np.ndarray, bins: np.ndarray, gamma: float, alpha: float, epsilon: float,
-    rng: np.random.Generator, env_params: Any, max_steps: int, env_state: np.ndarray,
-    observation: np.ndarray,
+    rng: np.random.Generator, env_rng: np.random.Generator, env_params: Any, max_steps: int,
+    env_state: np.ndarray, observation: np.ndarray,
 ) -> tuple[float, int]:  # fmt: skip
-    """Play and learn one episode on a twin (already reset); return its return and length.
+    """Reset the twin, then play and learn one episode; return its return and length.
 
     The arrays come unpacked: reading a record's array inside the loop would cost two
     atomic reference-count updates per step. In the copy compiled with ``GREEDY`` bound to
@@ -92,6 +95,7 @@ def twin_episode(
     """
     if GREEDY:
         epsilon = 0.0
+    TWIN_RESET(env_state, observation, env_rng, env_params)
     state = state_index(observation, low, high, bins)
     action = ALGORITHM_START(q, memory, params, state, epsilon, rng)
     episode_return, length = 0.0, 0
@@ -149,20 +153,19 @@ def train_episodes(
     for episode in range(start, stop):
         epsilon, alpha = episode_rates(agent, episode)
         env_params = base_params
-        if keys.size:
+        if RANDOMIZED:  # compiled in only where env.randomize draws physics
             env_params = TWIN_RANDOMIZE(base_params, physics_rng, keys, lows, highs)
-        TWIN_RESET(env_state, observation, env_rng, env_params)
         # Greedy episodes (epsilon 0) run a copy of the loop compiled with a constant
         # epsilon, without the generator calls they would skip anyway: a third faster.
         if epsilon > 0.0:
             episode_return, length = EXPLORING_EPISODE(
                 q, visits, memory, params, low, high, bins, gamma, alpha, epsilon, agent_rng,
-                env_params, max_steps, env_state, observation,
+                env_rng, env_params, max_steps, env_state, observation,
             )  # fmt: skip
         else:
             episode_return, length = GREEDY_EPISODE(
                 q, visits, memory, params, low, high, bins, gamma, alpha, 0.0, agent_rng,
-                env_params, max_steps, env_state, observation,
+                env_rng, env_params, max_steps, env_state, observation,
             )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
         env_steps += length
@@ -192,39 +195,60 @@ def greedy_returns(
     return returns
 
 
-def training_kernel(algorithm: Algorithm, twin: Twin) -> Any:
+@dataclass(frozen=True)
+class TrainingKernel:
+    """One (algorithm, twin) pair's compiled loops: the outer loop and its two episode loops."""
+
+    name: str
+    """the outer loop's name (its cache entry)"""
+    train_episodes: Any
+    """the outer loop (see :func:`train_episodes`)"""
+    exploring_episode: Any
+    """the episode loop for epsilon > 0"""
+    greedy_episode: Any
+    """the episode loop compiled for epsilon 0"""
+
+
+def training_kernel(algorithm: Algorithm, twin: Twin, randomized: bool = False) -> TrainingKernel:
     """The compiled training loop of one algorithm on one twin.
 
     Compiled for the pair, with the algorithm's hooks and the twin's functions inlined and no
     branch on either left in the loop; cached on disk under the pair's keys (which carry
     digests of their sources), so a run compiles (or loads) only the machine code it runs.
+    ``randomized`` compiles the draws of ``env.randomize`` in (a run without them does not
+    compile them at all).
     """
-    return _training_kernel(algorithm.key, twin.key, algorithm, twin)
+    return _training_kernel(algorithm.key, twin.key, randomized, algorithm, twin)
 
 
 @functools.cache
-def _training_kernel(algorithm_key: str, twin_key: str, algorithm: Algorithm, twin: Twin) -> Any:
+def _training_kernel(
+    algorithm_key: str, twin_key: str, randomized: bool, algorithm: Algorithm, twin: Twin
+) -> TrainingKernel:
     pair = f"{algorithm_key}__{twin_key}"
     hooks = {
         "ALGORITHM_START": algorithm.start,
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
+        "TWIN_RESET": twin.reset,
         "TWIN_STEP": twin.step,
     }
     # The two episode loops are compiled (and cached) on their own, not inlined into the
-    # outer loop: each is one smaller compilation, which numba does much faster.
+    # outer loop: each is a smaller compilation, and they can be compiled side by side.
     exploring = specialise(twin_episode, f"twin_episode__{pair}", {**hooks, "GREEDY": False})
     greedy = specialise(twin_episode, f"greedy_episode__{pair}", {**hooks, "GREEDY": True})
-    return specialise(
+    name = f"train_episodes__{pair}" + ("__randomized" if randomized else "")
+    outer = specialise(
         train_episodes,
-        f"train_episodes__{pair}",
+        name,
         {
             "EXPLORING_EPISODE": exploring,
             "GREEDY_EPISODE": greedy,
-            "TWIN_RESET": twin.reset,
             "TWIN_RANDOMIZE": twin.randomize,
+            "RANDOMIZED": randomized,
         },
     )
+    return TrainingKernel(name, outer, exploring, greedy)
 
 
 @functools.cache

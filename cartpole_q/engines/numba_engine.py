@@ -6,6 +6,8 @@ Q-table and metrics are byte-identical to it; about two hundred times faster.
 
 from __future__ import annotations
 
+import os
+import threading
 from collections.abc import Mapping
 from typing import Any
 
@@ -15,6 +17,7 @@ from gymnasium.utils import seeding
 from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.registry import TwinSettings
+from cartpole_q.numba_cache import is_cached
 from cartpole_q.profiles import profile_for
 
 
@@ -32,7 +35,8 @@ class NumbaEngine:
         env_rng_state: dict[str, Any] | None = None,
         randomize: Mapping[str, tuple[float, float]] | None = None,
     ) -> None:
-        self._train_episodes = training_kernel(params.algorithm, settings.twin)
+        self._kernel = training_kernel(params.algorithm, settings.twin, bool(randomize))
+        self._train_episodes = self._kernel.train_episodes
         self._greedy_returns = greedy_kernel(settings.twin)
         self._env = (
             settings.max_episode_steps,
@@ -68,9 +72,53 @@ class NumbaEngine:
         return None if solved < 0 else solved
 
     def warm_up(self, state: TrainingState) -> None:
-        """Compile the kernels with an empty range of episodes (nothing runs, nothing drawn)."""
+        """Compile the kernels (or load them from the cache); nothing runs, nothing is drawn.
+
+        Compiling takes seconds, once per machine: then the two episode loops and the greedy
+        play are compiled side by side, in this process and a forked one, which leaves its
+        code in numba's cache for this one to load (see :func:`_compile_side_by_side`).
+        """
+        if not is_cached(self._kernel.name):
+            self._compile_side_by_side(state)
         self.run(state, state.episode, check_solved=False)
         self.evaluate(state.tables.q, 0, 0)
+
+    def _compile_side_by_side(self, state: TrainingState) -> None:
+        """Compile the exploring episode loop here while a child compiles the greedy ones.
+
+        Each loop is compiled by running it on scratch copies for one step (a compiled
+        function is compiled for the argument types of its first call); the child writes
+        numba's cache and exits, and the outer loop then loads its code from there. Where a
+        process cannot fork (or has threads, where forking is unsafe), everything is
+        compiled here, one after another.
+        """
+        if not hasattr(os, "fork") or threading.active_count() > 1:
+            return
+        child = os.fork()
+        if child == 0:  # the child: the greedy loops, then exit without clean-up
+            code = 1
+            try:
+                self._scratch_episode(state, self._kernel.greedy_episode, 0.0)
+                self.evaluate(state.tables.q.copy(), 0, 0)
+                code = 0
+            finally:
+                os._exit(code)
+        try:
+            self._scratch_episode(state, self._kernel.exploring_episode, 0.5)
+        finally:
+            os.waitpid(child, 0)
+
+    def _scratch_episode(self, state: TrainingState, episode: Any, epsilon: float) -> None:
+        """Run an episode loop for one step on copies of everything it would change."""
+        p = self._params
+        q, visits, memory = state.tables
+        _, state_size, observation_size, params = self._env
+        episode(
+            q.copy(), visits.copy(), tuple(array.copy() for array in memory), p.params,
+            p.grid.low, p.grid.high, p.grid.bins, p.agent.gamma, 0.5, epsilon,
+            np.random.default_rng(0), np.random.default_rng(1), params, 1,
+            np.zeros(state_size, dtype=np.float64), np.zeros(observation_size, dtype=np.float32),
+        )  # fmt: skip
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
