@@ -402,3 +402,20 @@ def test_the_readme_names_every_shipped_config() -> None:
     section = text[text.index("Shipped configs (installed") :].split("\n\n")[0]
     missing = [name for name in shipped_configs() if f"`{name}`" not in section]
     assert not missing, f"the README's list of shipped configs misses {missing}"
+
+
+def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
+    from cartpole_q.config import load_config
+    from cartpole_q.envs.registry import twin_for
+    from cartpole_q.numba_cache import is_cached
+    from cartpole_q.rl.algorithms import get
+
+    result = invoke("compile", "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert "compiled q_learning on CartPole-v1 (numba engine)" in result.stdout
+    assert "2 training loops compiled or loaded" in result.stdout
+    twin = twin_for(load_config().env.id)
+    assert twin is not None
+    assert is_cached(f"train_episodes__{get('q_learning').key}__{twin.key}")
+    assert is_cached(f"next_step__{get('q_learning').key}__box")
+    assert_refused(invoke("compile", "-c", "default", "--all"), "not both")

@@ -405,6 +405,55 @@ def _train_into(
         raise typer.Exit(EXIT_INTERRUPTED)
 
 
+@app.command("compile", cls=_Command)
+def compile_command(
+    config: Annotated[
+        Path | None,
+        typer.Option(
+            "--config",
+            "-c",
+            metavar="PATH|NAME",
+            help="Compile this config's training loops (both engines).",
+            show_default="the embedded default",
+        ),
+    ] = None,
+    every: Annotated[
+        bool,
+        typer.Option(
+            "--all",
+            help="Compile every algorithm on every environment with a compiled twin, and on "
+            "the gymnasium engine for each observation kind.",
+        ),
+    ] = False,
+    workers: Annotated[
+        int | None,
+        typer.Option(metavar="N", min=1, help="Worker processes.", show_default="one per core"),
+    ] = None,
+    quiet: Annotated[
+        bool, typer.Option("--quiet", "-q", help="Print nothing but the summary line.")
+    ] = False,
+) -> None:
+    """Fill numba's cache ahead of time (CI images, classrooms): later runs start at once."""
+    with _exit_codes():
+        from cartpole_q.config import load_config
+        from cartpole_q.experiments.compiling import compile_all
+        from cartpole_q.experiments.run import StopRequest
+        from cartpole_q.numba_cache import cache_dir
+
+        if config is not None and every:
+            raise UserError("give either --config (one config) or --all (everything), not both.")
+        chosen = load_config(config) if config is not None else None
+        with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+            count, seconds = compile_all(
+                chosen, every, workers=workers, should_stop=stop.is_set,
+                on_done=None if quiet else lambda line: typer.echo(f"compiled {line}"),
+            )  # fmt: skip
+        typer.echo(f"{count} training loops compiled or loaded in {seconds:.1f} s ({cache_dir()})")
+        if stop.is_set():
+            typer.echo("interrupted: run it again to compile the rest", err=True)
+            raise typer.Exit(EXIT_INTERRUPTED)
+
+
 @app.command("configs", cls=_Command)
 def configs_command() -> None:
     """List the shipped example configs: `train -c NAME` takes one by its name."""

@@ -96,3 +96,30 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
         f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "
         f"({engine} engine): once per machine and version, {seconds}..."
     )
+
+
+def precompile(config: Config, engine: str) -> None:
+    """Compile (or load from the cache) what training ``config`` on ``engine`` runs.
+
+    Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up does.
+
+    Raises:
+        ConfigError: the config does not fit its environment, or ``engine`` is ``numba`` and
+            the environment has no compiled twin.
+    """
+    import dataclasses
+
+    import numpy as np
+
+    from cartpole_q.engines.base import TrainingState
+    from cartpole_q.envs.gym import inspect_env
+
+    config = dataclasses.replace(config, engine=engine)
+    info = inspect_env(config)
+    chosen = resolve_engine(config, info)
+    state = TrainingState.fresh(config, info, np.random.default_rng(0))
+    made = make_engine(chosen, config, info, env_seed=0)
+    try:
+        made.warm_up(state)
+    finally:
+        made.close()

@@ -1,0 +1,101 @@
+"""``cartpole-q compile``: fill numba's cache ahead of time, for CI images and classrooms.
+
+A first run compiles its training loop for several seconds, once per machine and version.
+This compiles the loops of a config (the embedded default's, or any), or with ``every`` the
+loops of every registered algorithm on every environment with a compiled twin and on the
+gymnasium engine for each observation kind, spread over worker processes; later runs load
+them from the cache in a fraction of a second.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from cartpole_q.config import Config, load_config
+from cartpole_q.experiments.workers import JobHandle, default_workers, execute
+from cartpole_q.rl.algorithms import names as algorithm_names
+
+ENGINE_CONFIGS = {
+    "numba": ("default", "mountaincar", "acrobot"),
+    "gymnasium": ("default", "frozenlake", "blackjack"),
+}
+"""shipped configs that cover every twin (numba) and every observation kind (gymnasium:
+a Box, a Discrete, a Tuple of Discrete)"""
+
+
+@dataclass(frozen=True)
+class CompileJob:
+    """One config on one engine."""
+
+    config: str
+    """a shipped config's name (empty: the config given)"""
+    algorithm: str
+    engine: str
+    label: str
+    """what it trains on, for messages"""
+
+    def describe(self) -> str:
+        """``q_learning on CartPole-v1 (numba engine)``."""
+        return f"{self.algorithm} on {self.label} ({self.engine} engine)"
+
+
+def jobs_for(config: Config | None, every: bool) -> list[CompileJob]:
+    """What to compile: one config's loops on both engines, or every algorithm's everywhere."""
+    if not every:
+        chosen = config or load_config()
+        return [
+            CompileJob("", chosen.agent.algorithm, engine, chosen.env.id)
+            for engine in ("numba", "gymnasium")
+        ]
+    return [
+        CompileJob(name, algorithm, engine, load_config(name).env.id)
+        for engine, configs in ENGINE_CONFIGS.items()
+        for name in configs
+        for algorithm in algorithm_names()
+    ]
+
+
+def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None) -> str:
+    """Job: compile one config's loops (a config mapping, or a shipped config's name)."""
+    from cartpole_q.config import ConfigError
+    from cartpole_q.engines import precompile
+
+    if handle.should_stop():
+        return ""
+    config = load_config(mapping if mapping is not None else (job.config or None))
+    config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm})
+    try:
+        precompile(config, job.engine)
+    except ConfigError as error:  # e.g. an algorithm's parameters a config cannot give
+        return f"skipped {job.describe()}: {error}"
+    return job.describe()
+
+
+def compile_all(
+    config: Config | None,
+    every: bool,
+    *,
+    workers: int | None = None,
+    should_stop: Callable[[], bool] | None = None,
+    on_done: Callable[[str], None] | None = None,
+) -> tuple[int, float]:
+    """Compile the loops; return how many jobs ran and the seconds it took."""
+    jobs = jobs_for(config, every)
+    mapping = None if config is None or every else config.to_dict()
+    started = time.perf_counter()
+    done = 0
+
+    def on_item(index: int, line: str) -> None:
+        nonlocal done
+        done += 1
+        if on_done is not None and line:
+            on_done(line)
+
+    execute(
+        _compile, [(job, mapping) for job in jobs], on_item,
+        workers=workers or default_workers(len(jobs)), should_stop=should_stop,
+    )  # fmt: skip
+    return done, time.perf_counter() - started
