@@ -13,11 +13,11 @@ import numpy as np
 from gymnasium import spaces
 
 from cartpole_q.config import Config
-from cartpole_q.engines.base import AgentParams, Tables, TrainingState
+from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.context import StepContext, step_context
 from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
 from cartpole_q.engines.play import play_greedy
-from cartpole_q.engines.rng_handle import GeneratorHandle, wrap_generator
 from cartpole_q.engines.rows import ROW_RULES
 from cartpole_q.envs.gym import make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
@@ -34,36 +34,32 @@ ALGORITHM_END: Any = None
 OBSERVATION_ROW: Any = None
 
 
-def first_step(
-    handle: Any, q: np.ndarray, memory: Any, params: Any, grid: Any, observation: Any,
-    epsilon: float,
-) -> tuple[int, int]:  # fmt: skip
+def first_step(context: Any, observation: Any, epsilon: float) -> tuple[int, int]:
     """An episode's first row and action, for the reset observation."""
-    state = OBSERVATION_ROW(observation, grid)
-    return state, ALGORITHM_START(q, memory, params, state, epsilon, handle.rng)
+    state = OBSERVATION_ROW(observation, context.grid)
+    action = ALGORITHM_START(context.q, context.memory, context.params, state, epsilon, context.rng)
+    return state, action
 
 
 def next_step(
-    handle: Any, q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, grid: Any,
-    gamma: float, state: int, action: int, reward: float, observation: Any, terminated: bool,
+    context: Any, state: int, action: int, reward: float, observation: Any, terminated: bool,
     truncated: bool, alpha: float, epsilon: float,
 ) -> tuple[int, int]:  # fmt: skip
     """Learn from one step; the next row and the next action (or ``ENDED``)."""
-    row = OBSERVATION_ROW(observation, grid)
-    visits[state, action] += 1
+    row = OBSERVATION_ROW(observation, context.grid)
+    context.visits[state, action] += 1
     chosen = ALGORITHM_STEP(
-        q, memory, params, state, action, reward, row, terminated, truncated, alpha, gamma,
-        epsilon, handle.rng,
+        context.q, context.memory, context.params, state, action, reward, row, terminated,
+        truncated, alpha, context.gamma, epsilon, context.rng,
     )  # fmt: skip
     return row, chosen
 
 
-def end_episode(
-    handle: Any, q: np.ndarray, memory: Any, params: Any, alpha: float, gamma: float,
-    epsilon: float,
-) -> None:  # fmt: skip
+def end_episode(context: Any, alpha: float, epsilon: float) -> None:
     """Finish an episode (the algorithm's ``end``)."""
-    ALGORITHM_END(q, memory, params, alpha, gamma, epsilon, handle.rng)
+    ALGORITHM_END(
+        context.q, context.memory, context.params, alpha, context.gamma, epsilon, context.rng
+    )
 
 
 @functools.cache
@@ -75,9 +71,9 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
         kind: the observation kind (``box``, ``discrete`` or ``tuple``; see
             :data:`~cartpole_q.engines.rows.ROW_RULES`).
 
-    They take the agent's generator wrapped in a handle (see :mod:`rng_handle`) and call
-    the algorithm's hooks as the numba engine's loop does; cached on disk under the
-    algorithm's key and the kind.
+    They take the run's step context (see :mod:`~cartpole_q.engines.context`) and call the
+    algorithm's hooks as the numba engine's loop does; cached on disk under the algorithm's
+    key and the kind.
     """
     bindings = {
         "ALGORITHM_START": algorithm.start,
@@ -136,23 +132,30 @@ class GymnasiumEngine:
         # Tuple observations as plain integers: one compiled specialisation for any env.
         self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
         self._step_cap = step_cap
-        self._handle: GeneratorHandle | None = None
-        self._handle_rng: np.random.Generator | None = None
+        self._context: StepContext | None = None
+        self._context_of: tuple[Any, ...] = ()
 
-    def _rng_handle(self, rng: np.random.Generator) -> GeneratorHandle:
-        # A numba call that takes a Generator costs ~6 microseconds; a handle ~0.5.
-        if self._handle_rng is not rng:
-            self._handle, self._handle_rng = wrap_generator(rng), rng
-        assert self._handle is not None
-        return self._handle
+    def _step_context(self, state: TrainingState) -> StepContext:
+        """The run's step context (made again only if the state's arrays were replaced)."""
+        q, visits, memory = state.tables
+        of = (state.agent_rng, q, visits, *memory)
+        if (
+            self._context is None
+            or len(of) != len(self._context_of)
+            or any(a is not b for a, b in zip(of, self._context_of, strict=True))
+        ):
+            p = self._params
+            self._context = step_context(
+                state.agent_rng, q, visits, memory, p.params, p.grid, p.agent.gamma
+            )
+            self._context_of = of
+        return self._context
 
     def run(self, state: TrainingState, stop: int, check_solved: bool) -> int | None:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`)."""
-        grid, agent, params = self._params.grid, self._params.agent, self._params.params
+        agent = self._params.agent
         env, metrics = self._env, state.metrics
-        q, visits, memory = state.tables
-        gamma = agent.gamma
-        handle = self._rng_handle(state.agent_rng)
+        context = self._step_context(state)
         randomize = self._config.env.randomize
         first, following, as_ints = self._first, self._next, self._as_ints
         for episode in range(state.episode, stop):
@@ -167,7 +170,7 @@ class GymnasiumEngine:
             self._first_reset_seed = None
             if as_ints:
                 observation = tuple(map(int, observation))
-            s, a = first(handle, q, memory, params, grid, observation, epsilon)
+            s, a = first(context, observation, epsilon)
             episode_return, length = 0.0, 0
             while a != ENDED:
                 observation, reward, terminated, truncated, _ = env.step(a)
@@ -175,11 +178,10 @@ class GymnasiumEngine:
                     observation = tuple(map(int, observation))
                 length += 1
                 episode_return += reward
-                s, a = following(handle, q, visits, memory, params, grid, gamma, s, a,
-                                 float(reward), observation, terminated, truncated, alpha,
-                                 epsilon)  # fmt: skip
+                s, a = following(context, s, a, float(reward), observation, terminated,
+                                 truncated, alpha, epsilon)  # fmt: skip
             if self._has_end:
-                self._end(handle, q, memory, params, alpha, gamma, epsilon)
+                self._end(context, alpha, epsilon)
             record_episode(metrics, episode, episode_return, length, epsilon, alpha)
             state.episode = episode + 1
             state.env_steps += length
@@ -188,27 +190,28 @@ class GymnasiumEngine:
         return None
 
     def warm_up(self, state: TrainingState) -> None:
-        """Compile the per-step functions on a one-row scratch table.
+        """Compile the per-step functions on scratch copies of the run's arrays.
 
         The observation sits on every lower grid edge (or is every component's ``start``),
-        so it maps to row 0; epsilon 0 and a terminated step draw nothing from the agent's
-        generator (an algorithm's own draws, such as Double Q-learning's coin, come from a
-        scratch generator here), and the scratch memory is a copy.
+        so it maps to row 0; everything the calls change is a copy, and the generator a
+        scratch one.
         """
-        grid, agent, params = self._params.grid, self._params.agent, self._params.params
+        p = self._params
+        grid = p.grid
         space = self._env.observation_space
         observation: Any = grid.low.astype(space.dtype)
         if grid.indexed:
             starts = tuple(int(start) for start in grid.starts)
             observation = starts if isinstance(space, spaces.Tuple) else starts[0]
         q, visits, memory = state.tables
-        scratch = Tables(q.copy(), visits.copy(), tuple(array.copy() for array in memory))
-        handle = wrap_generator(np.random.default_rng(0))
-        self._first(handle, scratch.q, scratch.memory, params, grid, observation, 0.0)
-        self._next(handle, scratch.q, scratch.visits, scratch.memory, params, grid, agent.gamma,
-                   0, 0, 0.0, observation, True, False, 0.0, 0.0)  # fmt: skip
+        scratch = step_context(
+            np.random.default_rng(0), q.copy(), visits.copy(),
+            tuple(array.copy() for array in memory), p.params, grid, p.agent.gamma,
+        )  # fmt: skip
+        self._first(scratch, observation, 0.0)
+        self._next(scratch, 0, 0, 0.0, observation, True, False, 0.0, 0.0)
         if self._has_end:
-            self._end(handle, scratch.q, scratch.memory, params, 0.0, agent.gamma, 0.0)
+            self._end(scratch, 0.0, 0.0)
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
