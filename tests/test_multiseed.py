@@ -81,7 +81,7 @@ def test_interrupted_multi_seed_run_resumes_to_the_same_results(
     parent = start_run(prepared, tmp_path / "parent")
     polls = iter(range(10**9))
     summary = run_seeds(prepared, parent, workers=1, should_stop=lambda: next(polls) >= 25)
-    assert summary["interrupted"] is True and summary["finished"] < 4
+    assert summary.interrupted is True and summary.finished < 4
     result = invoke("train", "--resume", parent, "-q", "--workers", "1")
     assert result.exit_code == 0, result.output
     assert json.loads((parent / "summary.json").read_text())["finished"] == 4

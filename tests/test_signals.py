@@ -50,7 +50,7 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     prepared = prepare(load_config(config), str(config))
     parent = start_run(prepared, base / "reference")
     summary = run_seeds(prepared, parent, workers=1)
-    assert summary["finished"] == len(SEEDS)
+    assert summary.finished == len(SEEDS)
     return parent
 
 
@@ -214,10 +214,10 @@ def test_interrupted_multi_seed_summary_is_over_the_finished_seeds(
     (seed_dir(parent, 2, SEEDS) / rundir.SUMMARY_FILE).unlink()  # killed: no result
 
     summary = aggregate(parent, SEEDS, 1.0, interrupted=True)
-    assert summary["finished"] == 1 and summary["unfinished"] == 2
-    assert summary["successes"] == 1 and summary["success_rate"] == 1.0
-    assert summary["eval_mean"]["mean"] == 500.0
-    assert summary["interrupted_seeds"] == "1" and summary["no_result_seeds"] == "2"
+    assert summary.finished == 1 and summary.unfinished == 2
+    assert summary.successes == 1 and summary.success_rate == 1.0
+    assert summary.eval_mean is not None and summary.eval_mean.mean == 500.0
+    assert summary.interrupted_seeds == "1" and summary.no_result_seeds == "2"
     print_multi_summary(parent, summary)
     out = capsys.readouterr().out
     assert "success                    1/1 greedy eval mean >= 475.0 (over the 1 finished" in out
@@ -229,7 +229,7 @@ def test_interrupted_multi_seed_summary_is_over_the_finished_seeds(
 
     _mark_interrupted(seed_dir(parent, 0, SEEDS))
     summary = aggregate(parent, SEEDS, 1.0, interrupted=True)
-    assert summary["finished"] == 0 and summary["success_rate"] is None
+    assert summary.finished == 0 and summary.success_rate is None
     print_multi_summary(parent, summary)
     out = capsys.readouterr().out
     assert "nan" not in out and "0/3" not in out

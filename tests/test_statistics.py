@@ -13,8 +13,8 @@ import scipy.stats
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from cartpole_q.experiments import statistics
-from cartpole_q.experiments.statistics import (
+from cartpole_q import statistics
+from cartpole_q.statistics import (
     PointStatistics,
     aggregate_iqm,
     bootstrap_interval,

@@ -23,8 +23,8 @@ import yaml
 
 from cartpole_q.config import ConfigError, load_config
 from cartpole_q.experiments import sweep as sweeping
-from cartpole_q.experiments.statistics import summarize_point
 from cartpole_q.experiments.sweep_spec import load_sweep
+from cartpole_q.statistics import summarize_point
 from cartpole_q.store import sweepdir
 from tests.conftest import invoke, write_yaml
 

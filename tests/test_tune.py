@@ -269,19 +269,23 @@ def test_the_pruner_stops_a_trial_only_when_it_cannot_reach_the_best_rate() -> N
     from types import SimpleNamespace
 
     from cartpole_q.experiments.tune import _cannot_win
+    from cartpole_q.results import SeedResult
+
+    def run(success: bool) -> SeedResult:
+        return SeedResult(0, 10, 100, None, None, None, 480.0 if success else 9.0, success)
 
     study = SimpleNamespace(best_trial=SimpleNamespace(user_attrs={"success_rate": 0.5}))
-    rows = [{"success": "true"}] + [{"success": "false"}] * 5  # 6 of 10 seeds run
+    rows = [run(True)] + [run(False)] * 5  # 6 of 10 seeds run
     assert not _cannot_win(study, rows, 10)  # 1 + 4 more = 0.5: a tie may still win
-    assert _cannot_win(study, [{"success": "false"}] * 6, 10)  # at most 0.4
-    assert not _cannot_win(study, [{"success": "false"}] * 5, 10)  # 0.5 still possible
+    assert _cannot_win(study, [run(False)] * 6, 10)  # at most 0.4
+    assert not _cannot_win(study, [run(False)] * 5, 10)  # 0.5 still possible
 
     class NoTrialYet:
         @property
         def best_trial(self) -> None:
             raise ValueError("no trial")
 
-    assert not _cannot_win(NoTrialYet(), [{"success": "false"}] * 9, 10)
+    assert not _cannot_win(NoTrialYet(), [run(False)] * 9, 10)
 
 
 def test_a_trial_that_cannot_reach_the_best_rate_is_pruned(tmp_path: Path) -> None:

@@ -363,6 +363,7 @@ def _train_into(
     from cartpole_q.cli.report import print_multi_summary, print_single_summary
     from cartpole_q.experiments import run as runner
     from cartpole_q.progress import make_reporter
+    from cartpole_q.results import MultiSeedSummary, RunSummary
 
     seeds = prepared.config.train.seeds
     if not quiet:
@@ -372,6 +373,7 @@ def _train_into(
     stopped_at_once = False
     with runner.StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
         try:
+            summary: RunSummary | MultiSeedSummary
             if seeds is None:
                 outcome = runner.execute_run(
                     run_dir, prepared, resume=resume, should_stop=stop.is_set, reporter=reporter,
@@ -395,12 +397,12 @@ def _train_into(
         typer.echo(f"interrupted at once: {resume_hint}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
     if not quiet:
-        if seeds is None:
+        if isinstance(summary, RunSummary):
             print_single_summary(run_dir, summary)
         else:
             print_multi_summary(run_dir, summary)
     typer.echo(str(run_dir))
-    if summary.get("interrupted"):
+    if summary.interrupted:
         typer.echo(f"interrupted: {resume_hint}", err=True)
         raise typer.Exit(EXIT_INTERRUPTED)
 
@@ -556,7 +558,7 @@ def eval_command(
             _eval_seeds(run_set, episodes, seed, json_output, workers, changed, max_steps)
             return
         run = run_set.runs[0]
-        threshold = run.summary.get("reward_threshold")
+        threshold = run.result.reward_threshold
         if changed or max_steps is not None:
             from cartpole_q.envs.gym import inspect_env
             from cartpole_q.evaluation import under_conditions

@@ -2,105 +2,109 @@
 
 from __future__ import annotations
 
+import math
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from cartpole_q.results import MultiSeedSummary, RunSummary, Spread
+from cartpole_q.store.sweepdir import PointRow
 
-def _rows_single(run_dir: Path, summary: dict[str, Any]) -> list[tuple[str, str]]:
-    threshold = summary.get("reward_threshold")
-    solved = summary.get("solved_episode")
-    evaluation = summary.get("eval") or {}
-    greedy = summary.get("first_greedy_success")
+
+def _rows_single(run_dir: Path, summary: RunSummary) -> list[tuple[str, str]]:
+    threshold = summary.reward_threshold
+    solved = summary.solved_episode
+    evaluation = summary.eval
+    greedy = summary.first_greedy_success
     rows = [
         ("run", str(run_dir)),
-        ("engine", summary.get("engine", "?")),
+        ("engine", summary.engine or "?"),
         (
             "solved",
             f"episode {solved} (100-episode average >= {threshold:g})"
-            if solved is not None
-            else f"no ({summary.get('episodes')} episodes)",
+            if solved is not None and threshold is not None
+            else f"no ({summary.episodes} episodes)",
         ),
     ]
-    if evaluation:
+    if evaluation is not None:
         rows.append((
             "greedy eval",
-            f"mean {evaluation['mean']:.1f} +/- {evaluation['std']:.1f} over {evaluation['episodes']} "
-            f"episodes (min {evaluation['min']:g}, max {evaluation['max']:g})",
+            f"mean {evaluation.mean:.1f} +/- {evaluation.std:.1f} over {evaluation.episodes} "
+            f"episodes (min {evaluation.min:g}, max {evaluation.max:g})",
         ))  # fmt: skip
-    if greedy:
+    if greedy is not None:
         rows.append((
             "greedy first >= threshold",
-            f"episode {greedy['episode']}, {greedy['env_steps']:,} env steps",
+            f"episode {greedy.episode}, {greedy.env_steps:,} env steps",
         ))  # fmt: skip
     rows.append((
         "time",
-        f"{summary.get('wall_seconds', 0):.2f} s, {summary.get('env_steps', 0):,} env steps "
-        f"({summary.get('steps_per_second', 0):,.0f} train steps/s, evaluations excluded)",
+        f"{summary.wall_seconds:.2f} s, {summary.env_steps:,} env steps "
+        f"({summary.steps_per_second:,.0f} train steps/s, evaluations excluded)",
     ))  # fmt: skip
-    if summary.get("interrupted"):
-        rows.append(("status", f"interrupted after episode {summary.get('episodes')}"))
+    if summary.interrupted:
+        rows.append(("status", f"interrupted after episode {summary.episodes}"))
     return rows
 
 
-def _rows_multi(run_dir: Path, summary: dict[str, Any]) -> list[tuple[str, str]]:
-    def spread(key: str) -> str:
-        value = summary.get(key)
-        if not value:
+def _rows_multi(run_dir: Path, summary: MultiSeedSummary) -> list[tuple[str, str]]:
+    def spread(value: Spread | None) -> str:
+        if value is None:
             return "-"
-        return f"median {value['median']:,.0f} (IQR {value['q25']:,.0f}-{value['q75']:,.0f})"
+        return f"median {value.median:,.0f} (IQR {value.q25:,.0f}-{value.q75:,.0f})"
 
-    finished, runs = summary["finished"], summary["runs"]
-    threshold = summary.get("reward_threshold")
-    eval_mean = summary.get("eval_mean")
+    finished, runs = summary.finished, summary.runs
+    eval_mean = summary.eval_mean
     over = "" if finished == runs else f" (over the {finished} finished seeds)"
     rows = [
         ("run", str(run_dir)),
-        ("seeds", f"{summary['seeds']} ({runs} runs, {finished} finished)"),
-        ("engine", str(summary.get("engine"))),
+        ("seeds", f"{summary.seeds} ({runs} runs, {finished} finished)"),
+        ("engine", str(summary.engine)),
         (
             "success",
-            f"{summary['successes']}/{finished} greedy eval mean >= {threshold}{over}"
+            f"{summary.successes}/{finished} greedy eval mean >= {summary.reward_threshold}{over}"
             if finished
             else "- (no seed has finished)",
         ),
-        ("solved episode", f"{spread('solved_episode')}, {summary['solved_runs']} solved"),
-        ("env steps to solve", spread("env_steps_to_solve")),
-        ("greedy first >= threshold", spread("first_greedy_success_env_steps") + " env steps"),
+        ("solved episode", f"{spread(summary.solved_episode)}, {summary.solved_runs} solved"),
+        ("env steps to solve", spread(summary.env_steps_to_solve)),
+        (
+            "greedy first >= threshold",
+            spread(summary.first_greedy_success_env_steps) + " env steps",
+        ),
         (
             "eval mean",
-            f"mean {eval_mean['mean']:.1f}, min {eval_mean['min']:.1f}" if eval_mean else "-",
+            f"mean {eval_mean.mean:.1f}, min {eval_mean.min:.1f}" if eval_mean else "-",
         ),
     ]
     if finished < runs:
         rows.append(("unfinished", _unfinished(summary)))
-    rows.append(("time", f"{summary['wall_seconds']:.1f} s"))
-    if summary.get("interrupted"):
+    rows.append(("time", f"{summary.wall_seconds:.1f} s"))
+    if summary.interrupted:
         rows.append(("status", "interrupted"))
     return rows
 
 
-def _unfinished(summary: dict[str, Any]) -> str:
+def _unfinished(summary: MultiSeedSummary) -> str:
     """Which seeds have not finished, and how far the interrupted ones got.
 
-    >>> _unfinished({"runs": 4, "finished": 0, "interrupted_seeds": "0-1",
-    ...     "no_result_seeds": "2-3", "per_seed": {
-    ...         "0": {"interrupted": True, "eval_mean": 500.0},
-    ...         "1": {"interrupted": True, "eval_mean": 480.0}}})
+    >>> from cartpole_q.results import MultiSeedSummary, SeedEntry
+    >>> entry = SeedEntry("seed-000", 50, None, None, 500.0, None, True)
+    >>> summary = MultiSeedSummary("0-3", 4, 0, 4, "0-1", "2-3", True, None, None, 0, None,
+    ...     0, None, None, None, None, 0.0, {"0": entry, "1": SeedEntry(
+    ...         "seed-001", 50, None, None, 480.0, None, True)}, {})
+    >>> _unfinished(summary)
     '4 of 4: seeds 0-1 interrupted (greedy eval mean so far 490.0), seeds 2-3 without a result'
     """
     parts = []
-    if summary.get("interrupted_seeds"):
-        means = [
-            run["eval_mean"]
-            for run in summary.get("per_seed", {}).values()
-            if run.get("interrupted") and run.get("eval_mean") is not None
-        ]
+    if summary.interrupted_seeds:
+        means = summary.interrupted_eval_means()
         so_far = f" (greedy eval mean so far {sum(means) / len(means):.1f})" if means else ""
-        parts.append(f"{_seeds(summary['interrupted_seeds'])} interrupted{so_far}")
-    if summary.get("no_result_seeds"):
-        parts.append(f"{_seeds(summary['no_result_seeds'])} without a result")
-    return f"{summary['runs'] - summary['finished']} of {summary['runs']}: " + ", ".join(parts)
+        parts.append(f"{_seeds(summary.interrupted_seeds)} interrupted{so_far}")
+    if summary.no_result_seeds:
+        parts.append(f"{_seeds(summary.no_result_seeds)} without a result")
+    return f"{summary.runs - summary.finished} of {summary.runs}: " + ", ".join(parts)
 
 
 def _seeds(seeds: str) -> str:
@@ -126,12 +130,12 @@ def _print_rows(title: str, rows: list[tuple[str, str]]) -> None:
         print(f"  {key:<{width}}  {value}")
 
 
-def print_single_summary(run_dir: Path, summary: dict[str, Any]) -> None:
+def print_single_summary(run_dir: Path, summary: RunSummary) -> None:
     """Print the end-of-training table of one run."""
     _print_rows("Training summary", _rows_single(run_dir, summary))
 
 
-def print_multi_summary(run_dir: Path, summary: dict[str, Any]) -> None:
+def print_multi_summary(run_dir: Path, summary: MultiSeedSummary) -> None:
     """Print the end-of-training table of a multi-seed run."""
     _print_rows("Multi-seed summary", _rows_multi(run_dir, summary))
 
@@ -210,41 +214,44 @@ SWEEP_TABLE_ROWS = 15
 """``sweep`` prints at most this many points, the best first"""
 
 
-def _interval(row: dict[str, str], column: str, digits: int) -> str:
-    value = row[column]
-    if not value:
+def _interval(value: float | None, low: float | None, high: float | None, digits: int) -> str:
+    if value is None or low is None or high is None:
         return "-"
-    low, high = row[f"{column}_low"], row[f"{column}_high"]
-    return f"{float(value):.{digits}f} [{float(low):.{digits}f}, {float(high):.{digits}f}]"
+    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
 
 
 def sweep_table(
-    axes: list[str], point_rows: list[dict[str, str]], limit: int = SWEEP_TABLE_ROWS
+    axes: Sequence[str], point_rows: Sequence[PointRow], limit: int = SWEEP_TABLE_ROWS
 ) -> list[str]:
     """The points as text lines, best first (success rate, then IQM eval return).
 
-    >>> row = {"point": "000", "agent.alpha": "0.1", "seeds": "2", "success_rate": "1.0",
-    ...        "success_rate_low": "0.34", "success_rate_high": "1.0", "iqm_eval_return": "500.0",
-    ...        "iqm_eval_return_low": "500.0", "iqm_eval_return_high": "500.0",
-    ...        "median_solved_episode": "175.0", "median_solved_episode_low": "170.0",
-    ...        "median_solved_episode_high": "180.0"}
-    >>> for line in sweep_table(["agent.alpha"], [row]): print(line)
+    >>> from cartpole_q.statistics import PointStatistics
+    >>> stats = PointStatistics(2, 1.0, 0.34, 1.0, 500.0, 500.0, 500.0, 175.0, 170.0, 180.0,
+    ...     9000.0, 8000.0, 10000.0)
+    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
+    ...     print(line)
     point  agent.alpha  seeds  success rate [95%]  IQM eval return [95%]  median solve episode [95%]
     000    0.1          2      1.00 [0.34, 1.00]   500.0 [500.0, 500.0]   175 [170, 180]
     """
 
-    def rank(row: dict[str, str]) -> tuple[float, float]:
-        return (-float(row["success_rate"] or -1), -float(row["iqm_eval_return"] or "-inf"))
+    def rank(row: PointRow) -> tuple[float, float]:
+        stats = row.statistics
+        rate = -1.0 if stats.success_rate is None else stats.success_rate
+        iqm = -math.inf if stats.iqm_eval_return is None else stats.iqm_eval_return
+        return (-rate, -iqm)
 
     ordered = sorted(point_rows, key=rank)[:limit]
     header = ["point", *axes, "seeds", "success rate [95%]", "IQM eval return [95%]",
               "median solve episode [95%]"]  # fmt: skip
     table = [header]
     for row in ordered:
+        s = row.statistics
         table.append([
-            row["point"], *(row[axis] for axis in axes), row["seeds"],
-            _interval(row, "success_rate", 2), _interval(row, "iqm_eval_return", 1),
-            _interval(row, "median_solved_episode", 0),
+            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
+            _interval(s.success_rate, s.success_rate_low, s.success_rate_high, 2),
+            _interval(s.iqm_eval_return, s.iqm_eval_return_low, s.iqm_eval_return_high, 1),
+            _interval(s.median_solved_episode, s.median_solved_episode_low,
+                      s.median_solved_episode_high, 0),
         ])  # fmt: skip
     widths = [max(len(line[i]) for line in table) for i in range(len(header))]
     return ["  ".join(text.ljust(width) for text, width in zip(line, widths, strict=True)).rstrip()

@@ -22,7 +22,7 @@ import numpy as np
 
 from cartpole_q.config import shown_value
 from cartpole_q.errors import UserError
-from cartpole_q.experiments.statistics import (
+from cartpole_q.statistics import (
     iqm_interval,
     median,
     probability_of_improvement,
@@ -130,12 +130,11 @@ def seed_values(run_set: RunSet, metric: str) -> list[float]:
     values = []
     for run in run_set.runs:
         if metric == "eval_mean":
-            evaluation = run.summary.get("eval") or {}
-            if evaluation.get("mean") is None:
+            if run.result.eval_mean is None:
                 raise UserError(f"{run.path}: has no final evaluation to compare.")
-            values.append(float(evaluation["mean"]))
+            values.append(run.result.eval_mean)
         else:
-            solved = run.summary.get("solved_episode")
+            solved = run.result.solved_episode
             values.append(float("inf") if solved is None else float(solved))
     return values
 

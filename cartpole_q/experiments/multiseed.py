@@ -29,6 +29,7 @@ from cartpole_q.experiments.workers import (
     map_jobs,
 )
 from cartpole_q.progress import NullReporter, Reporter
+from cartpole_q.results import MultiSeedSummary, SeedEntry, SeedResult
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import write_json
 from cartpole_q.store.runsets import RunSet, seed_dir
@@ -43,7 +44,7 @@ def run_seeds(
     should_stop: Callable[[], bool] | None = None,
     resume: bool = False,
     seed_plots: bool = False,
-) -> dict[str, Any]:
+) -> MultiSeedSummary:
     """Train every seed of ``prepared.config`` under ``parent`` and write the aggregate.
 
     Args:
@@ -100,7 +101,7 @@ def run_seeds(
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
     if seed_plots:
         _plot_seeds(parent)
-    write_json(parent / rundir.SUMMARY_FILE, summary)
+    write_json(parent / rundir.SUMMARY_FILE, summary.to_json())
     return summary
 
 
@@ -144,84 +145,39 @@ def _train_seeds(
 
 def _finished(child: Path) -> bool:
     summary = rundir.read_summary(child)
-    return summary is not None and not summary.get("interrupted", True)
-
-
-def _spread(values: list[float]) -> dict[str, float] | None:
-    if not values:
-        return None
-    q25, median, q75 = np.percentile(values, [25, 50, 75])
-    return {"median": float(median), "q25": float(q25), "q75": float(q75)}
+    return summary is not None and not summary.interrupted
 
 
 def aggregate(
     parent: Path, seeds: tuple[int, ...], wall_seconds: float, interrupted: bool
-) -> dict[str, Any]:
+) -> MultiSeedSummary:
     """Summarise the seeds' runs: success rate, solve episodes and env steps, eval means.
 
     Every statistic (``success_rate`` included) is over the finished seeds (``finished`` of
     ``runs``); the others are counted in ``unfinished`` and named in ``interrupted_seeds``
     (stopped early, listed in ``per_seed`` too) and ``no_result_seeds`` (not started, or
-    killed before writing a result), both in ``--seeds`` syntax.
+    killed before writing a result), both in ``--seeds`` syntax. The ``statistics`` are a
+    sweep point's, from the same function.
     """
-    per_seed: dict[str, dict[str, Any]] = {}
-    threshold = None
-    engine = None
+    entries: dict[str, tuple[SeedEntry, SeedResult, str | None]] = {}
     for seed in seeds:
         child = seed_dir(parent, seed, seeds)
         summary = rundir.read_summary(child)
-        if summary is None:
-            continue
-        threshold = summary.get("reward_threshold", threshold)
-        engine = summary.get("engine", engine)
-        per_seed[str(seed)] = {
-            "path": child.name,
-            "solved_episode": summary.get("solved_episode"),
-            "env_steps_to_solve": summary.get("env_steps_to_solve"),
-            "eval_mean": (summary.get("eval") or {}).get("mean"),
-            "first_greedy_success": summary.get("first_greedy_success"),
-            "episodes": summary.get("episodes"),
-            "interrupted": summary.get("interrupted", False),
-        }
-    finished = [run for run in per_seed.values() if not run["interrupted"]]
-    eval_means = [run["eval_mean"] for run in finished if run["eval_mean"] is not None]
-    successes = sum(1 for mean in eval_means if threshold is not None and mean >= threshold)
-    solved = [run["solved_episode"] for run in finished if run["solved_episode"] is not None]
-    steps = [run["env_steps_to_solve"] for run in finished if run["env_steps_to_solve"] is not None]
-    greedy = [
-        run["first_greedy_success"]["env_steps"] for run in finished if run["first_greedy_success"]
-    ]
-    interrupted_seeds = [seed for seed in seeds if per_seed.get(str(seed), {}).get("interrupted")]
-    no_result = [seed for seed in seeds if str(seed) not in per_seed]
-    return {
-        "seeds": format_seeds(seeds),
-        "runs": len(seeds),
-        "finished": len(finished),
-        "unfinished": len(seeds) - len(finished),
-        "interrupted_seeds": format_seeds(interrupted_seeds),
-        "no_result_seeds": format_seeds(no_result),
-        "interrupted": interrupted or len(finished) < len(seeds),
-        "engine": engine,
-        "reward_threshold": threshold,
-        "successes": successes,
-        "success_rate": successes / len(finished) if finished else None,
-        "solved_runs": len(solved),
-        "solved_episode": _spread(solved),
-        "env_steps_to_solve": _spread(steps),
-        "first_greedy_success_env_steps": _spread(greedy),
-        "eval_mean": (
-            None
-            if not eval_means
-            else {
-                "mean": float(np.mean(eval_means)),
-                "min": float(np.min(eval_means)),
-                "median": float(np.median(eval_means)),
-            }
+        if summary is not None:
+            entry = SeedEntry.of(child.name, summary)
+            entries[str(seed)] = (entry, summary.result(seed), summary.engine)
+    return MultiSeedSummary.of_seeds(
+        seeds=format_seeds(seeds),
+        runs=len(seeds),
+        entries=entries,
+        wall_seconds=wall_seconds,
+        interrupted=interrupted,
+        versions=rundir.versions(),
+        interrupted_seeds=format_seeds(
+            [seed for seed in seeds if str(seed) in entries and entries[str(seed)][1].interrupted]
         ),
-        "wall_seconds": round(wall_seconds, 3),
-        "per_seed": per_seed,
-        "versions": rundir.versions(),
-    }
+        no_result_seeds=format_seeds([seed for seed in seeds if str(seed) not in entries]),
+    )
 
 
 def _evaluate_one(

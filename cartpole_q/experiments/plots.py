@@ -70,17 +70,16 @@ def plot_rewards(
         if run_set.kind == "run":
             run = runs[0]
             items.append(Curve(
-                path.name, run.metrics.returns, run.summary.get("solved_episode"),
-                threshold=run.summary.get("reward_threshold"),
-                interrupted=bool(run.summary.get("interrupted")),
+                path.name, run.metrics.returns, run.result.solved_episode,
+                threshold=run.result.reward_threshold, interrupted=run.result.interrupted,
             ))  # fmt: skip
             continue
         name = path.name if run_set.kind == "multi-seed run" else f"point {path.name}"
         items.append(SeedBand(
             name, [run.metrics.returns for run in runs],
-            [run.summary.get("solved_episode") for run in runs],
+            [run.result.solved_episode for run in runs],
             threshold=run_set.reward_threshold,
-            interrupted=sum(bool(run.summary.get("interrupted")) for run in runs),
+            interrupted=sum(run.result.interrupted for run in runs),
         ))  # fmt: skip
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
@@ -187,8 +186,8 @@ def plot_policy(
         q_table, visits = agreement_table(runs)
         title = f"Policy of {run_dir.name}: majority of {len(runs)} seeds"
         value_name = "agreement (fraction of seeds)"
-    elif run.summary.get("interrupted"):
-        title += f" (training interrupted at episode {run.summary.get('episodes')})"
+    elif run.result.interrupted:
+        title += f" (training interrupted at episode {run.result.episodes})"
     env_id = run.config.env.id
     grid = run.config.discretization
     if grid is None:

@@ -30,6 +30,7 @@ from cartpole_q.config import (
 from cartpole_q.envs.gym import EnvInfo, inspect_env
 from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
+from cartpole_q.results import RunSummary, SeedResult
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import remove_stale_temporaries
 from cartpole_q.store.checkpoint import (
@@ -58,7 +59,7 @@ class Outcome:
 
     path: Path
     result: TrainResult
-    summary: dict[str, Any]
+    summary: RunSummary
 
 
 class StopRequest:
@@ -188,7 +189,7 @@ def execute_run(
         on_snapshot=_greedy_viewer(run_dir, config, watch_every, video_every),
     )
     summary = rundir.write_run(run_dir, result, overwrite=True, plot=plot)
-    reporter.finish(key, outcome_line(label or run_dir.name, summary))
+    reporter.finish(key, outcome_line(label or run_dir.name, summary.result()))
     return Outcome(run_dir, result, summary)
 
 
@@ -247,24 +248,26 @@ def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
             f"{run_dir}: is a multi-seed run; --episodes extends one run: extend its seeds "
             f"one by one with `cartpole-q train --resume {run_dir}/seed-NNN --episodes N`."
         )
-    summary = rundir.read_summary(run_dir)
-    if summary is not None and not summary.get("interrupted", True):
-        if multi_seed:
-            raise RunError(f"{run_dir}: this run already finished; there is nothing to resume.")
-        _check_extendable(run_dir, config, summary, episodes is not None)
     if multi_seed:
+        aggregate = rundir.read_multi_seed_summary(run_dir)
+        if aggregate is not None and not aggregate.interrupted:
+            raise RunError(f"{run_dir}: this run already finished; there is nothing to resume.")
         _check_seed_configs(run_dir, config)
+    else:
+        summary = rundir.read_summary(run_dir)
+        if summary is not None and not summary.interrupted:
+            _check_extendable(run_dir, config, summary, episodes is not None)
     return prepare(config, str(config_path))
 
 
 def _check_extendable(
-    run_dir: Path, config: Config, summary: dict[str, Any], from_option: bool
+    run_dir: Path, config: Config, summary: RunSummary, from_option: bool
 ) -> None:
     """Refuse to resume a finished run unless it ended at ``train.episodes`` and more are asked."""
-    done = summary.get("episodes")
+    done = summary.episodes
     meta = read_checkpoint_meta(run_dir)
     if meta is None:
-        solved = summary.get("solved_episode")
+        solved = summary.solved_episode
         if solved is not None and solved == done:
             reason = (
                 f"it stopped at episode {solved}, where it solved (train.stop_when_solved), so "
@@ -276,7 +279,7 @@ def _check_extendable(
         raise RunError(
             f"{run_dir}: this run already finished; there is nothing to resume: {reason}."
         )
-    trained = int(meta.get("episode", done or 0))
+    trained = int(meta.get("episode", done))
     if config.train.episodes <= trained:
         asked = (
             f"--episodes {config.train.episodes}"
@@ -356,18 +359,15 @@ def _check_seed_configs(parent: Path, config: Config) -> None:
             )
 
 
-def outcome_line(label: str, summary: dict[str, Any]) -> str:
+def outcome_line(label: str, result: SeedResult) -> str:
     """One line saying how a run ended.
 
-    >>> outcome_line("seed 3", {"solved_episode": 180, "eval": {"mean": 500.0},
-    ...     "episodes": 180, "interrupted": False})
+    >>> outcome_line("seed 3", SeedResult(3, 180, 9000, 180, 9000, None, 500.0, True))
     'seed 3: solved at episode 180, greedy eval mean 500.0'
     """
-    evaluation = summary.get("eval") or {}
-    mean = evaluation.get("mean")
-    tail = f", greedy eval mean {mean:.1f}" if mean is not None else ""
-    if summary.get("interrupted"):
-        return f"{label}: interrupted after episode {summary['episodes']}{tail}"
-    if summary.get("solved_episode") is not None:
-        return f"{label}: solved at episode {summary['solved_episode']}{tail}"
-    return f"{label}: not solved in {summary['episodes']} episodes{tail}"
+    tail = f", greedy eval mean {result.eval_mean:.1f}" if result.eval_mean is not None else ""
+    if result.interrupted:
+        return f"{label}: interrupted after episode {result.episodes}{tail}"
+    if result.solved_episode is not None:
+        return f"{label}: solved at episode {result.solved_episode}{tail}"
+    return f"{label}: not solved in {result.episodes} episodes{tail}"

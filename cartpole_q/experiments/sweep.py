@@ -10,7 +10,6 @@ workers or an interruption.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -28,12 +27,12 @@ from cartpole_q.config import (
     shown_value,
 )
 from cartpole_q.errors import RunError
-from cartpole_q.experiments.statistics import PointStatistics, summarize_point
-from cartpole_q.experiments.sweep_spec import SweepSpec, axis_cell, load_sweep
+from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.progress import NullSweepProgress, SweepProgress
+from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
-from cartpole_q.store.sweepdir import RESULT_COLUMNS, cell
+from cartpole_q.store.sweepdir import PointRow, ResultRow, axis_cell
 
 MAX_RUNS_PER_TASK = 100
 """a task is at most this many runs (about a second for the default config); each run
@@ -54,9 +53,19 @@ def saved_text(directory: Path, saved: int, total: int) -> str:
     return f"{saved:,} of {total:,} runs are saved in {results}"
 
 
-FinishedRun = tuple[int, int, dict[str, str], np.ndarray, tuple[np.ndarray, np.ndarray]]
-"""a run as :func:`run_task` yields it: point, seed, ``results.csv`` cells, kept table,
-and the learning curve (returns, lengths)"""
+@dataclass(frozen=True)
+class FinishedRun:
+    """A run as :func:`run_task` yields it."""
+
+    point: int
+    """the point's index"""
+    result: SeedResult
+    q_table: np.ndarray
+    """the kept table"""
+    returns: np.ndarray
+    """the learning curve: each training episode's return"""
+    lengths: np.ndarray
+    """each training episode's length"""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -76,7 +85,7 @@ class SweepOutcome:
     total_runs: int
     done_runs: int
     complete: bool
-    points: list[dict[str, str]] = field(default_factory=list)
+    points: list[PointRow] = field(default_factory=list)
     """the ``points.csv`` rows (only when complete)"""
 
 
@@ -93,8 +102,7 @@ def run_task(
         task: (point index, the point's config as a mapping, its seeds) groups.
 
     Yields:
-        ``(point, seed, cells, q_table, (returns, lengths))`` as each run ends, ``cells``
-        keyed by :data:`~cartpole_q.store.sweepdir.RESULT_COLUMNS`.
+        Each run as it ends.
     """
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.training import train
@@ -106,28 +114,9 @@ def run_task(
             if handle.should_stop():
                 return
             result = train(config.for_seed(seed), env_info=env_info)
-            curve = (result.returns, result.lengths)
-            yield point, seed, result_cells(result, seed), result.q_table, curve
-
-
-def result_cells(result: Any, seed: int) -> dict[str, str]:
-    """A :class:`~cartpole_q.training.TrainResult` as its ``results.csv`` cells."""
-    solved = result.solved_episode
-    threshold = result.reward_threshold
-    eval_mean = None if result.eval is None else float(result.eval.mean)
-    greedy = result.first_greedy_success()
-    values = {
-        "seed": seed,
-        "solved_episode": solved,
-        "env_steps_to_solve": None if solved is None else int(result.lengths[:solved].sum()),
-        "first_greedy_success_env_steps": None if greedy is None else greedy["env_steps"],
-        "eval_mean": eval_mean,
-        "success": None if threshold is None or eval_mean is None else eval_mean >= threshold,
-        "episodes": result.episodes,
-        "env_steps": result.env_steps,
-        "train_seconds": round(result.train_seconds, 6),
-    }
-    return {column: cell(values[column]) for column in RESULT_COLUMNS}
+            yield FinishedRun(
+                point, SeedResult.of_train(result), result.q_table, result.returns, result.lengths
+            )
 
 
 # -- the parent side ---------------------------------------------------------------------
@@ -319,17 +308,16 @@ class _Book:
     def __init__(self, spec: SweepSpec, directory: Path) -> None:
         self._spec = spec
         self._directory = directory
-        self._header = sweepdir.result_header(spec.axes)
-        self.rows: dict[tuple[int, int], dict[str, str]] = {}
+        self.rows: dict[tuple[int, int], ResultRow] = {}
         seeds = set(spec.seeds)
         results = directory / sweepdir.RESULTS_FILE
-        for row in sweepdir.read_results(directory, self._header):
+        for row in sweepdir.read_results(directory, spec.axes):
             key = self._key(row)
             if key[0] >= len(spec.points) or key in self.rows:
                 raise RunError(
-                    f"{results}: has a row (point {row['point']}, seed {row['seed']}) that is not "
-                    "of this sweep, or twice; the sweep directory was changed by hand. Start a "
-                    "new sweep."
+                    f"{results}: has a row (point {row.point}, seed {row.result.seed}) that is "
+                    "not of this sweep, or twice; the sweep directory was changed by hand. Start "
+                    "a new sweep."
                 )
             if key[1] not in seeds:
                 raise RunError(
@@ -349,47 +337,46 @@ class _Book:
         self.saved = len(self.rows)
         """how many rows ``results.csv`` holds"""
 
-    def _key(self, row: dict[str, str]) -> tuple[int, int]:
+    def _key(self, row: ResultRow) -> tuple[int, int]:
         try:
-            return int(row["point"]), int(row["seed"])
-        except (KeyError, ValueError):
+            return int(row.point), row.result.seed
+        except ValueError:
             raise RunError(
-                f"{self._directory / sweepdir.RESULTS_FILE}: has a damaged row ({row}); start a "
-                "new sweep."
+                f"{self._directory / sweepdir.RESULTS_FILE}: has a damaged row (point "
+                f"{row.point}); start a new sweep."
             ) from None
 
-    def _check_axis_cells(self, row: dict[str, str], point: int) -> None:
+    def _check_axis_cells(self, row: ResultRow, point: int) -> None:
         """Refuse a finished row whose axis cells are not the point's values any more."""
         values = self._spec.points[point].values
         for key in self._spec.axes:
             now = axis_cell(values[key])
-            if row[key] != now:
+            if row.axes[key] != now:
                 raise RunError(
                     f"{self._directory / sweepdir.SWEEP_FILE}: {key}: the finished runs of point "
-                    f"{row['point']} ran with {row[key]}, sweep.yaml now gives {now}; --resume "
+                    f"{row.point} ran with {row.axes[key]}, sweep.yaml now gives {now}; --resume "
                     "finishes a sweep exactly as it started (only `seeds` may grow)."
                 )
 
     def points_done(self) -> int:
         return sum(1 for count in self._per_point.values() if count == len(self._spec.seeds))
 
-    def add(self, finished: list[Any]) -> None:
+    def add(self, finished: Sequence[FinishedRun]) -> None:
         spec = self._spec
-        for point, seed, cells, q_table, curve in finished:
+        for run in finished:
+            point, seed = run.point, run.result.seed
             if point not in self._tables:
                 point_id = spec.point_id(point)
                 self._tables[point] = sweepdir.read_tables(self._directory, point_id)
                 if spec.curves:
                     self._curves[point] = sweepdir.read_curves(self._directory, point_id)
-            self._tables[point][spec.seed_key(seed)] = q_table
+            self._tables[point][spec.seed_key(seed)] = run.q_table
             if spec.curves:
-                self._curves[point][spec.seed_key(seed)] = curve
+                self._curves[point][spec.seed_key(seed)] = (run.returns, run.lengths)
             values = spec.points[point].values
-            self.rows[(point, seed)] = {
-                "point": spec.point_id(point),
-                **{key: axis_cell(values[key]) for key in spec.axes},
-                **cells,
-            }
+            self.rows[(point, seed)] = ResultRow(
+                spec.point_id(point), {key: axis_cell(values[key]) for key in spec.axes}, run.result
+            )
             self._per_point[point] += 1
             self._dirty.add(point)
         self.flush()
@@ -404,7 +391,7 @@ class _Book:
             if self._spec.curves:
                 sweepdir.write_curves(self._directory, point_id, self._curves[point])
         rows = self.sorted_rows()
-        sweepdir.write_results(self._directory, self._header, rows)
+        sweepdir.write_results(self._directory, self._spec.axes, rows)
         self.saved = len(rows)
         # Only once both are written: an interruption above leaves everything to save again.
         for point in self._dirty:
@@ -414,65 +401,33 @@ class _Book:
         self._dirty.clear()
         self._last_flush = time.monotonic()
 
-    def sorted_rows(self) -> list[dict[str, str]]:
+    def sorted_rows(self) -> list[ResultRow]:
         return [self.rows[key] for key in sorted(self.rows)]
 
 
-def points_header(spec: SweepSpec) -> list[str]:
-    """The ``points.csv`` header: ``point``, the axes, then the statistics."""
-    return ["point", *spec.axes, *PointStatistics.columns()]
-
-
-def point_statistics(rows: Sequence[dict[str, str]]) -> PointStatistics:
-    """The statistics of one point from its ``results.csv`` rows."""
-    means = [float(row["eval_mean"]) for row in rows if row["eval_mean"]]
-    has_rate = all(row["success"] in ("true", "false") for row in rows if row["eval_mean"])
-    stats = summarize_point(
-        means,
-        [row["success"] == "true" for row in rows if row["eval_mean"]],
-        [_number(row["solved_episode"]) for row in rows if row["eval_mean"]],
-        [_number(row["env_steps_to_solve"]) for row in rows if row["eval_mean"]],
-    )
-    if not has_rate:  # no reward threshold: there is no success to count
-        stats = dataclasses.replace(
-            stats, success_rate=None, success_rate_low=None, success_rate_high=None
-        )
-    return stats
-
-
-def _number(text: str) -> float | None:
-    return float(text) if text else None
-
-
-def summarize_sweep(
-    spec: SweepSpec, directory: Path, rows: Sequence[dict[str, str]]
-) -> list[dict[str, str]]:
+def summarize_sweep(spec: SweepSpec, directory: Path, rows: Sequence[ResultRow]) -> list[PointRow]:
     """Write ``points.csv`` and ``sweep.png`` from the finished rows; return the point rows."""
-    by_point: dict[str, list[dict[str, str]]] = {}
+    by_point: dict[str, list[ResultRow]] = {}
     for row in rows:
-        by_point.setdefault(row["point"], []).append(row)
+        by_point.setdefault(row.point, []).append(row)
     point_rows = []
-    statistics = []
     for point in spec.points:
         point_id = spec.point_id(point.index)
-        stats = point_statistics(by_point.get(point_id, []))
-        statistics.append(stats)
+        results = [row.result for row in by_point.get(point_id, [])]
         point_rows.append(
-            {
-                "point": point_id,
-                **{key: axis_cell(point.values[key]) for key in spec.axes},
-                **{name: cell(value) for name, value in stats.as_row().items()},
-            }
+            PointRow(
+                point_id,
+                {key: axis_cell(point.values[key]) for key in spec.axes},
+                summarize_seeds(results),
+            )
         )
-    sweepdir.write_points(directory, points_header(spec), point_rows)
-    sweepdir.write_figure(directory, sweep_png(spec, statistics, by_point))
+    sweepdir.write_points(directory, spec.axes, point_rows)
+    sweepdir.write_figure(directory, sweep_png(spec, point_rows, by_point))
     return point_rows
 
 
 def sweep_png(
-    spec: SweepSpec,
-    statistics: Sequence[PointStatistics],
-    by_point: dict[str, list[dict[str, str]]],
+    spec: SweepSpec, point_rows: Sequence[PointRow], by_point: dict[str, list[ResultRow]]
 ) -> bytes:
     """Draw ``sweep.png``: the statistics against the axes, and the performance profiles."""
     from cartpole_q.figures import SweepAxis, figure_png, sweep_figure
@@ -484,13 +439,15 @@ def sweep_png(
     eval_means = []
     for point in spec.points:
         rows = by_point.get(spec.point_id(point.index), [])
-        eval_means.append(np.array([float(row["eval_mean"]) for row in rows if row["eval_mean"]]))
+        eval_means.append(
+            np.array([row.result.eval_mean for row in rows if row.result.eval_mean is not None])
+        )
     threshold = _threshold(spec)
     figure = sweep_figure(
         spec.name,
         axes,
         [spec.point_id(point.index) for point in spec.points],
-        [stats.as_row() for stats in statistics],
+        [row.statistics.as_row() for row in point_rows],
         eval_means,
         threshold,
     )

@@ -28,6 +28,7 @@ from cartpole_q.config import (
     read_yaml_mapping,
 )
 from cartpole_q.store import sweepdir
+from cartpole_q.store.sweepdir import axis_cell
 
 SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip", "curves")
 """the keys a sweep file may have"""
@@ -298,14 +299,3 @@ def _expand(
         config = load_config(base, overrides, source=label, override_source=label)
         points.append(Point(index, values, config))
     return tuple(points)
-
-
-def axis_cell(value: Any) -> str:
-    """An axis value as its CSV cell: strings as they are, everything else as JSON.
-
-    >>> axis_cell(0.1), axis_cell("sarsa"), axis_cell([1, 1, 6, 12]), axis_cell(True)
-    ('0.1', 'sarsa', '[1, 1, 6, 12]', 'true')
-    """
-    if isinstance(value, str):
-        return value
-    return json.dumps(value)

@@ -24,7 +24,7 @@ import os
 import socket
 import time
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,15 +33,15 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, mapping_differences, shown_value
 from cartpole_q.errors import RunError, WriteError
-from cartpole_q.experiments.statistics import iqm, summarize_point
 from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, FinishedRun, run_task
-from cartpole_q.experiments.sweep_spec import axis_cell
 from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
 from cartpole_q.experiments.workers import InProcess, chunk_size, execute
 from cartpole_q.progress import NullReporter
+from cartpole_q.results import SeedResult, summarize_seeds
+from cartpole_q.statistics import iqm
 from cartpole_q.store import tunedir
 from cartpole_q.store.atomic import remove_stale_temporaries, write_failure
-from cartpole_q.store.sweepdir import cell
+from cartpole_q.store.sweepdir import axis_cell, cell
 
 IQM_BONUS = 1e-3
 """with objective success_rate: the most a trial's IQM eval return adds (below one seed's share)"""
@@ -476,7 +476,7 @@ def _run_trials(
 def evaluate_trial(
     spec: TuneSpec, trial: Any, values: dict[str, Any], the_study: Any, workers: int,
     backend: str, address: str | None, should_stop: Callable[[], bool] | None,
-) -> list[dict[str, str]] | None:  # fmt: skip
+) -> list[SeedResult] | None:  # fmt: skip
     """Run the trial's config on every seed; None if pruned.
 
     The first seed runs in this process (loading the compiled loop, which forked workers
@@ -486,11 +486,10 @@ def evaluate_trial(
     config = spec.config_for(values, f"trial {trial.number}")
     mapping = config.to_dict()
     seeds = list(spec.seeds)
-    rows: list[dict[str, str]] = []
+    rows: list[SeedResult] = []
 
     def collect(index: int, finished: FinishedRun) -> None:
-        _, seed, cells, _, _ = finished
-        rows.append({**cells, "seed": str(seed)})
+        rows.append(finished.result)
 
     here = InProcess(should_stop, NullReporter())
     for finished in run_task(here, [(trial.number, mapping, seeds[:1])]):
@@ -511,14 +510,14 @@ def evaluate_trial(
                 address=address, should_stop=should_stop)  # fmt: skip
         if spec.pruner and position < len(seeds):
             # Reported, so that samplers can rank a pruned trial by how far it got.
-            trial.report(sum(row["success"] == "true" for row in rows) / len(seeds), len(rows))
+            trial.report(sum(bool(row.success) for row in rows) / len(seeds), len(rows))
             if _cannot_win(the_study, rows, len(seeds)):
                 return None
-    rows.sort(key=lambda row: int(row["seed"]))
+    rows.sort(key=lambda row: row.seed)
     return rows
 
 
-def _cannot_win(the_study: Any, rows: list[dict[str, str]], seeds: int) -> bool:
+def _cannot_win(the_study: Any, rows: list[SeedResult], seeds: int) -> bool:
     """Whether even all remaining seeds succeeding would leave a lower success rate than the best's.
 
     Equal rates are not pruned: the trial could still win on the tie-breakers.
@@ -529,31 +528,28 @@ def _cannot_win(the_study: Any, rows: list[dict[str, str]], seeds: int) -> bool:
         return False  # no finished trial yet
     if best is None:
         return False
-    successes = sum(row["success"] == "true" for row in rows)
+    successes = sum(bool(row.success) for row in rows)
     return bool((successes + seeds - len(rows)) / seeds < best)
 
 
 def trial_figures(
-    spec: TuneSpec, rows: list[dict[str, str]], threshold: float | None = None
-) -> dict[str, Any]:
+    spec: TuneSpec, rows: Sequence[SeedResult], threshold: float | None = None
+) -> dict[str, float]:
     """A trial's statistics over its seeds, and its objective value.
 
     Args:
         spec: the tune file.
-        rows: the trial's ``results.csv``-like rows, one per seed.
+        rows: the trial's results, one per seed.
         threshold: the reward threshold (it scales the IQM bonus; 100 when None).
     """
-    means = [float(row["eval_mean"]) for row in rows]
-    stats = summarize_point(
-        means,
-        [row["success"] == "true" for row in rows],
-        [float(row["solved_episode"]) if row["solved_episode"] else None for row in rows],
-        [float(row["env_steps_to_solve"]) if row["env_steps_to_solve"] else None for row in rows],
-    )
+    means = [row.eval_mean for row in rows if row.eval_mean is not None]
+    stats = summarize_seeds(rows)
     # An unsolved seed counts as UNSOLVED_STEPS, so failing fast never looks like learning fast.
-    steps = [float(row["env_steps_to_solve"] or UNSOLVED_STEPS) for row in rows]
+    steps = [float(row.env_steps_to_solve or UNSOLVED_STEPS) for row in rows]
     tie_break = float(np.median(steps))
-    figures = {name: value for name, value in stats.as_row().items() if value is not None}
+    figures: dict[str, float] = {
+        name: value for name, value in stats.as_row().items() if value is not None
+    }
     figures["tie_break_env_steps"] = tie_break
     if spec.objective == "success_rate":
         # Among trials with the same success rate (all at 0 early on), the higher IQM eval

@@ -27,13 +27,13 @@ from cartpole_q.config import (
 )
 from cartpole_q.experiments.sweep_spec import (
     FORBIDDEN_AXES,
-    axis_cell,
     check_overlaps,
     check_top_keys,
     checked_name,
     load_base,
     safe_name,
 )
+from cartpole_q.store.sweepdir import axis_cell
 
 TUNE_KEYS = ("name", "base", "seeds", "trials", "objective", "space", "sampler", "pruner")
 OBJECTIVES = ("success_rate", "iqm_eval_return")

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import dataclasses
 import functools
 import io
 import json
@@ -36,6 +37,7 @@ from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import check_q_table
+from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
 from cartpole_q.store.atomic import (
     atomic_save_npy,
     atomic_write_bytes,
@@ -43,6 +45,7 @@ from cartpole_q.store.atomic import (
     write_json,
 )
 from cartpole_q.store.checkpoint import CHECKPOINT_FILE
+from cartpole_q.training import TrainResult
 
 CONFIG_FILE = "config.yaml"
 Q_TABLE_FILE = "q_table.npy"
@@ -145,37 +148,9 @@ def _versions() -> dict[str, str]:
     return found
 
 
-def summarize(result: Any) -> dict[str, Any]:
-    """The ``summary.json`` content of a :class:`~cartpole_q.training.TrainResult`."""
-    played_in = "twin" if result.engine == "numba" else "gymnasium"
-    greedy = result.first_greedy_success()
-    return {
-        "episodes": result.episodes,
-        "env_steps": result.env_steps,
-        "wall_seconds": round(result.wall_seconds, 6),
-        "train_seconds": round(result.train_seconds, 6),
-        "steps_per_second": round(result.steps_per_second, 1),
-        "solved_episode": result.solved_episode,
-        "env_steps_to_solve": (
-            None
-            if result.solved_episode is None
-            else int(result.lengths[: result.solved_episode].sum())
-        ),
-        "reward_threshold": result.reward_threshold,
-        "q_table": {
-            "episode": result.kept_episode,
-            "source": "solve point" if result.solved_episode is not None else "last episode",
-        },
-        # The numba engine plays its evaluations on the compiled twin (bit-identical to
-        # Gymnasium's environment); `cartpole-q eval` always plays in gymnasium.make.
-        "eval": None if result.eval is None else {**result.eval.to_dict(), "played_in": played_in},
-        "first_greedy_success": (None if greedy is None else {**greedy, "played_in": played_in}),
-        "engine": result.engine,
-        "seed": result.config.seed,
-        "interrupted": result.interrupted,
-        "versions": versions(),
-        "finished_at": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    }
+def summarize(result: TrainResult) -> RunSummary:
+    """The ``summary.json`` of a training result, stamped with versions and the time."""
+    return RunSummary.of_train(result, versions(), time.strftime("%Y-%m-%dT%H:%M:%S%z"))
 
 
 def metrics_csv(metrics: EpisodeMetrics) -> str:
@@ -198,8 +173,8 @@ def evaluations_csv(evaluations: list[dict[str, Any]]) -> str:
 
 
 def write_run(
-    run_dir: str | Path, result: Any, *, plot: bool = True, overwrite: bool = False
-) -> dict[str, Any]:
+    run_dir: str | Path, result: TrainResult, *, plot: bool = True, overwrite: bool = False
+) -> RunSummary:
     """Write a :class:`~cartpole_q.training.TrainResult` into ``run_dir``.
 
     Files go in the contract's order: data first, ``summary.json`` last. An interrupted
@@ -246,7 +221,7 @@ def write_run(
         figure = reward_curve_figure([curve], result.reward_threshold, title=title)
         atomic_write_bytes(run_dir / CURVE_FILE, figure_png(figure))
     summary = summarize(result)
-    write_json(run_dir / SUMMARY_FILE, summary)
+    write_json(run_dir / SUMMARY_FILE, summary.to_json())
     if not result.interrupted and not result.extendable:
         (run_dir / CHECKPOINT_FILE).unlink(missing_ok=True)
     return summary
@@ -265,7 +240,8 @@ class Run:
     visits: np.ndarray | None
     metrics: EpisodeMetrics
     """the columns of ``metrics.csv`` (episodes are numbered from 1 in order)"""
-    summary: dict[str, Any]
+    result: SeedResult
+    """what it achieved (from ``summary.json``, or a sweep's ``results.csv`` row)"""
 
     @property
     def name(self) -> str:
@@ -321,8 +297,30 @@ def load_run(path: str | Path) -> Run:
             )
     metrics = read_metrics(path / METRICS_FILE)
     return Run(
-        path=path, config=config, q_table=q_table, visits=visits, metrics=metrics, summary=summary
+        path=path,
+        config=config,
+        q_table=q_table,
+        visits=visits,
+        metrics=metrics,
+        result=_with_threshold(summary.result(config.seed), config),
     )
+
+
+def _with_threshold(result: SeedResult, config: Config) -> SeedResult:
+    """A result judged by its config's threshold when its summary predates recording it."""
+    if result.reward_threshold is not None:
+        return result
+    threshold = config_threshold(config)
+    return dataclasses.replace(
+        result, reward_threshold=threshold, success=is_success(result.eval_mean, threshold)
+    )
+
+
+def config_threshold(config: Config) -> float | None:
+    """The reward threshold a config's runs are judged by (``None`` without one)."""
+    from cartpole_q.envs.gym import inspect_env
+
+    return inspect_env(config).reward_threshold
 
 
 def load_array(path: Path, dtype: type) -> np.ndarray:
@@ -390,25 +388,38 @@ def read_metrics(path: Path) -> EpisodeMetrics:
     )
 
 
-def read_summary(run_dir: Path) -> dict[str, Any] | None:
-    """A run directory's ``summary.json``: the one reader of it.
+def read_summary(run_dir: Path) -> RunSummary | None:
+    """A single run's ``summary.json``: the one reader of it.
 
     Returns:
         The summary, or ``None`` when there is none (the run has not finished).
 
     Raises:
-        RunError: the file exists but is not a JSON object.
+        RunError: the file exists but is not a run's summary (naming the file and key).
     """
     path = run_dir / SUMMARY_FILE
+    data = _read_json(path)
+    return None if data is None else RunSummary.from_json(data, str(path))
+
+
+def read_multi_seed_summary(parent: Path) -> MultiSeedSummary | None:
+    """A multi-seed run's ``summary.json`` (``None`` until the command has ended).
+
+    Raises:
+        RunError: the file exists but is not a multi-seed summary.
+    """
+    path = parent / SUMMARY_FILE
+    data = _read_json(path)
+    return None if data is None else MultiSeedSummary.from_json(data, str(path))
+
+
+def _read_json(path: Path) -> object:
     try:
-        summary = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         return None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
         raise RunError(f"{path}: is not valid JSON ({error}).") from None
-    if not isinstance(summary, dict):
-        raise RunError(f"{path}: must hold a JSON object.")
-    return summary
 
 
 def _config_of(path: Path) -> Config:

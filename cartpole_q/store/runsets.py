@@ -10,13 +10,13 @@ records, so that the commands treat them alike, with notes naming what is unfini
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, load_config
+from cartpole_q.config import Config, ConfigError, Schedule, load_config
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.store import rundir, sweepdir
@@ -57,8 +57,7 @@ class RunSet:
     @property
     def reward_threshold(self) -> float | None:
         """The threshold the seeds were judged by (``None`` without one)."""
-        value = self.runs[0].summary.get("reward_threshold")
-        return None if value is None else float(value)
+        return self.runs[0].result.reward_threshold
 
 
 def load_run_set(path: Path) -> RunSet:
@@ -75,9 +74,9 @@ def load_run_set(path: Path) -> RunSet:
         return _multi_seed(path)
     run = rundir.load_run(path)
     notes = []
-    if run.summary.get("interrupted"):
+    if run.result.interrupted:
         notes.append(
-            f"{path}: training was interrupted after episode {run.summary.get('episodes')} of "
+            f"{path}: training was interrupted after episode {run.result.episodes} of "
             f"{run.config.train.episodes}; its table at that point is used (finish it with "
             f"`cartpole-q train --resume {path}`)."
         )
@@ -97,7 +96,7 @@ def _multi_seed(parent: Path) -> RunSet:
         summary = rundir.read_summary(child)
         if summary is None:
             (unfinished if child.is_dir() else missing).append(child.name)
-        elif summary.get("interrupted", True):
+        elif summary.interrupted:
             unfinished.append(child.name)
         else:
             runs.append(rundir.load_run(child))
@@ -128,7 +127,7 @@ def _names(names: list[str], limit: int = 8) -> str:
     return shown if len(names) <= limit else f"{shown} and {len(names) - limit} more"
 
 
-def _sweep_point(point_dir: Path, rows: list[dict[str, str]]) -> RunSet:
+def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
     """A sweep point's seeds as runs: rows, tables and (when kept) learning curves."""
     sweep = point_dir.parent.parent
     try:
@@ -139,11 +138,11 @@ def _sweep_point(point_dir: Path, rows: list[dict[str, str]]) -> RunSet:
         ) from None
     tables = sweepdir.read_tables(sweep, point_dir.name)
     curves = sweepdir.read_curves(sweep, point_dir.name)
-    threshold = _threshold(config)
+    threshold = rundir.config_threshold(config)
     seeds = sweepdir.sweep_seeds(sweep)
     runs = []
     for row in rows:
-        seed = int(row["seed"])
+        seed = row.result.seed
         key = sweepdir.seed_key(seed, seeds)
         if key not in tables:
             raise RunError(
@@ -159,7 +158,7 @@ def _sweep_point(point_dir: Path, rows: list[dict[str, str]]) -> RunSet:
                 q_table=tables[key],
                 visits=None,
                 metrics=_metrics(seed_config, returns, lengths),
-                summary=_summary_of_row(row, threshold),
+                result=dataclasses.replace(row.result, reward_threshold=threshold),
             )
         )
     total = len(seeds)
@@ -172,17 +171,11 @@ def _sweep_point(point_dir: Path, rows: list[dict[str, str]]) -> RunSet:
     return RunSet(point_dir, "sweep point", runs, notes)
 
 
-def _threshold(config: Config) -> float | None:
-    from cartpole_q.envs.gym import inspect_env
-
-    return inspect_env(config).reward_threshold
-
-
 def _metrics(config: Config, returns: np.ndarray, lengths: np.ndarray) -> EpisodeMetrics:
     """Per-episode metrics from a kept curve; epsilon and alpha from the config's schedules."""
     from cartpole_q.rl.schedules import schedule_value
 
-    def rates(schedule: Any) -> np.ndarray:
+    def rates(schedule: Schedule) -> np.ndarray:
         code, start, end, rate = schedule.code, schedule.start, schedule.end, schedule.rate
         return np.array(
             [schedule_value(code, start, end, rate, e) for e in range(len(returns))],
@@ -195,25 +188,3 @@ def _metrics(config: Config, returns: np.ndarray, lengths: np.ndarray) -> Episod
         rates(config.agent.epsilon),
         rates(config.agent.alpha),
     )
-
-
-def _summary_of_row(row: dict[str, str], threshold: float | None) -> dict[str, Any]:
-    """The ``summary.json`` fields a sweep row holds."""
-
-    def number(name: str) -> float | None:
-        return float(row[name]) if row.get(name) else None
-
-    solved = number("solved_episode")
-    first = number("first_greedy_success_env_steps")
-    steps_to_solve = number("env_steps_to_solve")
-    mean = number("eval_mean")
-    return {
-        "episodes": int(row["episodes"]),
-        "env_steps": int(row["env_steps"]),
-        "solved_episode": None if solved is None else int(solved),
-        "env_steps_to_solve": None if steps_to_solve is None else int(steps_to_solve),
-        "first_greedy_success": None if first is None else {"env_steps": int(first)},
-        "eval": None if mean is None else {"mean": mean},
-        "reward_threshold": threshold,
-        "interrupted": False,
-    }

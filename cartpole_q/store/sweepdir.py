@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import zipfile
 from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +23,8 @@ import yaml
 
 from cartpole_q.config import parse_seeds, read_yaml_mapping
 from cartpole_q.errors import RunError
+from cartpole_q.results import SeedResult
+from cartpole_q.statistics import PointStatistics
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
 from cartpole_q.store.rundir import CONFIG_FILE, create_run_dir, write_config
 
@@ -112,6 +116,28 @@ def result_header(axes: Sequence[str]) -> list[str]:
     return ["point", *axes, *RESULT_COLUMNS]
 
 
+@dataclass(frozen=True)
+class ResultRow:
+    """One finished run of a sweep: its point, the point's axis values and its figures."""
+
+    point: str
+    """the point's id (``000``)"""
+    axes: Mapping[str, str]
+    """each axis key's value at the point, as its cell (:func:`axis_cell`)"""
+    result: SeedResult
+
+
+def axis_cell(value: Any) -> str:
+    """An axis value as its CSV cell: strings as they are, everything else as JSON.
+
+    >>> axis_cell(0.1), axis_cell("sarsa"), axis_cell([1, 1, 6, 12]), axis_cell(True)
+    ('0.1', 'sarsa', '[1, 1, 6, 12]', 'true')
+    """
+    if isinstance(value, str):
+        return value
+    return json.dumps(value)
+
+
 def cell(value: Any) -> str:
     """A value as a CSV cell: empty for missing, ``true``/``false``, floats round-trip.
 
@@ -127,6 +153,56 @@ def cell(value: Any) -> str:
     return str(value)
 
 
+def result_cells(result: SeedResult) -> dict[str, str]:
+    """A run's figures as its ``results.csv`` cells (:data:`RESULT_COLUMNS`)."""
+    return {column: cell(getattr(result, column)) for column in RESULT_COLUMNS}
+
+
+def row_cells(row: ResultRow) -> dict[str, str]:
+    """A row as its ``results.csv`` cells, by column."""
+    return {"point": row.point, **row.axes, **result_cells(row.result)}
+
+
+def parse_row(cells: Mapping[str, str], axes: Sequence[str], where: Path) -> ResultRow:
+    """A ``results.csv`` row back from its cells.
+
+    Raises:
+        RunError: a cell is not what its column holds; the sweep directory is damaged.
+    """
+    try:
+        return ResultRow(
+            point=cells["point"],
+            axes={key: cells[key] for key in axes},
+            result=SeedResult(
+                seed=int(cells["seed"]),
+                episodes=int(cells["episodes"]),
+                env_steps=int(cells["env_steps"]),
+                solved_episode=_integer(cells["solved_episode"]),
+                env_steps_to_solve=_integer(cells["env_steps_to_solve"]),
+                first_greedy_success_env_steps=_integer(cells["first_greedy_success_env_steps"]),
+                eval_mean=float(cells["eval_mean"]) if cells["eval_mean"] else None,
+                success=_flag(cells["success"]),
+                train_seconds=float(cells["train_seconds"] or 0.0),
+            ),
+        )
+    except (KeyError, ValueError, TypeError):
+        raise RunError(
+            f"{where}: has a damaged row ({dict(cells)}); the sweep directory was changed by "
+            "hand. Start a new sweep."
+        ) from None
+
+
+def _integer(text: str) -> int | None:
+    # float first: results.csv from before typed rows may hold "12.0"
+    return None if not text else int(float(text))
+
+
+def _flag(text: str) -> bool | None:
+    if text in ("", "true", "false"):
+        return None if not text else text == "true"
+    raise ValueError(text)
+
+
 def csv_text(header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> str:
     """CSV text (Unix line ends) of rows whose cells are already strings."""
     buffer = io.StringIO()
@@ -137,30 +213,29 @@ def csv_text(header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> str:
     return buffer.getvalue()
 
 
-def write_results(
-    directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]
-) -> None:
+def write_results(directory: Path, axes: Sequence[str], rows: Iterable[ResultRow]) -> None:
     """Rewrite ``results.csv`` whole (rows already in (point, seed) order)."""
-    atomic_write_text(directory / RESULTS_FILE, csv_text(header, rows))
+    text = csv_text(result_header(axes), (row_cells(row) for row in rows))
+    atomic_write_text(directory / RESULTS_FILE, text)
 
 
-def read_results(directory: Path, header: Sequence[str]) -> list[dict[str, str]]:
-    """The rows of ``results.csv`` as cells (none if it does not exist yet).
+def read_results(directory: Path, axes: Sequence[str]) -> list[ResultRow]:
+    """The rows of ``results.csv`` (none if it does not exist yet).
 
     Raises:
-        RunError: the file's header is not the sweep's.
+        RunError: the file's header is not the sweep's, or a row is damaged.
     """
     path = directory / RESULTS_FILE
     if not path.is_file():
         return []
     with path.open(newline="", encoding="utf-8") as file:
         reader = csv.DictReader(file)
-        if reader.fieldnames != list(header):
+        if reader.fieldnames != result_header(axes):
             raise RunError(
                 f"{path}: its columns are not the ones {SWEEP_FILE} gives; the sweep directory "
                 "was changed by hand. Start a new sweep."
             )
-        return [dict(row) for row in reader]
+        return [parse_row(cells, axes, path) for cells in reader]
 
 
 def seed_key(seed: int, seeds: Sequence[int]) -> str:
@@ -255,9 +330,32 @@ def read_tables(directory: Path, point_id: str) -> dict[str, np.ndarray]:
         ) from None
 
 
-def write_points(directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
+@dataclass(frozen=True)
+class PointRow:
+    """One ``points.csv`` row: a point, its axis values and its statistics."""
+
+    point: str
+    axes: Mapping[str, str]
+    """each axis key's value at the point, as its cell (:func:`axis_cell`)"""
+    statistics: PointStatistics
+
+
+def points_header(axes: Sequence[str]) -> list[str]:
+    """The ``points.csv`` header: ``point``, the axes, then the statistics."""
+    return ["point", *axes, *PointStatistics.columns()]
+
+
+def write_points(directory: Path, axes: Sequence[str], rows: Iterable[PointRow]) -> None:
     """Write ``points.csv``."""
-    atomic_write_text(directory / POINTS_FILE, csv_text(header, rows))
+    cells = (
+        {
+            "point": row.point,
+            **row.axes,
+            **{name: cell(value) for name, value in row.statistics.as_row().items()},
+        }
+        for row in rows
+    )
+    atomic_write_text(directory / POINTS_FILE, csv_text(points_header(axes), cells))
 
 
 def write_figure(directory: Path, png: bytes) -> None:
@@ -265,7 +363,7 @@ def write_figure(directory: Path, png: bytes) -> None:
     atomic_write_bytes(directory / FIGURE_FILE, png)
 
 
-def point_results(point_dir: Path) -> list[dict[str, str]] | None:
+def point_results(point_dir: Path) -> list[ResultRow] | None:
     """The ``results.csv`` rows of a sweep point (``<sweep>/points/<p>``); None if not one.
 
     Raises:
@@ -285,7 +383,17 @@ def point_results(point_dir: Path) -> list[dict[str, str]] | None:
     rows = []
     if path.is_file():
         with path.open(newline="", encoding="utf-8") as file:
-            rows = [row for row in csv.DictReader(file) if row.get("point") == point_dir.name]
+            reader = csv.DictReader(file)
+            axes = [
+                name
+                for name in (reader.fieldnames or [])
+                if name != "point" and name not in RESULT_COLUMNS
+            ]
+            rows = [
+                parse_row(cells, axes, path)
+                for cells in reader
+                if cells.get("point") == point_dir.name
+            ]
     if not rows:
         raise RunError(f"{point_dir}: this sweep point has no finished run in {path} yet.")
     return rows
