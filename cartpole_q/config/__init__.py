@@ -1,30 +1,28 @@
 """The run configuration: its schema, and loading it from YAML, names and overrides.
 
-This package imports neither numpy, numba nor gymnasium, so that the command line starts
-fast.
+One module per concern: :mod:`~cartpole_q.config.schema` (the dataclasses and their keys'
+metadata), :mod:`~cartpole_q.config.yaml_io` (safe YAML, the shipped configs),
+:mod:`~cartpole_q.config.overrides` (``--set``, merging, unknown keys),
+:mod:`~cartpole_q.config.validation` (the readers and the cross-key rules),
+:mod:`~cartpole_q.config.diff` (what differs between configs),
+:mod:`~cartpole_q.config.loading` (:func:`load_config`, putting them together) and
+:mod:`~cartpole_q.config.reference` (the README's key table, generated).
+
+This package imports neither numba nor gymnasium, so that the command line starts fast.
 
 >>> config = load_config()
 >>> config.env.id, config.discretization.bins
 ('CartPole-v1', (1, 1, 2, 10))
 """
 
-from cartpole_q.config.loading import (
-    NOT_SET,
+from cartpole_q.config.diff import NOT_SET, config_differences, mapping_differences, shown_value
+from cartpole_q.config.loading import load_config
+from cartpole_q.config.overrides import (
     OVERRIDE_SOURCE,
     Provenance,
     blame,
     check_known_keys,
-    config_differences,
-    default_raw,
-    default_yaml_text,
-    load_config,
-    mapping_differences,
     parse_assignment,
-    parse_seeds,
-    read_yaml_mapping,
-    resolve_config_path,
-    shipped_configs,
-    shown_value,
 )
 from cartpole_q.config.schema import (
     ENGINES,
@@ -36,9 +34,18 @@ from cartpole_q.config.schema import (
     DiscretizationConfig,
     EnvConfig,
     EvalConfig,
+    Key,
     Schedule,
     TrainConfig,
     format_seeds,
+)
+from cartpole_q.config.validation import parse_seeds
+from cartpole_q.config.yaml_io import (
+    default_raw,
+    default_yaml_text,
+    read_yaml_mapping,
+    resolve_config_path,
+    shipped_configs,
 )
 from cartpole_q.errors import ConfigError
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
@@ -57,6 +64,7 @@ __all__ = [
     "DiscretizationConfig",
     "EnvConfig",
     "EvalConfig",
+    "Key",
     "Provenance",
     "Schedule",
     "TrainConfig",

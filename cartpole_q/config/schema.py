@@ -1,19 +1,28 @@
-"""The run configuration's schema: frozen dataclasses, one docstring per field.
+"""The run configuration's schema: frozen dataclasses whose fields carry their own metadata.
 
 A :class:`Config` is complete (every default filled) and validated when it exists: only
 :func:`cartpole_q.config.load_config` makes one, and nothing mutates it afterwards.
+
+Every field of :class:`Config` and its sections carries a :class:`Key` (written with
+:func:`spec`): the kind of value it takes, its range or choices, and its line in the README's
+config reference. Validation, :meth:`Config.to_dict`, the unknown-key check, merging and the
+README's table all walk these fields, so a new config key is a field here and a value in
+``default.yaml``. The dataclasses' field order is the order of a config file.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
+import typing
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import Any, Literal
 
 import yaml
 
+from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 ENGINES = ("auto", "numba", "gymnasium")
@@ -26,6 +35,76 @@ MAX_SEED = 2**32 - 1
 """the largest seed (``seed``, ``eval.seed``, ``--seed``, ``--seeds``)"""
 EXACT_INTEGER = 2**53
 """an integer given as a float (``1e6``) must be below this, where floats are exact"""
+
+Kind = Literal[
+    "name", "str", "int", "float", "bool", "choice", "algorithm", "schedule", "seeds",
+    "bins", "floats", "kwargs", "physics", "randomize", "params", "section",
+]  # fmt: skip
+"""What a config key's value is (see :attr:`Key.kind`)."""
+
+
+@dataclass(frozen=True)
+class Key:
+    """A config key's metadata: how it is read, written back and documented.
+
+    The names ``kind``, ``low``, ``high``, ``low_open`` and ``choices`` mean what they mean
+    on an algorithm's :class:`~cartpole_q.rl.algorithm.Param`, so that one reader checks
+    both.
+    """
+
+    kind: Kind
+    """the value: ``name`` (a run name), ``str``, ``int``, ``float``, ``bool``, ``choice``,
+    ``algorithm`` (a registered one), ``schedule``, ``seeds``, ``bins`` (positive integers),
+    ``floats`` (finite numbers), ``kwargs`` (``gymnasium.make``'s), ``physics`` and
+    ``randomize`` (checked against the environment's profile), ``params`` (the algorithm's
+    own keys, which stand in the section itself) or ``section`` (a mapping of keys)"""
+    doc: str
+    """its line in the README's config reference (Markdown); ``{interval}`` and
+    ``{choices}`` are replaced by the range and the choices below; empty: no line (a
+    section whose keys have theirs)"""
+    low: float | None = None
+    """the smallest value (``None``: no bound)"""
+    high: float | None = None
+    """the largest value (``None``: no bound)"""
+    low_open: bool = False
+    """``low`` itself is excluded"""
+    choices: tuple[str, ...] = ()
+    """the values of a ``choice``"""
+    nullable: bool = False
+    """``null`` is a value of its own: the single top-level seed, the environment's
+    threshold, no grid"""
+
+    @property
+    def interval(self) -> str:
+        """The accepted values as messages and the README write them: ``(0, 1]``."""
+        return Param(
+            "", 0, "", kind=self.kind, low=self.low, high=self.high, low_open=self.low_open,
+            choices=self.choices,
+        ).interval  # fmt: skip
+
+
+_KEY = "cartpole_q.key"
+"""where a field's metadata holds its :class:`Key`"""
+
+
+def spec(
+    kind: Kind,
+    doc: str,
+    *,
+    low: float | None = None,
+    high: float | None = None,
+    low_open: bool = False,
+    choices: tuple[str, ...] = (),
+    nullable: bool = False,
+) -> dict[str, Key]:
+    """A field's metadata: ``field(metadata=spec("float", "discount", low=0.0, high=1.0))``."""
+    return {_KEY: Key(kind, doc, low, high, low_open, choices, nullable)}
+
+
+def key_of(item: dataclasses.Field[Any]) -> Key:
+    """The :class:`Key` a dataclass field carries."""
+    key: Key = item.metadata[_KEY]
+    return key
 
 
 @dataclass(frozen=True)
@@ -59,27 +138,80 @@ class Schedule:
         """Return the YAML form: a number for a constant, else a mapping."""
         if self.kind == "constant":
             return self.start
-        if self.kind == "exponential":
-            return {"type": "exponential", "start": self.start, "decay": self.rate, "end": self.end}
-        return {"type": "log", "k": self.rate, "end": self.end, "start": self.start}
+        form = SCHEDULE_FORMS[self.kind]
+        return {"type": self.kind, **{key.name: getattr(self, key.field) for key in form}}
+
+
+@dataclass(frozen=True)
+class ScheduleKey:
+    """A key of a schedule mapping: its YAML name and the :class:`Schedule` field it sets."""
+
+    name: str
+    """the key in YAML (``decay``, ``k``)"""
+    field: str
+    """the :class:`Schedule` field it sets"""
+    bounds: Key | None = None
+    """its range; ``None``: the range of the schedule's own key (``agent.alpha``'s)"""
+    default: float | None = None
+    """the value when it is left out; ``None``: it is required"""
+
+
+SCHEDULE_FORMS: Mapping[str, tuple[ScheduleKey, ...]] = MappingProxyType({
+    "constant": (ScheduleKey("value", "start"),),
+    "exponential": (
+        ScheduleKey("start", "start"),
+        ScheduleKey("decay", "rate", Key("float", "", low=0.0, high=1.0, low_open=True)),
+        ScheduleKey("end", "end"),
+    ),
+    "log": (
+        ScheduleKey("k", "rate", Key("float", "", low=0.0, low_open=True)),
+        ScheduleKey("end", "end"),
+        ScheduleKey("start", "start", default=1.0),
+    ),
+})  # fmt: skip
+"""the keys of each schedule mapping after its ``type``, in the order files write them
+(a number is a constant, too)"""
 
 
 @dataclass(frozen=True)
 class EnvConfig:
     """Which Gymnasium environment to learn."""
 
-    id: str
-    """the id given to ``gymnasium.make``"""
-    kwargs: Mapping[str, Any]
-    """keyword arguments forwarded to ``gymnasium.make`` (read-only mapping)"""
-    physics: Mapping[str, float | str] = field(default_factory=lambda: MappingProxyType({}))
-    """attributes set on ``env.unwrapped`` after ``gymnasium.make``: the keys and ranges the
-    environment's profile allows (CartPole's, in :mod:`cartpole_q.profiles.cartpole`)"""
-    randomize: Mapping[str, tuple[float, float]] = field(
-        default_factory=lambda: MappingProxyType({})
+    id: str = field(
+        metadata=spec(
+            "str",
+            "any Gymnasium environment with `Discrete` actions and a 1-D `Box` observation "
+            "(binned), a `Discrete` or a `Tuple` of `Discrete` observations (the Q-table's "
+            "index)",
+        )
     )
-    """``[low, high]`` per key the profile lets vary; one uniform draw per key (in the
-    profile's order) before every training episode's reset"""
+    kwargs: Mapping[str, Any] = field(
+        metadata=spec(
+            "kwargs",
+            "passed to `gymnasium.make`, e.g. `sutton_barto_reward: true`, "
+            "`max_episode_steps: 200` (a positive whole number); whatever the environment "
+            "refuses is an error naming the key",
+        )
+    )
+    physics: Mapping[str, float | str] = field(
+        default_factory=lambda: MappingProxyType({}),
+        metadata=spec(
+            "physics",
+            "attributes set on `env.unwrapped` after `gymnasium.make`, the values derived "
+            "from them recomputed as the environment's `__init__` does (CartPole's "
+            "`total_mass` and `polemass_length`); the compiled twin takes the same values "
+            "and stays bit-identical. The keys and ranges each environment's profile allows:",
+        ),
+    )
+    randomize: Mapping[str, tuple[float, float]] = field(
+        default_factory=lambda: MappingProxyType({}),
+        metadata=spec(
+            "randomize",
+            "`{key: [low, high]}`: before every training episode one `uniform(low, high)` "
+            "per key, in the profile's order, from the run's third random generator; "
+            "evaluations use `env.physics`. The keys each environment's profile lets vary:",
+        ),
+    )
 
 
 @dataclass(frozen=True)
@@ -90,123 +222,178 @@ class DiscretizationConfig:
     (``Config.discretization`` is then ``None``).
     """
 
-    bins: tuple[int, ...]
-    """bins per observation dimension; a dimension with 1 bin is ignored"""
-    low: tuple[float, ...]
-    """lower edge of the grid per dimension; values below fall in the first bin"""
-    high: tuple[float, ...]
-    """upper edge of the grid per dimension; values above fall in the last bin"""
+    bins: tuple[int, ...] = field(
+        metadata=spec("bins", "bins per observation dimension (1 ignores the dimension)")
+    )
+    low: tuple[float, ...] = field(
+        metadata=spec("floats", "the grid's lower edges; values below fall in the first bin")
+    )
+    high: tuple[float, ...] = field(
+        metadata=spec("floats", "the grid's upper edges; values above fall in the last bin")
+    )
 
 
 @dataclass(frozen=True)
 class AgentConfig:
     """The learning algorithm and its hyperparameters."""
 
-    algorithm: str
-    """a registered algorithm's name (:func:`cartpole_q.rl.algorithms.names`)"""
-    gamma: float
-    """discount factor in [0, 1]"""
-    alpha: Schedule
-    """learning rate, every value in (0, 1]"""
-    epsilon: Schedule
-    """exploration rate of the epsilon-greedy policy, every value in [0, 1]"""
-    q_init: float
-    """initial value of every Q-table entry"""
-    max_q_table_bytes: int
-    """refuse to allocate a Q-table larger than this many bytes"""
-    params: Mapping[str, float | int | str] = field(default_factory=lambda: MappingProxyType({}))
-    """the algorithm's own keys (``agent.n``, ``agent.lambda``; see its module in
-    :mod:`cartpole_q.rl.algorithms`), every one it declares, defaults filled (read-only)"""
+    algorithm: str = field(
+        metadata=spec(
+            "algorithm",
+            "{choices} (each stated precisely in the project's design notes: target, order "
+            "of work, random draws)",
+        )
+    )
+    # Declared second since files write an algorithm's own keys right after its name;
+    # keyword-only so that it may keep a default before the fields without one.
+    params: Mapping[str, float | int | str] = field(
+        default_factory=lambda: MappingProxyType({}),
+        kw_only=True,
+        metadata=spec(
+            "params",
+            "the algorithm's own keys (`agent.n`, `agent.lambda`), every one it declares, "
+            "defaults filled (a read-only mapping; see its module in `cartpole_q.rl.algorithms`)",
+        ),
+    )
+    gamma: float = field(metadata=spec("float", "discount, in {interval}", low=0.0, high=1.0))
+    alpha: Schedule = field(
+        metadata=spec(
+            "schedule",
+            "learning rate in {interval}: a number, or a schedule",
+            low=0.0,
+            high=1.0,
+            low_open=True,
+        )
+    )
+    epsilon: Schedule = field(
+        metadata=spec(
+            "schedule",
+            "exploration rate of the epsilon-greedy policy in {interval}: a number, or a schedule",
+            low=0.0,
+            high=1.0,
+        )
+    )
+    q_init: float = field(
+        metadata=spec("float", "initial value of every Q-table entry (optimistic values explore)")
+    )
+    max_q_table_bytes: int = field(
+        metadata=spec(
+            "int", "refuse a Q-table larger than this many bytes, before allocating it", low=1
+        )
+    )
 
 
 @dataclass(frozen=True)
 class TrainConfig:
     """How long to train and what to record on the way."""
 
-    episodes: int
-    """number of training episodes (an upper bound when ``stop_when_solved``)"""
-    seeds: tuple[int, ...] | None
-    """train one run per seed, in parallel; ``None`` trains the single top-level seed"""
-    stop_when_solved: bool
-    """stop at the first episode whose 100-episode average return reaches the threshold"""
-    reward_threshold: float | None
-    """the solve threshold; ``None`` takes the environment's registered threshold"""
-    eval_every: int
-    """run a greedy evaluation every this many episodes; 0 disables it"""
-    eval_episodes: int
-    """episodes per periodic greedy evaluation"""
-    checkpoint_every: int
-    """write a resumable checkpoint every this many episodes; 0 disables it"""
+    episodes: int = field(
+        metadata=spec(
+            "int",
+            "training episodes (an upper bound when `stop_when_solved`)",
+            low=1,
+            high=MAX_EPISODES,
+        )
+    )
+    seeds: tuple[int, ...] | None = field(
+        metadata=spec(
+            "seeds",
+            'e.g. `"0-99"` or `[0, 1, 2]`: one run per seed, in parallel; `null` trains the '
+            "single `seed`",
+            nullable=True,
+        )
+    )
+    stop_when_solved: bool = field(
+        metadata=spec(
+            "bool",
+            "stop at the first episode whose 100-episode average return reaches the "
+            "threshold; either way the table kept is the one from the solve point",
+        )
+    )
+    reward_threshold: float | None = field(
+        metadata=spec(
+            "float",
+            "the solve threshold; `null` takes the environment's (475 for CartPole-v1), for "
+            "CartPole scaled with a changed time limit: `env.kwargs.max_episode_steps: 1000` "
+            "makes it 475 × 1000 / 500 = 950",  # noqa: RUF001 (the README's sign)
+            nullable=True,
+        )
+    )
+    eval_every: int = field(
+        metadata=spec(
+            "int", "a greedy evaluation every this many training episodes (0: never)", low=0
+        )
+    )
+    eval_episodes: int = field(
+        metadata=spec(
+            "int", "episodes per greedy evaluation during training", low=1, high=MAX_EPISODES
+        )
+    )
+    checkpoint_every: int = field(
+        metadata=spec("int", "a resumable checkpoint every this many episodes (0: never)", low=0)
+    )
 
 
 @dataclass(frozen=True)
 class EvalConfig:
     """The greedy evaluation recorded in ``summary.json`` and used by ``cartpole-q eval``."""
 
-    episodes: int
-    """number of greedy episodes"""
-    seed: int
-    """seed of the evaluation environment's first reset"""
+    episodes: int = field(
+        metadata=spec(
+            "int",
+            "episodes of the final greedy evaluation (and `cartpole-q eval`'s default)",
+            low=1,
+            high=MAX_EPISODES,
+        )
+    )
+    seed: int = field(
+        metadata=spec(
+            "int",
+            "seed of the final evaluation's first reset (and `cartpole-q eval`'s default)",
+            low=0,
+            high=MAX_SEED,
+        )
+    )
 
 
 @dataclass(frozen=True)
 class Config:
     """A complete, validated run configuration. Never mutated after loading."""
 
-    name: str
-    """run-name prefix: letters, digits, '-', '_'"""
-    seed: int
-    """the run's seed; every random generator of the run is derived from it"""
-    engine: str
-    """``auto``, ``numba`` or ``gymnasium``"""
-    env: EnvConfig
-    discretization: DiscretizationConfig | None
-    """the binning grid of a Box observation; ``None`` for Discrete and Tuple-of-Discrete
-    observations, which index the Q-table directly (when a config gives no grid, CartPole
-    takes the embedded default's and every other environment none)"""
-    agent: AgentConfig
-    train: TrainConfig
-    eval: EvalConfig
+    name: str = field(metadata=spec("name", "run-name prefix: letters, digits, `-`, `_`"))
+    seed: int = field(
+        metadata=spec(
+            "int",
+            "the run's seed, 0 to 2^32 - 1; every random generator of the run derives from it",
+            low=0,
+            high=MAX_SEED,
+        )
+    )
+    engine: str = field(
+        metadata=spec(
+            "choice",
+            "{choices}; `auto` is `numba` where the environment has a compiled twin",
+            choices=ENGINES,
+        )
+    )
+    env: EnvConfig = field(metadata=spec("section", ""))
+    discretization: DiscretizationConfig | None = field(
+        metadata=spec(
+            "section",
+            "the binning grid, for `Box` observations only. Left out, CartPole takes the "
+            "default's grid and every other environment none; `Discrete(n, start)` and "
+            "`Tuple` observations need none (`config.yaml` says `discretization: null`; "
+            "giving one is an error naming the reason), a `Box` without one is an error",
+            nullable=True,
+        )
+    )
+    agent: AgentConfig = field(metadata=spec("section", ""))
+    train: TrainConfig = field(metadata=spec("section", ""))
+    eval: EvalConfig = field(metadata=spec("section", ""))
 
     def to_dict(self) -> dict[str, Any]:
         """Return the config as plain YAML-ready data, every key present."""
-        return {
-            "name": self.name,
-            "seed": self.seed,
-            "engine": self.engine,
-            "env": {
-                "id": self.env.id,
-                "kwargs": _plain(self.env.kwargs),
-                "physics": _plain(self.env.physics),
-                "randomize": _plain(self.env.randomize),
-            },
-            "discretization": None
-            if self.discretization is None
-            else {
-                "bins": list(self.discretization.bins),
-                "low": list(self.discretization.low),
-                "high": list(self.discretization.high),
-            },
-            "agent": {
-                "algorithm": self.agent.algorithm,
-                **_plain(self.agent.params),
-                "gamma": self.agent.gamma,
-                "alpha": self.agent.alpha.to_yaml(),
-                "epsilon": self.agent.epsilon.to_yaml(),
-                "q_init": self.agent.q_init,
-                "max_q_table_bytes": self.agent.max_q_table_bytes,
-            },
-            "train": {
-                "episodes": self.train.episodes,
-                "seeds": None if self.train.seeds is None else format_seeds(self.train.seeds),
-                "stop_when_solved": self.train.stop_when_solved,
-                "reward_threshold": self.train.reward_threshold,
-                "eval_every": self.train.eval_every,
-                "eval_episodes": self.train.eval_episodes,
-                "checkpoint_every": self.train.checkpoint_every,
-            },
-            "eval": {"episodes": self.eval.episodes, "seed": self.eval.seed},
-        }
+        return _yaml_fields(self)
 
     def to_yaml(self) -> str:
         """Return the resolved config as YAML; loading it gives back an equal config."""
@@ -219,6 +406,25 @@ class Config:
         return dataclasses.replace(
             self, seed=seed, train=dataclasses.replace(self.train, seeds=None)
         )
+
+
+@functools.cache
+def sections() -> Mapping[str, type]:
+    """The sections of a config file, in file order, and the dataclass each is read into.
+
+    >>> list(sections())
+    ['env', 'discretization', 'agent', 'train', 'eval']
+    """
+    hints = typing.get_type_hints(Config)
+    found: dict[str, type] = {}
+    for item in dataclasses.fields(Config):
+        if key_of(item).kind == "section":
+            # `DiscretizationConfig | None`: the dataclass among the union's members.
+            members = typing.get_args(hints[item.name]) or (hints[item.name],)
+            found[item.name] = next(
+                m for m in members if isinstance(m, type) and dataclasses.is_dataclass(m)
+            )
+    return MappingProxyType(found)
 
 
 def format_seeds(seeds: Iterable[int]) -> str:
@@ -240,8 +446,29 @@ def format_seeds(seeds: Iterable[int]) -> str:
     return ",".join(parts)
 
 
+def _yaml_fields(record: Any) -> dict[str, Any]:
+    """A section (or the whole config) as YAML data, its keys in field order."""
+    data: dict[str, Any] = {}
+    for item in dataclasses.fields(record):
+        value = getattr(record, item.name)
+        kind = key_of(item).kind
+        if kind == "params":
+            data.update(_plain(value))  # the algorithm's own keys stand in the section
+        elif value is None:
+            data[item.name] = None
+        elif kind == "section":
+            data[item.name] = _yaml_fields(value)
+        elif kind == "schedule":
+            data[item.name] = value.to_yaml()
+        elif kind == "seeds":
+            data[item.name] = format_seeds(value)
+        else:
+            data[item.name] = _plain(value)
+    return data
+
+
 def _plain(value: Any) -> Any:
-    """Turn read-only mappings back into plain dicts for YAML and JSON."""
+    """Turn read-only mappings and tuples back into plain dicts and lists for YAML and JSON."""
     if isinstance(value, Mapping):
         return {key: _plain(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
