@@ -118,3 +118,110 @@ def test_a_multi_seed_run_draws_figures_only_when_asked(seeds_run: Path, tmp_pat
         assert (parent / "seed-001" / name).read_bytes() == (
             seeds_run / "seed-001" / name
         ).read_bytes()
+
+
+RAY_CONFIG = {
+    "train": {
+        "episodes": 120, "stop_when_solved": False, "checkpoint_every": 20, "eval_every": 40,
+        "eval_episodes": 2,
+    },
+    "eval": {"episodes": 5},
+}  # fmt: skip
+RUN_FILES = ("q_table.npy", "visits.npy", "metrics.csv", "evaluations.csv", "config.yaml")
+
+
+@pytest.mark.slow
+def test_the_ray_backend_trains_and_resumes_seeds_to_the_same_bytes(tmp_path: Path) -> None:
+    """Seeds trained as Ray tasks on a real local cluster equal local ones, also when the
+    cluster resumes seeds that local workers left interrupted (their checkpoints travel)."""
+    ray = pytest.importorskip("ray")
+    from cartpole_q.experiments.run import prepare_resume
+    from tests.conftest import write_yaml
+
+    path = write_yaml(tmp_path / "ray.yaml", RAY_CONFIG)
+    reference = tmp_path / "reference"
+    result = invoke("train", "-c", path, "--seeds", "0-3", "--workers", "1", "--out", reference)
+    assert result.exit_code == 0, result.output
+
+    prepared = prepare(load_config(path, {"train.seeds": "0-3"}), "test")
+    mixed = start_run(prepared, tmp_path / "mixed")
+    polls = iter(range(10**9))
+    stopped = run_seeds(prepared, mixed, workers=1, should_stop=lambda: next(polls) >= 12)
+    assert stopped.interrupted and stopped.interrupted_seeds, "a seed should stop midway"
+    interrupted = seed_dir(
+        mixed, int(stopped.interrupted_seeds.split("-")[0].split(",")[0]), (0, 1, 2, 3)
+    )
+    assert (interrupted / "checkpoint.npz").is_file()
+
+    fresh = start_run(prepared, tmp_path / "fresh")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        resumed = run_seeds(prepare_resume(mixed), mixed, workers=2, resume=True, backend="ray")
+        whole = run_seeds(prepared, fresh, workers=2, backend="ray")
+    finally:
+        ray.shutdown()
+    assert resumed.finished == whole.finished == 4 and not whole.interrupted
+    for parent in (mixed, fresh):
+        for seed in range(4):
+            child, expected = (
+                seed_dir(parent, seed, (0, 1, 2, 3)),
+                seed_dir(reference, seed, (0, 1, 2, 3)),
+            )
+            for name in RUN_FILES:
+                assert (child / name).read_bytes() == (expected / name).read_bytes(), (child, name)
+            # Reaching train.episodes keeps the checkpoint, to extend the run later.
+            assert (child / "checkpoint.npz").is_file()
+    summary = json.loads((fresh / "summary.json").read_text())
+    assert (
+        summary["statistics"] == json.loads((reference / "summary.json").read_text())["statistics"]
+    )
+
+
+def test_the_ray_backend_is_for_several_seeds(tmp_path: Path) -> None:
+    from tests.test_cli import assert_refused
+
+    assert_refused(
+        invoke("train", "--backend", "ray", "--out", tmp_path / "one"),
+        "--backend ray runs the seeds of a multi-seed run as Ray tasks: give --seeds",
+    )
+    assert_refused(
+        invoke("train", "--address", "auto", "--seeds", "0-1"), "--address is for --backend ray."
+    )
+    assert not (tmp_path / "one").exists()
+
+
+def test_a_ray_task_continues_from_the_checkpoint_it_is_given(tmp_path: Path) -> None:
+    """The job a Ray task runs, called here: a checkpoint changed by hand changes the result,
+    so the one sent along is the one continued (with the true one, the same bytes)."""
+    import io
+
+    import numpy as np
+
+    from cartpole_q.experiments.multiseed import _train_seeds_in_memory
+    from cartpole_q.experiments.workers import InProcess
+    from cartpole_q.progress import NullReporter
+    from cartpole_q.store.checkpoint import checkpoint_bytes
+    from cartpole_q.training import train
+
+    config = load_config({**RAY_CONFIG, "seed": 5})
+    checkpoints: list[bytes] = []
+    whole = train(config)
+
+    train(
+        config,
+        should_stop=lambda: bool(checkpoints),
+        on_checkpoint=lambda snapshot: checkpoints.append(checkpoint_bytes(snapshot)),
+    )
+    first = checkpoints[0]
+    with np.load(io.BytesIO(first)) as data:
+        arrays = {name: data[name] for name in data.files}
+    arrays["q"] = np.zeros_like(arrays["q"])  # forget what was learnt
+    buffer = io.BytesIO()
+    np.savez(buffer, **arrays)
+    handle = InProcess(None, NullReporter())
+    mapping = config.to_dict()
+    (true,) = _train_seeds_in_memory(handle, mapping, [(5, first)])
+    (changed,) = _train_seeds_in_memory(handle, mapping, [(5, buffer.getvalue())])
+    assert np.array_equal(true.result["q_table"], whole.q_table)
+    assert not np.array_equal(changed.result["q_table"], whole.q_table)
+    assert len(true.result["metrics"].returns) == len(changed.result["metrics"].returns) == 120

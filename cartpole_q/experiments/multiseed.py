@@ -13,26 +13,31 @@ import os
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import suppress
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from cartpole_q.config import format_seeds, load_config
 from cartpole_q.errors import RunError
-from cartpole_q.experiments.run import Prepared, execute_run, prepare
+from cartpole_q.experiments.run import (
+    Prepared,
+    check_resumable,
+    execute_run,
+    outcome_line,
+    prepare,
+)
 from cartpole_q.experiments.workers import (
     JobHandle,
     chunk_size,
-    default_workers,
     execute,
-    map_jobs,
 )
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.results import MultiSeedSummary, SeedEntry, SeedResult
 from cartpole_q.store import rundir
-from cartpole_q.store.atomic import write_json
-from cartpole_q.store.runsets import RunSet, seed_dir
+from cartpole_q.store.atomic import atomic_write_bytes, write_json
+from cartpole_q.store.checkpoint import CHECKPOINT_FILE, load_checkpoint
+from cartpole_q.store.runsets import seed_dir
+from cartpole_q.training import Checkpoint, TrainResult
 
 
 def run_seeds(
@@ -44,6 +49,8 @@ def run_seeds(
     should_stop: Callable[[], bool] | None = None,
     resume: bool = False,
     seed_plots: bool = False,
+    backend: str = "local",
+    address: str | None = None,
 ) -> MultiSeedSummary:
     """Train every seed of ``prepared.config`` under ``parent`` and write the aggregate.
 
@@ -58,6 +65,11 @@ def run_seeds(
         seed_plots: draw each seed's ``reward_curve.png`` (about 0.15 s per seed) and the
             parent's, which shows every seed with a band. Without it no figure is drawn,
             so that many seeds train in seconds (``cartpole-q plot DIR`` draws it later).
+        backend: ``local`` (workers write their seed's directory, checkpoints included)
+            or ``ray`` (tasks, maybe on other machines, train in memory and send each
+            finished seed back, which this process writes; an interrupted seed's
+            checkpoint goes with its task).
+        address: a running Ray cluster's address (``ray`` only).
 
     Returns:
         The aggregate summary (also written as ``parent/summary.json``).
@@ -82,20 +94,26 @@ def run_seeds(
         jobs.append((seed, child, child_resume))
 
     finished: list[int] = []
+    if backend == "ray":
+        _train_remotely(
+            prepared, jobs, finished, workers, address, should_stop, reporter, seed_plots
+        )
+    else:
 
-    def on_item(index: int, item: tuple[int, bool]) -> None:
-        seed, interrupted = item
-        if not interrupted:
-            finished.append(seed)
+        def on_item(index: int, item: tuple[int, bool]) -> None:
+            seed, interrupted = item
+            if not interrupted:
+                finished.append(seed)
 
-    # Several seeds per job: a worker loads the config and the compiled loop once per
-    # job, not once per seed.
-    items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
-    size = chunk_size(len(items), workers)
-    chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
-    execute(
-        _train_seeds, chunks, on_item, workers=workers, should_stop=should_stop, reporter=reporter
-    )
+        # Several seeds per job: a worker loads the config and the compiled loop once per
+        # job, not once per seed.
+        items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
+        size = chunk_size(len(items), workers)
+        chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
+        execute(
+            _train_seeds, chunks, on_item,
+            workers=workers, should_stop=should_stop, reporter=reporter,
+        )  # fmt: skip
     interrupted = len(finished) < len(jobs)
 
     summary = aggregate(parent, seeds, time.perf_counter() - started, interrupted)
@@ -143,6 +161,93 @@ def _train_seeds(
         yield seed, outcome.result.interrupted
 
 
+@dataclass(frozen=True)
+class _TrainedSeed:
+    """A seed trained by a Ray task: its result without the config, and its last checkpoint."""
+
+    seed: int
+    result: dict[str, Any]
+    """the :class:`~cartpole_q.training.TrainResult` fields but ``config`` (a config holds
+    read-only mappings, which do not pickle; the parent has it)"""
+    checkpoint: bytes | None
+    """the last ``checkpoint.npz`` the run wrote, as bytes"""
+
+
+def _train_remotely(
+    prepared: Prepared,
+    jobs: Sequence[tuple[int, Path, bool]],
+    finished: list[int],
+    workers: int,
+    address: str | None,
+    should_stop: Callable[[], bool] | None,
+    reporter: Reporter,
+    seed_plots: bool,
+) -> None:
+    """Train seeds as Ray tasks and write each finished seed's directory here."""
+    config = prepared.config
+    items = []
+    for seed, child, child_resume in jobs:
+        path = child / CHECKPOINT_FILE
+        checkpoint = None
+        if child_resume and path.is_file():
+            # checked here, as a local worker checks it, before a task takes it anywhere
+            check_resumable(child, load_checkpoint(child), config.for_seed(seed))
+            checkpoint = path.read_bytes()
+        if child_resume:
+            # config.yaml says what the run now is; the run is unfinished until its summary
+            rundir.write_config(child, config.for_seed(seed))
+            (child / rundir.SUMMARY_FILE).unlink(missing_ok=True)
+        items.append((seed, checkpoint))
+    size = chunk_size(len(items), workers)
+    chunks = [(config.to_dict(), items[i : i + size]) for i in range(0, len(items), size)]
+    directories = {seed: child for seed, child, _ in jobs}
+
+    def on_item(index: int, trained: _TrainedSeed) -> None:
+        child = directories[trained.seed]
+        result = TrainResult(config=config.for_seed(trained.seed), **trained.result)
+        if trained.checkpoint is not None:
+            atomic_write_bytes(child / CHECKPOINT_FILE, trained.checkpoint)
+        summary = rundir.write_run(child, result, overwrite=True, plot=seed_plots)
+        label = f"seed {trained.seed}"  # no bar: Ray tasks send no progress, only results
+        reporter.finish(label, outcome_line(label, summary.result()))
+        finished.append(trained.seed)
+
+    execute(
+        _train_seeds_in_memory, chunks, on_item,
+        backend="ray", workers=workers, address=address, should_stop=should_stop,
+    )  # fmt: skip
+
+
+def _train_seeds_in_memory(
+    handle: JobHandle, mapping: dict[str, Any], items: Sequence[tuple[int, bytes | None]]
+) -> Iterator[_TrainedSeed]:
+    """Job (Ray): train seeds of one config in memory, each from its checkpoint if it has one.
+
+    Yields:
+        Each seed as it finishes.
+    """
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.store.checkpoint import checkpoint_bytes, checkpoint_from_bytes
+    from cartpole_q.training import train
+
+    config = load_config(mapping)
+    env_info = inspect_env(config)
+    for seed, checkpoint in items:
+        last: list[bytes] = []
+
+        def keep(snapshot: Checkpoint, kept: list[bytes] = last) -> None:
+            kept[:] = [checkpoint_bytes(snapshot)]
+
+        resume = None if checkpoint is None else checkpoint_from_bytes(checkpoint, f"seed {seed}")
+        result = train(config.for_seed(seed), env_info=env_info, resume=resume, on_checkpoint=keep)
+        fields = {
+            field.name: getattr(result, field.name)
+            for field in dataclasses.fields(result)
+            if field.name != "config"
+        }
+        yield _TrainedSeed(seed, fields, last[0] if last else checkpoint)
+
+
 def _finished(child: Path) -> bool:
     summary = rundir.read_summary(child)
     return summary is not None and not summary.interrupted
@@ -178,122 +283,3 @@ def aggregate(
         ),
         no_result_seeds=format_seeds([seed for seed in seeds if str(seed) not in entries]),
     )
-
-
-def _evaluate_one(
-    handle: JobHandle | None,
-    name: str,
-    config_mapping: dict[str, Any],
-    q_table: np.ndarray,
-    episodes: int | None,
-    seed: int | None,
-    physics: dict[str, Any] | None = None,
-    max_steps: int | None = None,
-) -> dict[str, Any]:
-    """Job: one seed's greedy evaluation in ``gymnasium.make`` (and its exact figures)."""
-    from cartpole_q.evaluation import evaluate, exact_report, under_conditions
-
-    trained = load_config(config_mapping)
-    config = under_conditions(trained, physics, max_steps)
-    report = evaluate(q_table, config, episodes=episodes, seed=seed)
-    result = {"run_seed": trained.seed, "path": name, **report.to_dict()}
-    exact = exact_report(config, q_table)
-    if not isinstance(exact, str):
-        result["exact"] = exact.to_dict()
-    return result
-
-
-def exact_summary(results: list[dict[str, Any]]) -> dict[str, Any] | None:
-    """The seeds' exact greedy returns against the optimum (``None`` without a model).
-
-    ``within_0.01`` counts the seeds whose gap is at most 0.01, ``within_1%`` those within
-    1% of the optimum's magnitude (both as the issue's acceptance states them).
-    """
-    exact = [result["exact"] for result in results if "exact" in result]
-    if not exact:
-        return None
-    optimum = exact[0]["optimum"]["return"]
-    greedy = np.array([item["greedy"]["return"] for item in exact])
-    gaps = optimum - greedy
-    tolerance = 1e-9 * max(1.0, abs(optimum))  # the same value, up to rounding
-    return {
-        "note": exact[0]["note"],
-        "optimum": optimum,
-        "greedy_median": float(np.median(greedy)),
-        "greedy_min": float(np.min(greedy)),
-        "gap_max": float(np.max(gaps)),
-        "within_0.01": int(np.sum(gaps <= 0.01 + tolerance)),
-        "within_1%": int(np.sum(gaps <= 0.01 * abs(optimum) + tolerance)),
-        "optimal": int(np.sum(gaps <= tolerance)),
-        "seeds": len(exact),
-    }
-
-
-def evaluate_seeds(
-    run_set: RunSet,
-    *,
-    episodes: int | None = None,
-    seed: int | None = None,
-    workers: int | None = None,
-    physics: dict[str, Any] | None = None,
-    max_steps: int | None = None,
-) -> dict[str, Any]:
-    """Evaluate every finished seed of a multi-seed run or sweep point, in parallel.
-
-    ``physics`` and ``max_steps`` play under other conditions (see ``under_conditions``).
-
-    Returns:
-        ``runs`` (one ``eval --json`` object per finished seed, with ``run_seed`` and
-        ``path``), ``successes`` (means at or above the threshold), ``reward_threshold``,
-        ``episodes``, the ``mean`` and ``min`` of the seeds' means, ``seeds`` (how many
-        the run has), ``missing`` and ``unfinished`` (seeds left out), ``conditions`` (the physics and time limit played under, when changed),
-        ``notes`` (what was left out or is unfinished) and ``note`` (them as one line, or
-        None).
-    """
-    from cartpole_q.envs.gym import inspect_env
-    from cartpole_q.evaluation import under_conditions
-
-    runs = run_set.runs
-    workers = workers or default_workers(len(runs))
-    jobs = [
-        (run.path.name, run.config.to_dict(), run.q_table, episodes, seed, physics, max_steps)
-        for run in runs
-    ]
-    results = map_jobs(_evaluate_one, jobs, workers)
-    reward_threshold = run_set.reward_threshold
-    if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
-        conditions = under_conditions(run_set.config, physics, max_steps)
-        reward_threshold = inspect_env(conditions).reward_threshold
-    means = [result["mean"] for result in results]
-    exact = exact_summary(results)
-    return {
-        **({"exact": exact} if exact else {}),
-        "runs": results,
-        "successes": sum(
-            1 for m in means if reward_threshold is not None and m >= reward_threshold
-        ),
-        "reward_threshold": reward_threshold,
-        "episodes": results[0]["episodes"],
-        "mean": float(np.mean(means)),
-        "min": float(np.min(means)),
-        "seeds": run_set.seeds,
-        "missing": list(run_set.missing),
-        "unfinished": list(run_set.unfinished),
-        "conditions": conditions_of(physics, max_steps),
-        "notes": list(run_set.notes),
-        "note": " ".join(run_set.notes) or None,
-    }
-
-
-def conditions_of(physics: dict[str, Any] | None, max_steps: int | None) -> dict[str, Any]:
-    """The changed conditions an evaluation played under, as ``eval --json`` echoes them.
-
-    >>> conditions_of({"length": 0.75}, None), conditions_of(None, None)
-    ({'physics': {'length': 0.75}}, {})
-    """
-    conditions: dict[str, Any] = {}
-    if physics:
-        conditions["physics"] = dict(physics)
-    if max_steps is not None:
-        conditions["max_steps"] = max_steps
-    return conditions

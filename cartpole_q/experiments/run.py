@@ -119,6 +119,44 @@ def prepare(config: Config, source: str | Provenance) -> Prepared:
     return Prepared(config, env_info, engine, str(source))
 
 
+def prepare_new(
+    config_file: Path | None,
+    assignments: list[str],
+    *,
+    seed: int | None = None,
+    seeds: str | None = None,
+    episodes: int | None = None,
+    engine: str | None = None,
+) -> Prepared:
+    """Load a new run's config from a file (or the default) and the command line's values.
+
+    Args:
+        config_file: a config file or a shipped config's name (``None``: the default).
+        assignments: ``--set KEY=VALUE`` texts, applied in order.
+        seed: the run's seed (one run: clears ``train.seeds``).
+        seeds: ``train.seeds`` (several runs).
+        episodes: ``train.episodes``.
+        engine: ``engine``.
+
+    Raises:
+        ConfigError: naming the file or option and the key.
+    """
+    from cartpole_q.config import parse_assignment, resolve_config_path
+
+    overrides: dict[str, Any] = dict(map(parse_assignment, assignments))
+    if seed is not None:
+        overrides.update({"seed": seed, "train.seeds": None})
+    if seeds is not None:
+        overrides["train.seeds"] = seeds
+    if episodes is not None:
+        overrides["train.episodes"] = episodes
+    if engine is not None:
+        overrides["engine"] = engine
+    loaded = load_config(config_file, overrides)
+    file = str(resolve_config_path(config_file)) if config_file else "default config"
+    return prepare(loaded, Provenance(file, tuple(overrides)))
+
+
 def start_run(prepared: Prepared, out: Path | None) -> Path:
     """Create the run directory and write its ``config.yaml``.
 

@@ -32,6 +32,11 @@ MEMORY_PREFIX = "memory_"
 
 def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
     """Save a :class:`~cartpole_q.training.Checkpoint` as one atomic ``checkpoint.npz``."""
+    atomic_write_bytes(run_dir / CHECKPOINT_FILE, checkpoint_bytes(checkpoint))
+
+
+def checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
+    """The ``checkpoint.npz`` file's bytes (a worker on another machine sends them back)."""
     meta = {
         "engine": checkpoint.engine,
         "episode": checkpoint.episode,
@@ -57,7 +62,7 @@ def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
         arrays["solved_q"] = checkpoint.solved_q
     buffer = io.BytesIO()
     np.savez(buffer, allow_pickle=False, **arrays)
-    atomic_write_bytes(run_dir / CHECKPOINT_FILE, buffer.getvalue())
+    return buffer.getvalue()
 
 
 def load_checkpoint(run_dir: Path) -> Checkpoint:
@@ -70,7 +75,22 @@ def load_checkpoint(run_dir: Path) -> Checkpoint:
     if not path.is_file():
         raise RunError(f"{path}: no checkpoint; there is nothing to resume in {run_dir}.")
     try:
-        with np.load(path, allow_pickle=False) as data:
+        content = path.read_bytes()
+    except OSError as error:
+        raise RunError(
+            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
+        ) from None
+    return checkpoint_from_bytes(content, str(path))
+
+
+def checkpoint_from_bytes(content: bytes, where: str) -> Checkpoint:
+    """A checkpoint back from its file's bytes (``where`` names it in errors).
+
+    Raises:
+        RunError: the bytes are not a checkpoint.
+    """
+    try:
+        with np.load(io.BytesIO(content), allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
             return Checkpoint(
                 engine=meta["engine"],
@@ -93,7 +113,7 @@ def load_checkpoint(run_dir: Path) -> Checkpoint:
         OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError
     ) as error:  # fmt: skip
         raise RunError(
-            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
+            f"{where}: the checkpoint is damaged and cannot be resumed ({error})."
         ) from None
 
 

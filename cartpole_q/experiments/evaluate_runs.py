@@ -1,0 +1,287 @@
+"""Greedy evaluation of finished runs: one run (with video or a window), or many seeds at once.
+
+``cartpole-q eval`` calls one function here and prints what it returns. Every evaluation
+plays in ``gymnasium.make``; where the environment has an exact model, the greedy policy's
+exact return is given beside the optimum. ``cartpole-q optimum`` is here too: the model's
+optimum without a run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import load_config
+from cartpole_q.envs.models import GridLayout, grid_layout
+from cartpole_q.errors import UserError
+from cartpole_q.evaluation import EvalReport, ExactReport, evaluate, exact_report, under_conditions
+from cartpole_q.experiments.workers import JobHandle, default_workers, map_jobs
+from cartpole_q.store.rundir import Run
+from cartpole_q.store.runsets import RunSet
+
+
+@dataclass(frozen=True)
+class RunEvaluation:
+    """One run's greedy evaluation: its returns, the threshold, the exact figures."""
+
+    report: EvalReport
+    threshold: float | None
+    """the threshold under the conditions played (a changed time limit scales CartPole's)"""
+    exact: ExactReport | None
+    """the greedy policy's exact return beside the optimum (``None`` without a model)"""
+    conditions: dict[str, Any]
+    """the changed physics and time limit played under (empty when unchanged)"""
+
+    def to_json(self) -> dict[str, Any]:
+        """What ``eval --json`` prints: the report, and the exact figures and conditions."""
+        data = self.report.to_dict()
+        if self.exact is not None:
+            data["exact"] = self.exact.to_dict()
+        if self.conditions:
+            data["conditions"] = self.conditions
+        return data
+
+
+def evaluate_run(
+    run: Run,
+    *,
+    episodes: int | None = None,
+    seed: int | None = None,
+    physics: Mapping[str, Any] | None = None,
+    max_steps: int | None = None,
+    video: Path | None = None,
+    video_episodes: int = 1,
+    render: bool = False,
+    force: bool = False,
+) -> RunEvaluation:
+    """Play one run's greedy policy in ``gymnasium.make``, maybe recording or showing it.
+
+    Args:
+        run: the run.
+        episodes: greedy episodes (default: the run's ``eval.episodes``).
+        seed: the first reset's seed (default: the run's ``eval.seed``).
+        physics: play under these ``env.physics`` values instead.
+        max_steps: play with this time limit instead.
+        video: record the first ``video_episodes`` episodes as this GIF or MP4.
+        video_episodes: how many episodes ``video`` records.
+        render: show the episodes in Gymnasium's window.
+        force: let ``video`` replace an existing file.
+
+    Raises:
+        UserError: ``render`` and ``video`` together, ``render`` without a display, or a
+            ``video`` path that cannot be written (checked before any episode is played).
+        ConfigError: ``physics`` or ``max_steps`` do not fit the environment.
+    """
+    from cartpole_q.envs.gym import display_problem, inspect_env
+
+    threshold = run.result.reward_threshold
+    if physics or max_steps is not None:
+        run = dataclasses.replace(run, config=under_conditions(run.config, physics, max_steps))
+        threshold = inspect_env(run.config).reward_threshold
+    if render and video is not None:
+        raise UserError("--render and --video cannot be combined: choose one.")
+    if render and (problem := display_problem()) is not None:
+        raise UserError(
+            f"--render needs a display, but {problem}; "
+            "record the episodes with --video FILE.gif instead."
+        )
+    if video is None:
+        report = evaluate(
+            run.q_table, run.config, episodes=episodes, seed=seed,
+            render_mode="human" if render else None,
+        )  # fmt: skip
+    else:
+        from cartpole_q.store.video import VideoRecorder, offscreen_rendering
+
+        # The recorder checks the file (extension, directory, an existing file) before playing.
+        with VideoRecorder(video, episodes=video_episodes, force=force) as recorder:
+            with offscreen_rendering():
+                report = evaluate(
+                    run.q_table, run.config, episodes=episodes, seed=seed,
+                    render_mode="rgb_array", on_frame=recorder.on_frame,
+                )  # fmt: skip
+            recorder.save()
+    exact = exact_report(run.config, run.q_table)  # a sentence when there is no model
+    return RunEvaluation(
+        report,
+        threshold,
+        None if isinstance(exact, str) else exact,
+        conditions_of(physics, max_steps),
+    )
+
+
+def _evaluate_one(
+    handle: JobHandle | None,
+    name: str,
+    config_mapping: dict[str, Any],
+    q_table: np.ndarray,
+    episodes: int | None,
+    seed: int | None,
+    physics: dict[str, Any] | None = None,
+    max_steps: int | None = None,
+) -> dict[str, Any]:
+    """Job: one seed's greedy evaluation in ``gymnasium.make`` (and its exact figures)."""
+    trained = load_config(config_mapping)
+    config = under_conditions(trained, physics, max_steps)
+    report = evaluate(q_table, config, episodes=episodes, seed=seed)
+    result = {"run_seed": trained.seed, "path": name, **report.to_dict()}
+    exact = exact_report(config, q_table)
+    if not isinstance(exact, str):
+        result["exact"] = exact.to_dict()
+    return result
+
+
+def exact_summary(results: list[dict[str, Any]]) -> dict[str, Any] | None:
+    """The seeds' exact greedy returns against the optimum (``None`` without a model).
+
+    ``within_0.01`` counts the seeds whose gap is at most 0.01, ``within_1%`` those within
+    1% of the optimum's magnitude (both as the issue's acceptance states them).
+    """
+    exact = [result["exact"] for result in results if "exact" in result]
+    if not exact:
+        return None
+    optimum = exact[0]["optimum"]["return"]
+    greedy = np.array([item["greedy"]["return"] for item in exact])
+    gaps = optimum - greedy
+    tolerance = 1e-9 * max(1.0, abs(optimum))  # the same value, up to rounding
+    return {
+        "note": exact[0]["note"],
+        "optimum": optimum,
+        "greedy_median": float(np.median(greedy)),
+        "greedy_min": float(np.min(greedy)),
+        "gap_max": float(np.max(gaps)),
+        "within_0.01": int(np.sum(gaps <= 0.01 + tolerance)),
+        "within_1%": int(np.sum(gaps <= 0.01 * abs(optimum) + tolerance)),
+        "optimal": int(np.sum(gaps <= tolerance)),
+        "seeds": len(exact),
+    }
+
+
+def evaluate_seeds(
+    run_set: RunSet,
+    *,
+    episodes: int | None = None,
+    seed: int | None = None,
+    workers: int | None = None,
+    physics: dict[str, Any] | None = None,
+    max_steps: int | None = None,
+) -> dict[str, Any]:
+    """Evaluate every finished seed of a multi-seed run or sweep point, in parallel.
+
+    ``physics`` and ``max_steps`` play under other conditions (see ``under_conditions``).
+
+    Returns:
+        ``runs`` (one ``eval --json`` object per finished seed, with ``run_seed`` and
+        ``path``), ``successes`` (means at or above the threshold), ``reward_threshold``,
+        ``episodes``, the ``mean`` and ``min`` of the seeds' means, ``seeds`` (how many
+        the run has), ``missing`` and ``unfinished`` (seeds left out), ``conditions`` (the physics and time limit played under, when changed),
+        ``notes`` (what was left out or is unfinished) and ``note`` (them as one line, or
+        None).
+    """
+    from cartpole_q.envs.gym import inspect_env
+
+    runs = run_set.runs
+    workers = workers or default_workers(len(runs))
+    jobs = [
+        (run.path.name, run.config.to_dict(), run.q_table, episodes, seed, physics, max_steps)
+        for run in runs
+    ]
+    results = map_jobs(_evaluate_one, jobs, workers)
+    reward_threshold = run_set.reward_threshold
+    if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
+        conditions = under_conditions(run_set.config, physics, max_steps)
+        reward_threshold = inspect_env(conditions).reward_threshold
+    means = [result["mean"] for result in results]
+    exact = exact_summary(results)
+    return {
+        **({"exact": exact} if exact else {}),
+        "runs": results,
+        "successes": sum(
+            1 for m in means if reward_threshold is not None and m >= reward_threshold
+        ),
+        "reward_threshold": reward_threshold,
+        "episodes": results[0]["episodes"],
+        "mean": float(np.mean(means)),
+        "min": float(np.min(means)),
+        "seeds": run_set.seeds,
+        "missing": list(run_set.missing),
+        "unfinished": list(run_set.unfinished),
+        "conditions": conditions_of(physics, max_steps),
+        "notes": list(run_set.notes),
+        "note": " ".join(run_set.notes) or None,
+    }
+
+
+def conditions_of(physics: Mapping[str, Any] | None, max_steps: int | None) -> dict[str, Any]:
+    """The changed conditions an evaluation played under, as ``eval --json`` echoes them.
+
+    >>> conditions_of({"length": 0.75}, None), conditions_of(None, None)
+    ({'physics': {'length': 0.75}}, {})
+    """
+    conditions: dict[str, Any] = {}
+    if physics:
+        conditions["physics"] = dict(physics)
+    if max_steps is not None:
+        conditions["max_steps"] = max_steps
+    return conditions
+
+
+@dataclass(frozen=True)
+class Optimum:
+    """An environment's exact optimum (``cartpole-q optimum``)."""
+
+    env_id: str
+    kwargs: dict[str, Any]
+    exact: ExactReport
+    layout: GridLayout | None
+    """the grid world's map, ``None`` for other environments"""
+
+    def to_json(self) -> dict[str, Any]:
+        """What ``optimum --json`` prints."""
+        return {
+            "env_id": self.env_id,
+            "kwargs": self.kwargs,
+            **self.exact.to_dict(),
+            "policy": list(self.exact.optimal_policy),
+        }
+
+
+def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None) -> Optimum:
+    """The best expected return from the start, by value iteration on the environment's model.
+
+    Args:
+        env_id: a Gymnasium id with a transition table, or Blackjack.
+        assignments: ``(key, value)`` of env keys (``env.kwargs.map_name``).
+        gamma: also the optimal discounted return with this discount, below 1.
+
+    Raises:
+        UserError: ``gamma`` is 1, a key is not an env key, or the environment has no model.
+        ConfigError: the id or an argument is unknown.
+    """
+    from cartpole_q.envs.gym import inspect_env
+
+    if gamma is not None and gamma >= 1.0:
+        raise UserError(
+            "--gamma 1: the discounted optimum needs a discount below 1 (with no time limit, "
+            "undiscounted returns may not converge); the undiscounted optimum within the "
+            "time limit is printed without --gamma."
+        )
+    overrides: dict[str, Any] = {"env.id": env_id}
+    for key, value in assignments:
+        if key != "env" and not key.startswith("env."):
+            raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
+        overrides[key] = value
+    config = load_config(overrides=overrides)
+    inspect_env(config)  # an unknown id or argument: a config error naming it
+    exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
+    if isinstance(exact, str):
+        raise UserError(
+            f"{env_id}: no exact optimum: {exact}. It needs a transition table "
+            "(env.unwrapped.P: FrozenLake, Taxi, CliffWalking) or Blackjack's rules."
+        )
+    return Optimum(env_id, dict(config.env.kwargs), exact, grid_layout(config.env))
