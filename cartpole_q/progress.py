@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Hashable
 from dataclasses import dataclass
 from typing import IO, Any, Protocol
 
@@ -19,15 +20,15 @@ from cartpole_q.training import Progress
 class Reporter(Protocol):
     """Receives training progress for one or more runs."""
 
-    def start(self, key: Any, label: str, episodes: int) -> None:
+    def start(self, key: Hashable, label: str, episodes: int) -> None:
         """A run (``key``) starts; ``episodes`` is its configured length."""
         ...
 
-    def update(self, key: Any, progress: Progress) -> None:
+    def update(self, key: Hashable, progress: Progress) -> None:
         """A run advanced."""
         ...
 
-    def finish(self, key: Any, line: str) -> None:
+    def finish(self, key: Hashable, line: str) -> None:
         """A run ended; ``line`` says how."""
         ...
 
@@ -39,13 +40,13 @@ class Reporter(Protocol):
 class NullReporter:
     """Prints nothing (``--quiet``)."""
 
-    def start(self, key: Any, label: str, episodes: int) -> None:
+    def start(self, key: Hashable, label: str, episodes: int) -> None:
         """Ignore."""
 
-    def update(self, key: Any, progress: Progress) -> None:
+    def update(self, key: Hashable, progress: Progress) -> None:
         """Ignore."""
 
-    def finish(self, key: Any, line: str) -> None:
+    def finish(self, key: Hashable, line: str) -> None:
         """Ignore."""
 
     def close(self) -> None:
@@ -82,14 +83,14 @@ class PlainReporter:
         self._step: dict[Any, int] = {}
         self._single = True
 
-    def start(self, key: Any, label: str, episodes: int) -> None:
+    def start(self, key: Hashable, label: str, episodes: int) -> None:
         """Remember the run; lines come every tenth of its episodes."""
         self._labels[key] = label
         self._step[key] = max(1, int(episodes * self._every_fraction))
         self._next_line_at[key] = self._step[key]
         self._single = len(self._labels) == 1
 
-    def update(self, key: Any, progress: Progress) -> None:
+    def update(self, key: Hashable, progress: Progress) -> None:
         """Print a line when the run crosses the next tenth (single runs only)."""
         if not self._single or progress.episode < self._next_line_at.get(key, 0):
             return
@@ -97,7 +98,7 @@ class PlainReporter:
         self._next_line_at[key] = (progress.episode // step + 1) * step
         print(progress_line(self._labels[key], progress), file=self._stream, flush=True)
 
-    def finish(self, key: Any, line: str) -> None:
+    def finish(self, key: Hashable, line: str) -> None:
         """Print how the run ended."""
         print(line, file=self._stream, flush=True)
 
@@ -157,7 +158,7 @@ class RichReporter:
         self._min_interval = min_interval
         self._progress.start()
 
-    def start(self, key: Any, label: str, episodes: int) -> None:
+    def start(self, key: Hashable, label: str, episodes: int) -> None:
         """Add a bar for the run (or reuse the bar of ``key`` for its next run)."""
         if key in self._tasks:
             self._progress.reset(self._tasks[key], total=episodes, description=label, stats="")
@@ -166,7 +167,7 @@ class RichReporter:
         self._last_update[key] = 0.0
         self._latest.pop(key, None)
 
-    def update(self, key: Any, progress: Progress) -> None:
+    def update(self, key: Hashable, progress: Progress) -> None:
         """Move the run's bar (throttled, so the bar never slows training)."""
         self._latest[key] = progress
         now = time.monotonic()
@@ -175,7 +176,7 @@ class RichReporter:
         self._last_update[key] = now
         self._draw(key, progress)
 
-    def _draw(self, key: Any, progress: Progress) -> None:
+    def _draw(self, key: Hashable, progress: Progress) -> None:
         stats = (
             f"ret {progress.last_return:>4g} avg100 {progress.moving_average:5.1f} "
             f"eps {progress.epsilon:.2f} {compact_rate(progress.train_steps_per_second):>7}"
@@ -183,7 +184,7 @@ class RichReporter:
         self._progress.update(self._tasks[key], completed=progress.episode, stats=stats)
         self._progress.refresh()
 
-    def finish(self, key: Any, line: str) -> None:
+    def finish(self, key: Hashable, line: str) -> None:
         """Print how the run ended above the bars, and complete its bar at the real count.
 
         The last update may have been throttled away: the bar is drawn once more from the

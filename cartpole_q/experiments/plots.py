@@ -14,6 +14,7 @@ import numpy as np
 
 from cartpole_q.config import Config, format_seeds
 from cartpole_q.errors import RunError, UserError
+from cartpole_q.experiments.compare import Comparison, compare_figure_data
 from cartpole_q.figures import (
     FIGURE_FORMATS,
     Curve,
@@ -119,9 +120,8 @@ def _greedy_paths(
     return grid, paths
 
 
-def write_compare_figure(result: Any, out: Path) -> Path:
+def write_compare_figure(result: Comparison, out: Path) -> Path:
     """Draw a comparison's aggregate figure (``compare --out``) and write ``out``."""
-    from cartpole_q.experiments.compare import compare_figure_data
     from cartpole_q.figures import compare_figure
 
     figure = compare_figure(compare_figure_data(result), f"{len(result.sides)} runs compared")

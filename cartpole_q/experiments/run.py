@@ -13,11 +13,13 @@ from __future__ import annotations
 import math
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
 from typing import Any
+
+import numpy as np
 
 from cartpole_q.config import (
     Config,
@@ -39,7 +41,7 @@ from cartpole_q.store.checkpoint import (
     read_checkpoint_meta,
     write_checkpoint,
 )
-from cartpole_q.training import TrainResult, train
+from cartpole_q.training import Checkpoint, TrainResult, train
 
 
 @dataclass(frozen=True)
@@ -175,7 +177,7 @@ def execute_run(
     resume: bool = False,
     should_stop: Callable[[], bool] | None = None,
     reporter: Reporter | None = None,
-    key: Any = None,
+    key: Hashable = None,
     label: str | None = None,
     watch_every: int = 0,
     video_every: int = 0,
@@ -243,7 +245,7 @@ def _greedy_viewer(
         return None
     from cartpole_q.evaluation import evaluate
 
-    def view(episode: int, q_table: Any) -> None:
+    def view(episode: int, q_table: np.ndarray) -> None:
         if watch_every and episode % watch_every == 0:
             evaluate(q_table, config, episodes=1, render_mode="human")
         if video_every and episode % video_every == 0:
@@ -331,7 +333,7 @@ def _check_extendable(
         )
 
 
-def check_resumable(run_dir: Path, checkpoint: Any, config: Config) -> None:
+def check_resumable(run_dir: Path, checkpoint: Checkpoint, config: Config) -> None:
     """Refuse to continue a checkpoint under another config than it was trained with.
 
     Only ``train.episodes`` may differ, and only grow: the continued run is then

@@ -31,7 +31,7 @@ import sys
 import threading
 import time
 import traceback
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Hashable, Iterator, Sequence
 from contextlib import contextmanager, suppress
 from multiprocessing.connection import Connection
 from multiprocessing.connection import wait as wait_connections
@@ -435,22 +435,22 @@ class _PipeReporter:
         self._last = 0.0
         self._unsent: Progress | None = None
 
-    def start(self, key: Any, label: str, episodes: int) -> None:
+    def start(self, key: Hashable, label: str, episodes: int) -> None:
         _send(self._conn, ("start", key, label, episodes))
 
-    def update(self, key: Any, progress: Progress) -> None:
+    def update(self, key: Hashable, progress: Progress) -> None:
         now = time.monotonic()
         self._unsent = progress
         if now - self._last >= self._min_interval:
             self._last = now
             self._send_update(key)
 
-    def _send_update(self, key: Any) -> None:
+    def _send_update(self, key: Hashable) -> None:
         if self._unsent is not None:
             _send(self._conn, ("update", key, *dataclasses.astuple(self._unsent)))
             self._unsent = None
 
-    def finish(self, key: Any, line: str) -> None:
+    def finish(self, key: Hashable, line: str) -> None:
         # the last update may have been throttled: the bar must end on the real count
         self._send_update(key)
         _send(self._conn, ("finish", key, line))

@@ -28,8 +28,19 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any, TypeVar
 
+import numpy as np
+
 ENDED = -1
 """the next action a step returns when the episode has ended"""
+
+Table = np.ndarray
+"""a Q-table (or a table of its shape) as the hooks see it: float64 ``(n_states, n_actions)``"""
+Memory = tuple[np.ndarray, ...]
+"""an algorithm's memory: the arrays :attr:`~cartpole_q.rl.algorithm.Algorithm.memory` made"""
+Params = tuple[float, ...]
+"""an algorithm's parameters as floats, in :attr:`~cartpole_q.rl.algorithm.Algorithm.params` order"""
+Rng = np.random.Generator
+"""the agent's random generator (numba compiles numpy's ``Generator`` methods)"""
 
 Function = TypeVar("Function", bound=Callable[..., Any])
 
@@ -45,7 +56,7 @@ def compilable(function: Function) -> Function:
 
 
 @compilable
-def best_action(q: Any, state: int) -> int:
+def best_action(q: Table, state: int) -> int:
     """``argmax_a Q(state, a)``, the lowest action on ties."""
     best = 0
     for action in range(1, q.shape[1]):
@@ -55,7 +66,7 @@ def best_action(q: Any, state: int) -> int:
 
 
 @compilable
-def best_value(q: Any, state: int) -> float:
+def best_value(q: Table, state: int) -> float:
     """``max_a Q(state, a)``."""
     best = q[state, 0]
     for action in range(1, q.shape[1]):
@@ -65,7 +76,7 @@ def best_value(q: Any, state: int) -> float:
 
 
 @compilable
-def epsilon_greedy(q: Any, state: int, epsilon: float, rng: Any) -> int:
+def epsilon_greedy(q: Table, state: int, epsilon: float, rng: Rng) -> int:
     """A uniform random action with probability ``epsilon``, else the greedy one."""
     if epsilon <= 0.0:
         return best_action(q, state)
@@ -75,13 +86,13 @@ def epsilon_greedy(q: Any, state: int, epsilon: float, rng: Any) -> int:
 
 
 @compilable
-def update(q: Any, state: int, action: int, target: float, alpha: float) -> None:
+def update(q: Table, state: int, action: int, target: float, alpha: float) -> None:
     """``Q(s, a) += alpha * (target - Q(s, a))``."""
     q[state, action] += alpha * (target - q[state, action])
 
 
 @compilable
-def expected_value(q: Any, state: int, epsilon: float) -> float:
+def expected_value(q: Table, state: int, epsilon: float) -> float:
     """``(1 - epsilon) * Q(s, g) + (epsilon / n) * S``: ``Q(s, .)`` under epsilon-greedy.
 
     ``g`` is the greedy action of ``s``, ``S = Q(s, 0) + Q(s, 1) + ...`` summed in action
@@ -96,13 +107,15 @@ def expected_value(q: Any, state: int, epsilon: float) -> float:
 
 
 @compilable
-def first_action(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any) -> int:
+def first_action(
+    q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng
+) -> int:
     """The default first action of an episode: epsilon-greedy on ``Q``."""
     return epsilon_greedy(q, state, epsilon, rng)
 
 
 @compilable
 def no_episode_end(
-    q: Any, memory: Any, params: Any, alpha: float, gamma: float, epsilon: float, rng: Any
+    q: Table, memory: Memory, params: Params, alpha: float, gamma: float, epsilon: float, rng: Rng
 ) -> None:
     """The default end of an episode: nothing (one-step methods learn as they go)."""

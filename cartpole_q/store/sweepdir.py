@@ -127,7 +127,7 @@ class ResultRow:
     result: SeedResult
 
 
-def axis_cell(value: Any) -> str:
+def axis_cell(value: object) -> str:
     """An axis value as its CSV cell: strings as they are, everything else as JSON.
 
     >>> axis_cell(0.1), axis_cell("sarsa"), axis_cell([1, 1, 6, 12]), axis_cell(True)
@@ -138,7 +138,7 @@ def axis_cell(value: Any) -> str:
     return json.dumps(value)
 
 
-def cell(value: Any) -> str:
+def cell(value: object) -> str:
     """A value as a CSV cell: empty for missing, ``true``/``false``, floats round-trip.
 
     >>> cell(None), cell(True), cell(0.1), cell(7)

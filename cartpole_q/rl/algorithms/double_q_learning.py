@@ -17,16 +17,14 @@ action, an episode's first included, is epsilon-greedy on ``A + B``. ``q_table.n
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, best_action, compilable, update
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, best_action, compilable, update
 
 
 @compilable
-def best_action_of_sum(q_a: Any, q_b: Any, state: int) -> int:
+def best_action_of_sum(q_a: Table, q_b: Table, state: int) -> int:
     """``argmax_a (A(state, a) + B(state, a))``, the lowest action on ties."""
     best = 0
     best_sum = q_a[state, 0] + q_b[state, 0]
@@ -38,7 +36,7 @@ def best_action_of_sum(q_a: Any, q_b: Any, state: int) -> int:
 
 
 @compilable
-def epsilon_greedy_on_sum(q_a: Any, q_b: Any, state: int, epsilon: float, rng: Any) -> int:
+def epsilon_greedy_on_sum(q_a: Table, q_b: Table, state: int, epsilon: float, rng: Rng) -> int:
     """Epsilon-greedy on ``A + B``, with the draws of ``epsilon_greedy``."""
     if epsilon <= 0.0:
         return best_action_of_sum(q_a, q_b, state)
@@ -47,14 +45,14 @@ def epsilon_greedy_on_sum(q_a: Any, q_b: Any, state: int, epsilon: float, rng: A
     return best_action_of_sum(q_a, q_b, state)
 
 
-def start(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any) -> int:
+def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng) -> int:
     """The first action: epsilon-greedy on ``A + B``."""
     return epsilon_greedy_on_sum(q, memory[0], state, epsilon, rng)
 
 
-def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
          next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Any) -> int:  # fmt: skip
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
     """A coin picks the table to update; the other one values the updated one's choice."""
     q_b = memory[0]
     # Two explicit branches rather than swapped names: an array alias costs reference

@@ -14,15 +14,22 @@ True
 
 from __future__ import annotations
 
-from typing import Any
-
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.tabular import ENDED, epsilon_greedy, expected_value, update
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    epsilon_greedy,
+    expected_value,
+    update,
+)
 
 
-def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
          next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Any) -> int:  # fmt: skip
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
     """Update toward the expected value of ``s'`` under epsilon-greedy, then draw."""
     target = reward
     if not terminated:

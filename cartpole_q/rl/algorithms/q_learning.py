@@ -14,15 +14,22 @@ epsilon-greedily from the updated table (not at the episode's end).
 
 from __future__ import annotations
 
-from typing import Any
-
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.tabular import ENDED, best_value, epsilon_greedy, update
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    best_value,
+    epsilon_greedy,
+    update,
+)
 
 
-def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
          next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Any) -> int:  # fmt: skip
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
     """Update toward ``r + gamma * max_b Q(s', b)``, then draw the next action."""
     target = reward
     if not terminated:
