@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from cartpole_q.results import MultiSeedSummary, RunSummary, Spread
+from cartpole_q.results import MultiSeedSummary, RunSummary, Spread, is_success
 from cartpole_q.store.sweepdir import PointRow
 
 
@@ -157,7 +157,8 @@ def eval_line(
     """
     verdict = ""
     if threshold is not None:
-        verdict = f" [>= {threshold:g}: {'yes' if report['mean'] >= threshold else 'no'}]"
+        reached = is_success(report["mean"], threshold)
+        verdict = f" [>= {threshold:g}: {'yes' if reached else 'no'}]"
     return (
         f"{run_dir}: greedy mean {report['mean']:.2f} +/- {report['std']:.2f} "
         f"(min {report['min']:g}, max {report['max']:g}) over {report['episodes']} episodes "

@@ -21,6 +21,7 @@ from cartpole_q.envs.models import GridLayout, grid_layout
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import EvalReport, ExactReport, evaluate, exact_report, under_conditions
 from cartpole_q.experiments.workers import JobHandle, default_workers, map_jobs
+from cartpole_q.results import is_success
 from cartpole_q.store.rundir import Run
 from cartpole_q.store.runsets import RunSet
 
@@ -201,9 +202,7 @@ def evaluate_seeds(
     return {
         **({"exact": exact} if exact else {}),
         "runs": results,
-        "successes": sum(
-            1 for m in means if reward_threshold is not None and m >= reward_threshold
-        ),
+        "successes": sum(is_success(m, reward_threshold) is True for m in means),
         "reward_threshold": reward_threshold,
         "episodes": results[0]["episodes"],
         "mean": float(np.mean(means)),
