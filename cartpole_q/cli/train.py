@@ -106,8 +106,7 @@ def train(
     ] = False,
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
-    # Connected (or refused) before the run directory is created.
-    with exit_codes(), backend_connection(backend, workers, address):
+    with exit_codes():
         from cartpole_q.experiments import run as runner
         from cartpole_q.store.lock import directory_lock
 
@@ -126,10 +125,11 @@ def train(
             with directory_lock(resume, "run") if resume.is_dir() else nullcontext():
                 prepared = runner.prepare_resume(resume, episodes)
                 _check_options(prepared.config.train.seeds, watch, video_every, backend)
-                _train_into(
-                    resume, prepared, True, workers, backend, address, quiet, watch,
-                    video_every, seed_plots,
-                )  # fmt: skip
+                with backend_connection(backend, workers, address):
+                    _train_into(
+                        resume, prepared, True, workers, backend, address, quiet, watch,
+                        video_every, seed_plots,
+                    )  # fmt: skip
             return
         if seed is not None and seeds is not None:
             raise UserError("give either --seed (one run) or --seeds (several), not both.")
@@ -138,16 +138,18 @@ def train(
             engine=None if engine is None else engine.value,
         )  # fmt: skip
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
-        run_dir = runner.start_run(prepared, out)
-        with directory_lock(run_dir, "run"):
-            _train_into(
-                run_dir, prepared, False, workers, backend, address, quiet, watch, video_every,
-                seed_plots,
-            )  # fmt: skip
+        # Connected (or refused) before the run directory is created.
+        with backend_connection(backend, workers, address):
+            run_dir = runner.start_run(prepared, out)
+            with directory_lock(run_dir, "run"):
+                _train_into(
+                    run_dir, prepared, False, workers, backend, address, quiet, watch,
+                    video_every, seed_plots,
+                )  # fmt: skip
 
 
 def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendChoice) -> None:
-    """Refuse options that cannot work for this run, before it starts."""
+    """Refuse options that cannot work for this run, before it starts (or Ray is started)."""
     if seeds is None and backend is BackendChoice.ray:
         raise UserError(
             "--backend ray runs the seeds of a multi-seed run as Ray tasks: give --seeds "
