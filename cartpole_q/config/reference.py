@@ -20,6 +20,7 @@ import yaml
 from cartpole_q.config.schema import Config, Key, key_of, sections
 from cartpole_q.config.yaml_io import default_raw
 from cartpole_q.profiles import all_profiles
+from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.algorithms import algorithms
 from cartpole_q.rl.algorithms import names as algorithm_names
 
@@ -50,11 +51,18 @@ def _rows(record: type, prefix: str, defaults: dict[str, Any]) -> Iterator[str]:
 
 
 def _param_rows(prefix: str) -> Iterator[str]:
-    """A row per key an algorithm adds (``agent.n``), the algorithm named."""
+    """A row per key an algorithm adds (``agent.n``), naming the algorithms that have it.
+
+    Algorithms that declare the same parameter (``agent.lambda`` of the trace methods)
+    share a row.
+    """
+    owners: dict[Param, list[str]] = {}
     for algorithm in algorithms():
         for param in algorithm.params:
-            meaning = f"{param.doc} ({param.interval}; `{algorithm.name}` only)"
-            yield _row(f"{prefix}{param.key}", f"`{_inline(param.default)}`", meaning)
+            owners.setdefault(param, []).append(algorithm.name)
+    for param, names in owners.items():
+        meaning = f"{param.doc} ({param.interval}; {_either(names)} only)"
+        yield _row(f"{prefix}{param.key}", f"`{_inline(param.default)}`", meaning)
 
 
 def _meaning(key: Key) -> str:

@@ -240,7 +240,7 @@ class AgentConfig:
     algorithm: str = field(
         metadata=spec(
             "algorithm",
-            "{choices} (each stated precisely in the project's design notes: target, order "
+            "{choices} (each stated precisely in docs/algorithms.md: target, order "
             "of work, random draws)",
         )
     )

@@ -107,6 +107,18 @@ def expected_value(q: Table, state: int, epsilon: float) -> float:
 
 
 @compilable
+def policy_probability(action: int, greedy: int, epsilon: float, n_actions: int) -> float:
+    """``pi(action | x)`` of epsilon-greedy, ``greedy`` being ``x``'s greedy action.
+
+    >>> policy_probability(1, 1, 0.2, 2), policy_probability(0, 1, 0.2, 2)
+    (0.9, 0.1)
+    """
+    if action == greedy:
+        return (1.0 - epsilon) + epsilon / n_actions
+    return epsilon / n_actions
+
+
+@compilable
 def first_action(
     q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng
 ) -> int:

@@ -14,9 +14,27 @@ import inspect
 from collections.abc import Iterator
 
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.algorithms import double_q_learning, expected_sarsa, q_learning, sarsa
+from cartpole_q.rl.algorithms import (
+    double_q_learning,
+    dyna_q,
+    dyna_q_plus,
+    expected_sarsa,
+    monte_carlo,
+    n_step_sarsa,
+    n_step_tree_backup,
+    off_policy_monte_carlo,
+    q_learning,
+    sarsa,
+    sarsa_lambda,
+    true_online_sarsa_lambda,
+    watkins_q_lambda,
+)
 
-PACKAGE = (q_learning, sarsa, expected_sarsa, double_q_learning)
+PACKAGE = (
+    q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
+    sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus, monte_carlo,
+    off_policy_monte_carlo,
+)  # fmt: skip
 """the package's algorithm modules, in the order the documentation lists them"""
 
 _REGISTRY: dict[str, Algorithm] = {}

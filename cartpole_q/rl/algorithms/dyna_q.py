@@ -1,0 +1,67 @@
+"""Dyna-Q (Sutton & Barto 8.2): Q-learning plus planning on a learned model.
+
+Per real step: Q-learning's update; the model remembers the transition
+(:mod:`cartpole_q.rl.model`); then ``agent.planning_steps`` times, a state seen is drawn
+(``rng.integers``), then an action taken in it, and Q-learning's update is made on the
+remembered transition; the next action is drawn from the table after planning. With
+``planning_steps = 0`` this is Q-learning, byte for byte. The contract: docs/algorithms.md.
+
+>>> import numpy as np
+>>> q = np.zeros((2, 2))
+>>> memory = dyna_memory(MemoryContext(2, 2, 0.0, {}, 10))
+>>> step(q, memory, (3.0,), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+0
+>>> float(q[0, 1])  # once for real, three times from the model: 1 - 0.5 ** 4
+0.9375
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.model import PLANNING_STEPS, model_memory, plan_dyna_q, remember
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    best_value,
+    epsilon_greedy,
+    update,
+)
+
+
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
+    """Learn from the real step, remember it, plan, then draw the next action."""
+    target = reward
+    if not terminated:
+        target = reward + gamma * best_value(q, next_state)
+    update(q, state, action, target, alpha)
+    remember(memory, state, action, next_state, reward, terminated, q.shape[1])
+    plan_dyna_q(q, memory, int(params[0]), alpha, gamma, rng)
+    if terminated or truncated:
+        return ENDED
+    return epsilon_greedy(q, next_state, epsilon, rng)
+
+
+def dyna_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """An empty model."""
+    return model_memory(context.n_states, context.n_actions)
+
+
+ALGORITHM = Algorithm(
+    name="dyna_q",
+    description="Dyna-Q: Q-learning plus planning on a learned model (agent.planning_steps)",
+    book="8.2",
+    step=step,
+    params=(PLANNING_STEPS,),
+    memory=dyna_memory,
+    memory_names=(
+        "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
+        "model_actions_taken", "model_actions_count", "model_counters",
+    ),
+)  # fmt: skip

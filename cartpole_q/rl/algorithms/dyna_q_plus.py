@@ -1,0 +1,103 @@
+"""Dyna-Q+ (Sutton & Barto 8.3): Dyna-Q with a bonus for pairs not tried for long.
+
+As Dyna-Q, with a counter of real steps ``time``: each real step first sets ``time = time + 1``
+and ``last_tried(s, a) = time``. Planning draws a state seen, then **any** action
+(``rng.integers(0, n)``); a pair never tried leads back to its state with reward 0; the
+planning target adds ``kappa * sqrt(time - last_tried)``. The direct update has no bonus. The
+contract: docs/algorithms.md.
+
+>>> import numpy as np
+>>> q = np.zeros((2, 2))
+>>> memory = dyna_plus_memory(MemoryContext(2, 2, 0.0, {}, 10))
+>>> step(q, memory, (0.0, 0.1), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+...      np.random.default_rng(0))
+0
+>>> float(q[0, 1]), int(memory[6][1]), int(memory[7][1])
+(0.5, 1, 1)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.model import PLANNING_STEPS, model_memory, remember
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    best_value,
+    compilable,
+    epsilon_greedy,
+    update,
+)
+
+
+@compilable
+def plan_with_bonus(
+    q: Table, model: Memory, last_tried: np.ndarray, steps: int, kappa: float, alpha: float,
+    gamma: float, rng: Rng,
+) -> None:  # fmt: skip
+    """``steps`` planning updates with the exploration bonus ``kappa * sqrt(tau)``."""
+    next_states, rewards, terminals = model[0], model[1], model[2]
+    seen, counters = model[3], model[6]
+    n_actions = q.shape[1]
+    time = counters[1]
+    for _ in range(steps):
+        state = seen[rng.integers(0, counters[0])]
+        action = int(rng.integers(0, n_actions))
+        flat = state * n_actions + action
+        reward, after, terminal = 0.0, state, False  # never tried: back to itself, reward 0
+        if next_states[flat] >= 0:
+            reward, after, terminal = rewards[flat], next_states[flat], terminals[flat] == 1
+        tau = float(time - last_tried[flat])
+        bonus = reward + kappa * math.sqrt(tau)
+        target = bonus
+        if not terminal:
+            target = bonus + gamma * best_value(q, after)
+        update(q, state, action, target, alpha)
+
+
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
+    """Count the step, learn from it, remember it, plan with bonuses, then draw."""
+    n_actions = q.shape[1]
+    counters, last_tried = memory[6], memory[7]
+    counters[1] += 1
+    last_tried[state * n_actions + action] = counters[1]
+    target = reward
+    if not terminated:
+        target = reward + gamma * best_value(q, next_state)
+    update(q, state, action, target, alpha)
+    remember(memory, state, action, next_state, reward, terminated, n_actions)
+    plan_with_bonus(q, memory, last_tried, int(params[0]), params[1], alpha, gamma, rng)
+    if terminated or truncated:
+        return ENDED
+    return epsilon_greedy(q, next_state, epsilon, rng)
+
+
+def dyna_plus_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """An empty model, and every pair last tried at time 0."""
+    pairs = context.n_states * context.n_actions
+    return (*model_memory(context.n_states, context.n_actions), np.zeros(pairs, dtype=np.int64))
+
+
+KAPPA = Param("kappa", 0.001, "the exploration bonus kappa * sqrt(steps since tried)", low=0.0)
+
+ALGORITHM = Algorithm(
+    name="dyna_q_plus",
+    description="Dyna-Q+: Dyna-Q with a bonus for pairs not tried for long (agent.kappa)",
+    book="8.3",
+    step=step,
+    params=(PLANNING_STEPS, KAPPA),
+    memory=dyna_plus_memory,
+    memory_names=(
+        "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
+        "model_actions_taken", "model_actions_count", "model_counters", "model_last_tried",
+    ),
+)  # fmt: skip

@@ -1,0 +1,88 @@
+"""n-step SARSA (Sutton & Barto 7.2): on-policy TD control with n-step returns.
+
+Each step joins a queue of pending steps (:mod:`cartpole_q.rl.pending`); a step is settled
+``n`` steps later with ``G = R_0 + gamma R_1 + ... + gamma^(n-1) R_(n-1) + gamma^n Q(s', a')``,
+or when the episode ends with the rewards it saw (bootstrapping after a time limit, not
+after a terminal state). ``a'`` is drawn for ``s'`` first, from the table as it is (as SARSA
+draws it). With ``n = 1`` this is SARSA, byte for byte. The contract: docs/algorithms.md.
+
+>>> import numpy as np
+>>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
+>>> memory = queue_memory(1)
+>>> step(q, memory, (1.0,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+1
+>>> float(q[0, 0])  # as SARSA: 0 + 0.5 * (1 + 4 - 0)
+2.5
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.pending import N, drop_oldest, push, queue_memory, slot
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    compilable,
+    epsilon_greedy,
+    update,
+)
+
+
+@compilable
+def settle_oldest(
+    q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
+    counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, alpha: float,
+    gamma: float,
+) -> None:  # fmt: skip
+    """Update the oldest pending step toward its return, and remove it from the queue."""
+    n = states.shape[0]
+    pending = counter[1]
+    oldest = slot(counter, n, 0)
+    target = rewards[oldest]
+    for i in range(1, pending):
+        target = target + gamma ** float(i) * rewards[slot(counter, n, i)]
+    if bootstrap:
+        target = target + gamma ** float(pending) * q[next_state, next_action]
+    update(q, states[oldest], actions[oldest], target, alpha)
+    drop_oldest(counter, n)
+
+
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
+    """Queue the step, draw ``a'``, then settle what is due."""
+    states, actions, rewards, counter = memory[0], memory[1], memory[2], memory[3]
+    push(states, actions, rewards, counter, state, action, reward)
+    next_action = ENDED
+    if not terminated:
+        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+    if terminated or truncated:
+        while counter[1] > 0:
+            settle_oldest(q, states, actions, rewards, counter, next_state, next_action,
+                          not terminated, alpha, gamma)  # fmt: skip
+        return ENDED
+    if counter[1] == states.shape[0]:
+        settle_oldest(q, states, actions, rewards, counter, next_state, next_action, True,
+                      alpha, gamma)  # fmt: skip
+    return next_action
+
+
+def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """The queue of pending steps, for ``agent.n`` of them."""
+    return queue_memory(int(context.params["n"]))
+
+
+ALGORITHM = Algorithm(
+    name="n_step_sarsa",
+    description="n-step SARSA: on-policy TD control with n-step returns (agent.n)",
+    book="7.2",
+    step=step,
+    params=(N,),
+    memory=memory,
+    memory_names=("pending_states", "pending_actions", "pending_rewards", "queue"),
+)

@@ -1,0 +1,81 @@
+"""True online SARSA(lambda) (van Seijen et al. 2016; Sutton & Barto 12.8, tabular features).
+
+Per step: ``a'`` drawn first (as SARSA); ``delta = r + gamma * Q(s', a') - Q(s, a)`` (``Q(s', a')
+= 0`` after a terminal state); dutch traces: every trace decays by ``gamma * lambda``, then
+``(s, a)``'s grows by ``1 - alpha * gamma * lambda * z_old(s, a)``; every traced pair moves by
+``alpha * (delta + Q(s, a) - q_old) * z`` and ``(s, a)`` back by ``alpha * (Q(s, a) - q_old)``;
+``q_old = Q(s', a')``. The contract: docs/algorithms.md.
+
+>>> import numpy as np
+>>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
+>>> memory = true_online_memory(MemoryContext(2, 2, 0.0, {}, 10))
+>>> step(q, memory, (0.5,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+...      np.random.default_rng(0))
+1
+>>> float(q[0, 0]), float(memory[5][0])  # 0.5 * 5 * 1 - 0.5 * 0; q_old = Q(s', a') = 4
+(2.5, 4.0)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, epsilon_greedy
+from cartpole_q.rl.traces import (
+    LAMBDA,
+    apply_traces,
+    clear_traces,
+    decay_traces,
+    trace_memory,
+    trace_slot,
+    trace_value,
+)
+
+
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
+    """The true online update with dutch traces and the ``q_old`` correction."""
+    values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
+    q_old_cell = memory[5]
+    lam = params[0]
+    n_actions = q.shape[1]
+    next_action = ENDED
+    q_next = 0.0
+    if not terminated:
+        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        q_next = q[next_state, next_action]
+    q_sa = q[state, action]
+    q_old = q_old_cell[0]
+    delta = reward + gamma * q_next - q_sa
+    z_sa = trace_value(slots, values, state * n_actions + action)
+    decay_traces(values, states, actions, slots, count, gamma * lam, n_actions)
+    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
+    values[where] = values[where] + (1.0 - alpha * gamma * lam * z_sa)
+    apply_traces(q, values, states, actions, count, alpha * (delta + q_sa - q_old))
+    q[state, action] = q[state, action] - alpha * (q_sa - q_old)
+    q_old_cell[0] = q_next
+    if terminated or truncated:
+        clear_traces(states, actions, slots, count, n_actions)
+        q_old_cell[0] = 0.0
+        return ENDED
+    return next_action
+
+
+def true_online_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """No traces yet, and ``q_old = 0``."""
+    return (*trace_memory(context.n_states, context.n_actions), np.zeros(1, dtype=np.float64))
+
+
+ALGORITHM = Algorithm(
+    name="true_online_sarsa_lambda",
+    description="True online SARSA(lambda): dutch traces with the exact online lambda-return",
+    book="12.8",
+    step=step,
+    params=(LAMBDA,),
+    memory=true_online_memory,
+    memory_names=(
+        "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count", "q_old",
+    ),
+)  # fmt: skip

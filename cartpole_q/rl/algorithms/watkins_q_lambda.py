@@ -1,0 +1,74 @@
+"""Watkins's Q(lambda) (Sutton & Barto 12.10): Q-learning with traces, cut after exploring.
+
+Per step: ``delta = y - Q(s, a)`` with ``y = r + gamma * max_b Q(s', b)`` (``r`` when
+terminated); ``(s, a)`` gets its trace (``agent.trace``); every pair with a trace moves by
+``alpha * delta * z``; then ``a'`` is drawn from the updated table: if it is greedy (its value
+is the largest, ties included) the traces decay by ``gamma * lambda``, else they are cleared,
+since the greedy policy's return no longer follows. With ``lambda = 0`` this is Q-learning,
+byte for byte. The contract: docs/algorithms.md.
+
+>>> import numpy as np
+>>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
+>>> memory = trace_memory(2, 2)
+>>> step(q, memory, (0.5, 1.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+...      np.random.default_rng(0))
+1
+>>> float(q[0, 0]), int(memory[4][0])  # as Q-learning; a greedy a' keeps the trace
+(2.5, 1)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, best_value, epsilon_greedy
+from cartpole_q.rl.traces import (
+    LAMBDA,
+    TRACE,
+    apply_and_decay,
+    apply_traces,
+    clear_traces,
+    give_trace,
+    trace_memory,
+)
+
+
+def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
+         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
+         epsilon: float, rng: Rng) -> int:  # fmt: skip
+    """Move every traced pair toward the greedy target; draw; decay or cut the traces."""
+    values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
+    decay, kind = gamma * params[0], int(params[1])
+    n_actions = q.shape[1]
+    target = reward
+    if not terminated:
+        target = reward + gamma * best_value(q, next_state)
+    delta = target - q[state, action]
+    give_trace(values, states, actions, slots, count, state, action, kind, alpha, n_actions)
+    if terminated or truncated:
+        apply_traces(q, values, states, actions, count, alpha * delta)
+        clear_traces(states, actions, slots, count, n_actions)
+        return ENDED
+    # Decayed in the same pass; cleared below instead when the next action explores.
+    apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
+    next_action = epsilon_greedy(q, next_state, epsilon, rng)
+    if q[next_state, next_action] != best_value(q, next_state):
+        clear_traces(states, actions, slots, count, n_actions)
+    return next_action
+
+
+def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
+    """No traces yet."""
+    return trace_memory(context.n_states, context.n_actions)
+
+
+ALGORITHM = Algorithm(
+    name="watkins_q_lambda",
+    description="Watkins's Q(lambda): Q-learning with traces, cut after an exploratory action",
+    book="12.10",
+    step=step,
+    params=(LAMBDA, TRACE),
+    memory=memory,
+    memory_names=("trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count"),
+)

@@ -1,0 +1,160 @@
+"""Sparse eligibility traces: only the (state, action) pairs with a trace are stored and touched.
+
+Five arrays of an algorithm's memory: ``values`` (each trace), ``states`` and ``actions``
+(its pair), in the order the pairs got their trace, ``slots`` (each pair's position in them
+by flat index ``state * n_actions + action``, ``-1`` without a trace) and ``count``. A step
+costs O(pairs with a trace), not O(table). A trace that decays to exactly 0.0 is dropped;
+the list keeps its order (which never changes a value: each pair is updated on its own).
+The contract: docs/algorithms.md, "Eligibility traces".
+
+>>> import numpy as np
+>>> q = np.zeros((2, 2))
+>>> values, states, actions, slots, count = trace_memory(2, 2)
+>>> give_trace(values, states, actions, slots, count, 1, 0, 0, 0.5, 2)
+>>> give_trace(values, states, actions, slots, count, 1, 0, 0, 0.5, 2)  # accumulating
+>>> apply_and_decay(q, values, states, actions, slots, count, 0.5, 0.25)
+>>> float(q[1, 0]), float(values[0])
+(1.0, 0.5)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cartpole_q.rl.algorithm import Param
+from cartpole_q.rl.tabular import Table, compilable
+
+TRACE_KINDS = ("accumulating", "replacing", "dutch")
+"""``agent.trace`` values, in the order of their codes"""
+ACCUMULATING, REPLACING, DUTCH = 0, 1, 2
+
+LAMBDA = Param("lambda", 0.9, "the trace decay lambda (0: one-step)", low=0.0, high=1.0)
+"""``agent.lambda`` of the trace methods"""
+TRACE = Param(
+    "trace", "replacing", "how a visit sets its pair's trace: z + 1, 1, or (1 - alpha) z + 1",
+    kind="choice", choices=TRACE_KINDS,
+)  # fmt: skip
+"""``agent.trace`` of SARSA(lambda) and Watkins's Q(lambda)"""
+
+
+@compilable
+def trace_slot(
+    values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, n_actions: int,
+) -> int:  # fmt: skip
+    """The slot of the pair's trace, appending one of value 0.0 if it has none."""
+    flat = state * n_actions + action
+    where = slots[flat]
+    if where < 0:
+        where = count[0]
+        slots[flat] = where
+        values[where] = 0.0
+        states[where] = state
+        actions[where] = action
+        count[0] = where + 1
+    return int(where)
+
+
+@compilable
+def give_trace(
+    values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
+) -> None:  # fmt: skip
+    """Give ``(state, action)`` its trace: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
+    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
+    if kind == ACCUMULATING:
+        values[where] = values[where] + 1.0
+    elif kind == REPLACING:
+        values[where] = 1.0
+    else:
+        values[where] = (1.0 - alpha) * values[where] + 1.0
+
+
+@compilable
+def trace_value(slots: np.ndarray, values: np.ndarray, flat: int) -> float:
+    """The trace of a pair by flat index (0.0 without one)."""
+    where = slots[flat]
+    if where < 0:
+        return 0.0
+    return float(values[where])
+
+
+@compilable
+def apply_and_decay(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, scale: float, decay: float,
+) -> None:  # fmt: skip
+    """``Q[x] = Q[x] + scale * z``, then ``z = decay * z``, for every trace, in one pass.
+
+    ``scale`` is ``alpha * delta``; a trace that decays to exactly 0.0 is dropped.
+    """
+    n_actions = q.shape[1]
+    kept = 0
+    for read in range(count[0]):
+        state, action, z = states[read], actions[read], values[read]
+        q[state, action] = q[state, action] + scale * z
+        z = decay * z
+        if z == 0.0:
+            slots[state * n_actions + action] = -1
+            continue
+        if kept != read:
+            states[kept], actions[kept] = state, action
+            slots[state * n_actions + action] = kept
+        values[kept] = z
+        kept += 1
+    count[0] = kept
+
+
+@compilable
+def decay_traces(
+    values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, decay: float, n_actions: int,
+) -> None:  # fmt: skip
+    """``z = decay * z`` for every trace; one that becomes exactly 0.0 is dropped."""
+    kept = 0
+    for read in range(count[0]):
+        state, action = states[read], actions[read]
+        z = decay * values[read]
+        if z == 0.0:
+            slots[state * n_actions + action] = -1
+            continue
+        if kept != read:
+            states[kept], actions[kept] = state, action
+            slots[state * n_actions + action] = kept
+        values[kept] = z
+        kept += 1
+    count[0] = kept
+
+
+@compilable
+def apply_traces(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, count: np.ndarray,
+    scale: float,
+) -> None:  # fmt: skip
+    """``Q[x] = Q[x] + scale * z`` for every trace, in list order."""
+    for read in range(count[0]):
+        state, action = states[read], actions[read]
+        q[state, action] = q[state, action] + scale * values[read]
+
+
+@compilable
+def clear_traces(
+    states: np.ndarray, actions: np.ndarray, slots: np.ndarray, count: np.ndarray,
+    n_actions: int,
+) -> None:  # fmt: skip
+    """Remove every trace."""
+    for read in range(count[0]):
+        slots[states[read] * n_actions + actions[read]] = -1
+    count[0] = 0
+
+
+def trace_memory(n_states: int, n_actions: int) -> tuple[np.ndarray, ...]:
+    """No traces yet: values, states, actions, slots (all -1) and ``[count]``."""
+    pairs = n_states * n_actions
+    return (
+        np.zeros(pairs, dtype=np.float64),
+        np.zeros(pairs, dtype=np.int64),
+        np.zeros(pairs, dtype=np.int64),
+        np.full(pairs, -1, dtype=np.int64),
+        np.zeros(1, dtype=np.int64),
+    )
