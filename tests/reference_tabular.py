@@ -1,13 +1,21 @@
-"""An independent re-derivation of the training contract for Discrete and Tuple observations.
+"""An independent re-derivation of the training contract, written from the texts alone.
 
-Written from ``design.md`` alone ("Discrete observations", "Randomness and the training
-loop", "Algorithms"), in plain Python on ``gymnasium.make``: it imports nothing from
-``cartpole_q``. The tests check that the package's run is byte-identical to it.
+Sources: ``design.md`` ("Randomness and the training loop", "Algorithms", the binning rule of
+"Run-directory contract", "Discrete observations", "CartPole physics") and
+``docs/algorithms.md`` (every algorithm beyond design.md's four). It is plain Python on
+``gymnasium.make`` (NumPy only for the generators and the returned arrays) and imports
+nothing from ``cartpole_q``: the tests check that the package's runs are byte-identical to it.
+
+The Q-table is a list of rows (one per state, ``n_actions`` Python floats each): Python
+floats are IEEE float64 and every formula below is written exactly as the texts state it,
+parenthesised, left to right.
 """
 
 from __future__ import annotations
 
 import math
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -15,9 +23,27 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+Schedule = Callable[[int], float]
+
+# design.md, "CartPole physics": the keys env.randomize may list, in the order they are drawn.
+RANDOMIZE_ORDER = ("gravity", "masscart", "masspole", "length", "force_mag", "tau")
+
+# docs/algorithms.md, "Monte Carlo": the buffer's length of an environment without a time limit.
+NO_TIME_LIMIT_LENGTH = 10_000
+
 
 @dataclass
 class ReferenceRun:
+    """What one re-derived training run produced.
+
+    Attributes:
+        q_table: The kept table, float64 of shape ``(*state_shape, n_actions)``.
+        visits: Visits of every (state, action) over all trained episodes, int64, same shape.
+        returns: Every trained episode's return.
+        lengths: Every trained episode's number of steps.
+        solved_episode: The 1-based solve episode, or None.
+    """
+
     q_table: np.ndarray
     visits: np.ndarray
     returns: list[float]
@@ -25,12 +51,718 @@ class ReferenceRun:
     solved_episode: int | None
 
 
-def exponential(start: float, decay: float, end: float) -> Any:
+# Schedules (design.md, "Randomness and the training loop").
+
+
+def constant(value: float) -> Schedule:
+    """A constant schedule.
+
+    Args:
+        value: The value of every episode.
+
+    Returns:
+        The schedule, a function of the 0-based episode.
+    """
+    return lambda episode: value
+
+
+def exponential(start: float, decay: float, end: float) -> Schedule:
+    """The exponential schedule ``max(end, start * decay ** float(e))``.
+
+    Args:
+        start: The value of episode 0.
+        decay: The factor per episode.
+        end: The floor.
+
+    Returns:
+        The schedule, a function of the 0-based episode.
+    """
     return lambda episode: max(end, start * decay ** float(episode))
 
 
-def constant(value: float) -> Any:
-    return lambda episode: value
+def log_schedule(k: float, end: float, start: float = 1.0) -> Schedule:
+    """The log schedule ``max(end, min(start, 1 - log10((e + 1) / k)))``.
+
+    Args:
+        k: The episode scale.
+        end: The floor.
+        start: The ceiling (1 by default).
+
+    Returns:
+        The schedule, a function of the 0-based episode.
+    """
+    return lambda episode: max(end, min(start, 1 - math.log10((episode + 1) / k)))
+
+
+def schedule(spec: float | Mapping[str, Any] | Schedule) -> Schedule:
+    """A schedule from its config form (a number or a mapping with ``type``).
+
+    Args:
+        spec: A number, ``{type: constant, value}``, ``{type: exponential, start, decay,
+            end}``, ``{type: log, k, end, start}``, or already a schedule.
+
+    Returns:
+        The schedule, a function of the 0-based episode.
+
+    Raises:
+        ValueError: An unknown schedule type.
+    """
+    if callable(spec):
+        return spec
+    if not isinstance(spec, Mapping):
+        return constant(float(spec))
+    kind = spec.get("type", "constant")
+    if kind == "constant":
+        return constant(float(spec["value"]))
+    if kind == "exponential":
+        return exponential(float(spec["start"]), float(spec["decay"]), float(spec["end"]))
+    if kind == "log":
+        return log_schedule(float(spec["k"]), float(spec["end"]), float(spec.get("start", 1.0)))
+    raise ValueError(f"unknown schedule type {kind!r}")
+
+
+# Observations to rows (design.md: the binning rule, "Discrete observations").
+
+
+def make_indexer(
+    space: spaces.Space[Any], discretization: Mapping[str, Sequence[float]] | None
+) -> tuple[tuple[int, ...], Callable[[Any], int]]:
+    """The state shape of an observation space and the function giving an observation's row.
+
+    Args:
+        space: A 1-D ``Box``, a ``Discrete`` or a ``Tuple`` of ``Discrete``.
+        discretization: ``bins``, ``low`` and ``high`` for a ``Box``; None otherwise.
+
+    Returns:
+        ``(state_shape, row)``: the table's shape without the action axis, and the C-order
+        row of an observation.
+    """
+    if isinstance(space, spaces.Box):
+        assert discretization is not None, "a Box observation needs a grid"
+        bins = [int(b) for b in discretization["bins"]]
+        lows = [float(v) for v in discretization["low"]]
+        highs = [float(v) for v in discretization["high"]]
+
+        def box_row(observation: Any) -> int:
+            row = 0
+            for d, x in enumerate(np.asarray(observation, dtype=np.float32).tolist()):
+                # x: the float32 coordinate widened to a float64 (a Python float).
+                # clip(floor(v), 0, bins - 1); a NaN falls in bin 0, bins = 1 is ignored.
+                index = 0
+                if bins[d] > 1:
+                    v = (x - lows[d]) / (highs[d] - lows[d]) * bins[d]
+                    if v >= bins[d]:
+                        index = bins[d] - 1
+                    elif v >= 0.0:
+                        index = math.floor(v)
+                row = row * bins[d] + index
+            return row
+
+        return tuple(bins), box_row
+
+    assert discretization is None, "Discrete and Tuple observations take no grid"
+    tuple_obs = isinstance(space, spaces.Tuple)
+    components: list[Any] = list(space.spaces) if isinstance(space, spaces.Tuple) else [space]
+    assert all(isinstance(c, spaces.Discrete) for c in components)
+    sizes = [int(c.n) for c in components]
+    starts = [int(c.start) for c in components]
+
+    def discrete_row(observation: Any) -> int:
+        values = observation if tuple_obs else (observation,)
+        row = 0
+        for k, size in enumerate(sizes):
+            row = row * size + (int(values[k]) - starts[k])
+        return row
+
+    return tuple(sizes), discrete_row
+
+
+# CartPole physics (design.md, "CartPole physics").
+
+
+def set_physics(env: gymnasium.Env[Any, Any], values: Mapping[str, Any]) -> None:
+    """Set CartPole attributes on ``env.unwrapped``, then recompute the derived ones.
+
+    Args:
+        env: A CartPole made by ``gymnasium.make``.
+        values: Attribute names and values.
+    """
+    cartpole = env.unwrapped
+    for key, value in values.items():
+        setattr(cartpole, key, value)
+    cartpole.total_mass = cartpole.masspole + cartpole.masscart  # type: ignore[attr-defined]
+    cartpole.polemass_length = cartpole.masspole * cartpole.length  # type: ignore[attr-defined]
+
+
+# The agent: one table (two for Double Q), the agent's generator, the episode's rates.
+
+
+class Agent:
+    """The Q-table with design.md's and docs/algorithms.md's helpers.
+
+    Attributes:
+        q: The table, ``q[x][b]``.
+        n: The number of actions.
+        gamma: The discount.
+        rng: The agent's generator (every draw of every algorithm).
+        epsilon: The current episode's epsilon.
+        alpha: The current episode's alpha.
+        params: The algorithm's extra keys (``n``, ``lambda``, ``trace``, ...).
+    """
+
+    def __init__(
+        self,
+        n_states: int,
+        n: int,
+        q_init: float,
+        gamma: float,
+        rng: np.random.Generator,
+        params: Mapping[str, Any],
+    ) -> None:
+        self.q = [[q_init] * n for _ in range(n_states)]
+        self.n = n
+        self.gamma = gamma
+        self.rng = rng
+        self.epsilon = 0.0
+        self.alpha = 0.0
+        self.params = params
+
+    # -- reading the table
+
+    def policy_row(self, x: int) -> list[float]:
+        """The values epsilon-greedy chooses from (Double Q overrides it with A + B)."""
+        return self.q[x]
+
+    def greedy(self, x: int) -> int:
+        """The lowest action with the largest ``Q(x, b)``."""
+        return argmax(self.q[x])
+
+    def max(self, x: int) -> float:
+        """``Q(x, greedy(x))``."""
+        return self.q[x][self.greedy(x)]
+
+    def expected(self, x: int) -> float:
+        """``E(x) = (1 - epsilon) * Q(x, g) + (epsilon / n) * S``."""
+        row = self.q[x]
+        g = argmax(row)
+        total = row[0]
+        for b in range(1, self.n):
+            total = total + row[b]
+        return (1 - self.epsilon) * row[g] + (self.epsilon / self.n) * total
+
+    def pi(self, b: int, x: int) -> float:
+        """Epsilon-greedy's probability of ``b`` in ``x``."""
+        if b == self.greedy(x):
+            return (1 - self.epsilon) + self.epsilon / self.n
+        return self.epsilon / self.n
+
+    # -- drawing and updating
+
+    def draw(self, x: int) -> int:
+        """design.md's epsilon-greedy action for ``x``."""
+        if self.epsilon <= 0.0:
+            return argmax(self.policy_row(x))
+        if self.epsilon >= 1.0:
+            return int(self.rng.integers(0, self.n))
+        if self.rng.random() < self.epsilon:
+            return int(self.rng.integers(0, self.n))
+        return argmax(self.policy_row(x))
+
+    def update(self, x: int, b: int, y: float) -> None:
+        """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))``."""
+        self.q[x][b] = self.q[x][b] + self.alpha * (y - self.q[x][b])
+
+    # -- what the algorithms override
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        """One step's work after ``visits[s, a] += 1``.
+
+        Args:
+            s: The step's state.
+            a: The step's action.
+            r: Its reward.
+            s2: The next state.
+            terminated: Whether the step terminated (also when it truncated too).
+            truncated: Whether the step only truncated.
+
+        Returns:
+            The next action, or None when the episode ends.
+        """
+        raise NotImplementedError
+
+    def kept_table(self) -> list[list[float]]:
+        """The table ``q_table.npy`` holds."""
+        return self.q
+
+
+def argmax(row: Sequence[float]) -> int:
+    """The lowest index among the largest values."""
+    best = 0
+    for b in range(1, len(row)):
+        if row[b] > row[best]:
+            best = b
+    return best
+
+
+# design.md's four one-step algorithms.
+
+
+class QLearning(Agent):
+    """``q_learning``: update, then draw the next action from the updated table."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        y = r if terminated else r + self.gamma * self.max(s2)
+        self.update(s, a, y)
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+
+class Sarsa(Agent):
+    """``sarsa``: draw ``a'`` from the table as it is (not when terminated), then update."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        if terminated:
+            self.update(s, a, r)
+            return None
+        a2 = self.draw(s2)
+        self.update(s, a, r + self.gamma * self.q[s2][a2])
+        return None if truncated else a2
+
+
+class ExpectedSarsa(Agent):
+    """``expected_sarsa``: update toward ``r + gamma * E(s')``, then draw."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        y = r if terminated else r + self.gamma * self.expected(s2)
+        self.update(s, a, y)
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+
+class DoubleQLearning(Agent):
+    """``double_q_learning``: ``u = rng.random()`` picks the table to update; acts on A + B."""
+
+    def __init__(self, n_states: int, n: int, q_init: float, *args: Any) -> None:
+        super().__init__(n_states, n, q_init, *args)
+        self.q_b = [[q_init] * n for _ in range(n_states)]
+
+    def policy_row(self, x: int) -> list[float]:
+        return [self.q[x][b] + self.q_b[x][b] for b in range(self.n)]
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        u = self.rng.random()
+        first, second = (self.q, self.q_b) if u < 0.5 else (self.q_b, self.q)
+        y = r if terminated else r + self.gamma * second[s2][argmax(first[s2])]
+        first[s][a] = first[s][a] + self.alpha * (y - first[s][a])
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+    def kept_table(self) -> list[list[float]]:
+        return [
+            [0.5 * (self.q[x][b] + self.q_b[x][b]) for b in range(self.n)]
+            for x in range(len(self.q))
+        ]
+
+
+# docs/algorithms.md: n-step methods.
+
+
+class NStepSarsa(Agent):
+    """``n_step_sarsa``: a queue of pending ``(S, A, R)``, settled ``n`` rewards late."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.pending: deque[tuple[int, int, float]] = deque()
+
+    def settle(self, bootstrap: bool, s2: int, a2: int | None) -> None:
+        """Update the oldest pending step toward its n-step return, and remove it."""
+        k = len(self.pending)
+        rewards = [step[2] for step in self.pending]
+        g = rewards[0]
+        for i in range(1, k):
+            g = g + self.gamma ** float(i) * rewards[i]
+        if bootstrap:
+            assert a2 is not None
+            g = g + self.gamma ** float(k) * self.q[s2][a2]
+        x, b, _ = self.pending.popleft()
+        self.update(x, b, g)
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.pending.append((s, a, r))
+        a2 = None if terminated else self.draw(s2)
+        if terminated or truncated:
+            while self.pending:
+                self.settle(not terminated, s2, a2)
+            return None
+        if len(self.pending) == int(self.params["n"]):
+            self.settle(True, s2, a2)
+        return a2
+
+
+class NStepTreeBackup(Agent):
+    """``n_step_tree_backup``: the tree backup under the epsilon-greedy target policy."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.pending: deque[tuple[int, int, float]] = deque()
+
+    def settle(self, terminated: bool, s2: int) -> None:
+        """Update the oldest pending step toward its tree-backup return, and remove it."""
+        steps = list(self.pending)
+        k = len(steps)
+        g = steps[k - 1][2] if terminated else steps[k - 1][2] + self.gamma * self.expected(s2)
+        for m in range(k - 2, -1, -1):
+            x, b, _ = steps[m + 1]
+            others = 0.0
+            for c in range(self.n):
+                if c != b:
+                    others = others + self.pi(c, x) * self.q[x][c]
+            g = steps[m][2] + self.gamma * (others + self.pi(b, x) * g)
+        x, b, _ = self.pending.popleft()
+        self.update(x, b, g)
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.pending.append((s, a, r))
+        if terminated or truncated:
+            while self.pending:
+                self.settle(terminated, s2)
+            return None
+        if len(self.pending) == int(self.params["n"]):
+            self.settle(False, s2)
+        return self.draw(s2)
+
+
+# docs/algorithms.md: eligibility traces.
+
+
+class TraceAgent(Agent):
+    """Sparse traces: a dict from flat index to ``z``, in the order pairs got a trace."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.traces: dict[int, float] = {}
+        self.lam = float(self.params["lambda"])
+
+    def give_trace(self, s: int, a: int) -> None:
+        """Give ``(s, a)`` a trace (appended at 0.0 if it has none), by ``agent.trace``."""
+        flat = s * self.n + a
+        if flat not in self.traces:
+            self.traces[flat] = 0.0
+        z = self.traces[flat]
+        kind = self.params["trace"]
+        if kind == "accumulating":
+            z = z + 1.0
+        elif kind == "replacing":
+            z = 1.0
+        elif kind == "dutch":
+            z = (1.0 - self.alpha) * z + 1.0
+        else:
+            raise ValueError(f"unknown trace {kind!r}")
+        self.traces[flat] = z
+
+    def decay(self) -> None:
+        """``z = (gamma * lambda) * z`` for every trace; traces now exactly 0.0 are dropped."""
+        for flat in list(self.traces):
+            z = (self.gamma * self.lam) * self.traces[flat]
+            if z == 0.0:
+                del self.traces[flat]
+            else:
+                self.traces[flat] = z
+
+    def apply(self, delta: float) -> None:
+        """``Q[x] = Q[x] + alpha * delta * z`` for every trace, in list order."""
+        for flat, z in self.traces.items():
+            x, b = divmod(flat, self.n)
+            self.q[x][b] = self.q[x][b] + self.alpha * delta * z
+
+
+class SarsaLambda(TraceAgent):
+    """``sarsa_lambda``: SARSA's delta applied along the traces."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        a2 = None
+        if terminated:
+            y = r
+        else:
+            a2 = self.draw(s2)
+            y = r + self.gamma * self.q[s2][a2]
+        delta = y - self.q[s][a]
+        self.give_trace(s, a)
+        self.apply(delta)
+        if terminated or truncated:
+            self.traces.clear()
+            return None
+        self.decay()
+        return a2
+
+
+class WatkinsQLambda(TraceAgent):
+    """``watkins_q_lambda``: Q-learning's delta along traces cut by exploratory actions."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        y = r if terminated else r + self.gamma * self.max(s2)
+        delta = y - self.q[s][a]
+        self.give_trace(s, a)
+        self.apply(delta)
+        if terminated or truncated:
+            self.traces.clear()
+            return None
+        a2 = self.draw(s2)
+        if self.q[s2][a2] == self.max(s2):
+            self.decay()
+        else:
+            self.traces.clear()
+        return a2
+
+
+class TrueOnlineSarsaLambda(TraceAgent):
+    """``true_online_sarsa_lambda``: dutch traces with the ``q_old`` correction."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.q_old = 0.0
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        a2 = None if terminated else self.draw(s2)
+        q_sa = self.q[s][a]
+        q_next = 0.0 if a2 is None else self.q[s2][a2]
+        delta = r + self.gamma * q_next - q_sa
+        flat = s * self.n + a
+        z_sa = self.traces.get(flat, 0.0)
+        self.decay()
+        if flat not in self.traces:
+            self.traces[flat] = 0.0
+        self.traces[flat] = self.traces[flat] + (1.0 - self.alpha * self.gamma * self.lam * z_sa)
+        for trace_flat, z in self.traces.items():
+            x, b = divmod(trace_flat, self.n)
+            self.q[x][b] = self.q[x][b] + self.alpha * (delta + q_sa - self.q_old) * z
+        self.q[s][a] = self.q[s][a] - self.alpha * (q_sa - self.q_old)
+        self.q_old = q_next
+        if terminated or truncated:
+            self.traces.clear()
+            self.q_old = 0.0
+            return None
+        return a2
+
+
+# docs/algorithms.md: planning.
+
+
+class DynaQ(Agent):
+    """``dyna_q`` (and, with ``plus``, ``dyna_q_plus``): Q-learning plus model replays."""
+
+    plus = False
+
+    def __init__(self, n_states: int, n: int, *args: Any) -> None:
+        super().__init__(n_states, n, *args)
+        self.model_next = [-1] * (n_states * n)
+        self.model_reward = [0.0] * (n_states * n)
+        self.model_terminated = [False] * (n_states * n)
+        self.seen: list[int] = []
+        self.seen_flag = [False] * n_states
+        self.actions_of: list[list[int]] = [[] for _ in range(n_states)]
+        self.time = 0
+        self.last_tried = [0] * (n_states * n)
+
+    def model(self, x: int, b: int) -> tuple[int, float, bool]:
+        """The remembered ``(x', reward, terminated)``; untried: back to ``x``, 0.0, False."""
+        flat = x * self.n + b
+        if self.model_next[flat] == -1:
+            return x, 0.0, False
+        return self.model_next[flat], self.model_reward[flat], self.model_terminated[flat]
+
+    def plan(self) -> None:
+        """One planning update."""
+        x = self.seen[int(self.rng.integers(0, len(self.seen)))]
+        if self.plus:
+            b = int(self.rng.integers(0, self.n))
+        else:
+            b = self.actions_of[x][int(self.rng.integers(0, len(self.actions_of[x])))]
+        x2, rho, t = self.model(x, b)
+        if self.plus:
+            tau = float(self.time - self.last_tried[x * self.n + b])
+            bonus = rho + float(self.params["kappa"]) * math.sqrt(tau)
+            y = bonus if t else bonus + self.gamma * self.max(x2)
+        else:
+            y = rho if t else rho + self.gamma * self.max(x2)
+        self.update(x, b, y)
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        flat = s * self.n + a
+        if self.plus:
+            self.time = self.time + 1
+            self.last_tried[flat] = self.time
+        y = r if terminated else r + self.gamma * self.max(s2)
+        self.update(s, a, y)
+        if not self.seen_flag[s]:
+            self.seen_flag[s] = True
+            self.seen.append(s)
+        if self.model_next[flat] == -1:
+            self.actions_of[s].append(a)
+        self.model_next[flat] = s2
+        self.model_reward[flat] = r
+        self.model_terminated[flat] = terminated
+        for _ in range(int(self.params["planning_steps"])):
+            self.plan()
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+
+class DynaQPlus(DynaQ):
+    """``dyna_q_plus``: any action replayed, with the bonus ``kappa * sqrt(tau)``."""
+
+    plus = True
+
+
+# docs/algorithms.md: Monte Carlo.
+
+
+class MonteCarlo(Agent):
+    """``monte_carlo`` (first visit, epsilon-soft) and, with ``off_policy``, its off-policy twin."""
+
+    off_policy = False
+
+    def __init__(self, n_states: int, n: int, *args: Any) -> None:
+        super().__init__(n_states, n, *args)
+        self.buffer_length = NO_TIME_LIMIT_LENGTH
+        self.states: list[int] = []
+        self.actions: list[int] = []
+        self.rewards: list[float] = []
+        self.behaviour: list[float] = []
+        self.first_visit: dict[int, int] = {}
+        self.counts = [0.0] * (n_states * n)  # N (on-policy) or C (off-policy)
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        t = len(self.states)
+        if self.off_policy:
+            self.behaviour.append(self.pi(a, s))
+        elif s * self.n + a not in self.first_visit:
+            self.first_visit[s * self.n + a] = t
+        self.states.append(s)
+        self.actions.append(a)
+        self.rewards.append(r)
+        if not terminated and not truncated and len(self.states) < self.buffer_length:
+            return self.draw(s2)
+        if self.off_policy:
+            self.backward_off_policy(terminated, s2)
+        else:
+            self.backward_on_policy(terminated, s2)
+        self.states, self.actions, self.rewards, self.behaviour = [], [], [], []
+        self.first_visit = {}
+        return None
+
+    def backward_on_policy(self, terminated: bool, s2: int) -> None:
+        """First-visit returns, by sample average or constant alpha."""
+        g = 0.0 if terminated else self.expected(s2)
+        for t in range(len(self.states) - 1, -1, -1):
+            g = self.gamma * g + self.rewards[t]
+            x, b = self.states[t], self.actions[t]
+            flat = x * self.n + b
+            if self.first_visit[flat] == t:
+                if self.params["update"] == "sample_average":
+                    self.counts[flat] = self.counts[flat] + 1.0
+                    self.q[x][b] = self.q[x][b] + (g - self.q[x][b]) / self.counts[flat]
+                else:
+                    self.update(x, b, g)
+
+    def backward_off_policy(self, terminated: bool, s2: int) -> None:
+        """Weighted importance sampling toward the greedy policy."""
+        g = 0.0 if terminated else self.max(s2)
+        w = 1.0
+        for t in range(len(self.states) - 1, -1, -1):
+            g = self.gamma * g + self.rewards[t]
+            x, b = self.states[t], self.actions[t]
+            flat = x * self.n + b
+            if self.params["update"] == "sample_average":
+                self.counts[flat] = self.counts[flat] + w
+            else:
+                self.counts[flat] = (1.0 - self.alpha) * self.counts[flat] + w
+            self.q[x][b] = self.q[x][b] + (w / self.counts[flat]) * (g - self.q[x][b])
+            if b != self.greedy(x):
+                break
+            w = w / self.behaviour[t]
+
+
+class OffPolicyMonteCarlo(MonteCarlo):
+    """``off_policy_monte_carlo``: behaviour epsilon-greedy, target greedy."""
+
+    off_policy = True
+
+
+ALGORITHMS: dict[str, type[Agent]] = {
+    "q_learning": QLearning,
+    "sarsa": Sarsa,
+    "expected_sarsa": ExpectedSarsa,
+    "double_q_learning": DoubleQLearning,
+    "n_step_sarsa": NStepSarsa,
+    "n_step_tree_backup": NStepTreeBackup,
+    "sarsa_lambda": SarsaLambda,
+    "watkins_q_lambda": WatkinsQLambda,
+    "true_online_sarsa_lambda": TrueOnlineSarsaLambda,
+    "dyna_q": DynaQ,
+    "dyna_q_plus": DynaQPlus,
+    "monte_carlo": MonteCarlo,
+    "off_policy_monte_carlo": OffPolicyMonteCarlo,
+}
+
+# docs/algorithms.md, "Config keys the algorithms add": the defaults.
+PARAMETER_DEFAULTS: dict[str, Any] = {
+    "n": 4,
+    "lambda": 0.9,
+    "trace": "replacing",
+    "planning_steps": 10,
+    "kappa": 0.001,
+    "update": "sample_average",
+}
+
+
+def env_threshold(env: gymnasium.Env[Any, Any], env_id: str) -> float | None:
+    """``train.reward_threshold: null``: the environment's, scaled for CartPole's time limit.
+
+    Args:
+        env: The environment as made.
+        env_id: Its id.
+
+    Returns:
+        The threshold, or None when the environment has none.
+    """
+    assert env.spec is not None
+    threshold = env.spec.reward_threshold
+    if threshold is None:
+        return None
+    registered = gymnasium.spec(env_id).max_episode_steps
+    steps = env.spec.max_episode_steps
+    if env_id.startswith("CartPole") and steps is not None and registered and steps != registered:
+        return threshold * steps / registered
+    return float(threshold)
 
 
 def reference_train(
@@ -38,107 +770,108 @@ def reference_train(
     *,
     algorithm: str,
     gamma: float,
-    alpha: Any,
-    epsilon: Any,
+    alpha: float | Mapping[str, Any] | Schedule,
+    epsilon: float | Mapping[str, Any] | Schedule,
     q_init: float,
     episodes: int,
     seed: int,
-    threshold: float | None,
-    kwargs: dict[str, Any] | None = None,
+    threshold: float | str | None = "env",
+    kwargs: Mapping[str, Any] | None = None,
+    discretization: Mapping[str, Sequence[float]] | None = None,
+    physics: Mapping[str, Any] | None = None,
+    randomize: Mapping[str, Sequence[float]] | None = None,
+    stop_when_solved: bool = True,
+    params: Mapping[str, Any] | None = None,
 ) -> ReferenceRun:
-    env = gymnasium.make(env_id, **(kwargs or {}))
-    space = env.observation_space
-    components = space.spaces if isinstance(space, spaces.Tuple) else (space,)
-    sizes = [int(c.n) for c in components]
-    starts = [int(c.start) for c in components]
+    """Train as the contract says, in plain Python on ``gymnasium.make``.
 
-    def row(observation: Any) -> int:
-        values = observation if isinstance(space, spaces.Tuple) else (observation,)
-        index = 0
-        for k, size in enumerate(sizes):
-            index = index * size + (int(values[k]) - starts[k])
-        return index
+    Args:
+        env_id: The Gymnasium id.
+        algorithm: ``agent.algorithm``.
+        gamma: ``agent.gamma``.
+        alpha: ``agent.alpha``: a number, a schedule mapping or a schedule function.
+        epsilon: ``agent.epsilon``, as ``alpha``.
+        q_init: ``agent.q_init``.
+        episodes: ``train.episodes``.
+        seed: The run's seed.
+        threshold: The solve threshold; ``"env"`` for the environment's own (as
+            ``train.reward_threshold: null``); None for never solved.
+        kwargs: ``env.kwargs``, forwarded to ``gymnasium.make``.
+        discretization: ``bins``, ``low`` and ``high`` for a Box observation.
+        physics: ``env.physics`` (CartPole).
+        randomize: ``env.randomize`` (CartPole): ``{key: [low, high]}``.
+        stop_when_solved: ``train.stop_when_solved``.
+        params: The algorithm's keys (``n``, ``lambda``, ``trace``, ``planning_steps``,
+            ``kappa``, ``update``); missing ones take docs/algorithms.md's defaults.
 
+    Returns:
+        The kept table, the visits, the returns and lengths, the solve episode.
+    """
+    alpha_of, epsilon_of = schedule(alpha), schedule(epsilon)
+    env = gymnasium.make(env_id, **dict(kwargs or {}))
+    state_shape, row = make_indexer(env.observation_space, discretization)
+    assert isinstance(env.action_space, spaces.Discrete)
     n = int(env.action_space.n)
-    shape = (math.prod(sizes), n)
-    q = np.full(shape, q_init, dtype=np.float64)
-    q_b = np.full(shape, q_init, dtype=np.float64)
-    double = algorithm == "double_q_learning"
-    visits = np.zeros(shape, dtype=np.int64)
-    agent_seq, env_seq, _ = np.random.SeedSequence(seed).spawn(3)
+    n_states = math.prod(state_shape)
+    if threshold == "env":
+        threshold = env_threshold(env, env_id)
+    assert threshold is None or isinstance(threshold, (int, float))
+
+    agent_seq, env_seq, physics_seq = np.random.SeedSequence(seed).spawn(3)
     rng = np.random.Generator(np.random.PCG64(agent_seq))
+    physics_rng = np.random.Generator(np.random.PCG64(physics_seq))
     env_seed = int(env_seq.generate_state(1, dtype=np.uint32)[0])
 
-    def greedy(s: int) -> int:
-        values = q[s] + q_b[s] if double else q[s]
-        return int(np.argmax(values))
-
-    def choose(s: int, eps: float) -> int:
-        if eps <= 0.0:
-            return greedy(s)
-        if eps >= 1.0 or rng.random() < eps:
-            return int(rng.integers(0, n))
-        return greedy(s)
-
+    agent = ALGORITHMS[algorithm](
+        n_states, n, float(q_init), float(gamma), rng, {**PARAMETER_DEFAULTS, **(params or {})}
+    )
+    if isinstance(agent, MonteCarlo):
+        assert env.spec is not None
+        limit = env.spec.max_episode_steps
+        agent.buffer_length = int(limit) if limit is not None else NO_TIME_LIMIT_LENGTH
+    if physics:
+        set_physics(env, physics)
+    visits = [[0] * n for _ in range(n_states)]
     returns: list[float] = []
     lengths: list[int] = []
     solved = None
+    kept: list[list[float]] | None = None
     for episode in range(episodes):
-        eps, rate = epsilon(episode), alpha(episode)
+        agent.epsilon, agent.alpha = epsilon_of(episode), alpha_of(episode)
+        if randomize:
+            drawn = {
+                key: physics_rng.uniform(randomize[key][0], randomize[key][1])
+                for key in RANDOMIZE_ORDER
+                if key in randomize
+            }
+            set_physics(env, drawn)
         observation, _ = env.reset(seed=env_seed if episode == 0 else None)
         s = row(observation)
-        a = choose(s, eps)
+        a: int | None = agent.draw(s)
         episode_return, length = 0.0, 0
-        while True:
+        while a is not None:
             observation, reward, terminated, truncated, _ = env.step(a)
-            length += 1
-            episode_return += reward
             s2 = row(observation)
             r = float(reward)
-            visits[s, a] += 1
-            ended = terminated or truncated
-            a2 = -1
-            if algorithm == "q_learning":
-                y = r if terminated else r + gamma * float(np.max(q[s2]))
-                q[s, a] += rate * (y - q[s, a])
-            elif algorithm == "sarsa":
-                y = r
-                if not terminated:
-                    a2 = choose(s2, eps)
-                    y = r + gamma * q[s2, a2]
-                q[s, a] += rate * (y - q[s, a])
-            elif algorithm == "expected_sarsa":
-                y = r
-                if not terminated:
-                    total = q[s2, 0]
-                    for b in range(1, n):
-                        total += q[s2, b]
-                    g = int(np.argmax(q[s2]))
-                    y = r + gamma * ((1.0 - eps) * q[s2, g] + (eps / n) * total)
-                q[s, a] += rate * (y - q[s, a])
-            else:
-                if rng.random() < 0.5:
-                    y = r if terminated else r + gamma * q_b[s2, int(np.argmax(q[s2]))]
-                    q[s, a] += rate * (y - q[s, a])
-                else:
-                    y = r if terminated else r + gamma * q[s2, int(np.argmax(q_b[s2]))]
-                    q_b[s, a] += rate * (y - q_b[s, a])
-            if ended:
-                break
-            if algorithm != "sarsa":
-                a2 = choose(s2, eps)
+            visits[s][a] += 1
+            episode_return += r
+            length += 1
+            a2 = agent.step(s, a, r, s2, bool(terminated), bool(truncated) and not terminated)
             s, a = s2, a2
         returns.append(episode_return)
         lengths.append(length)
-        if threshold is not None and episode >= 99:
-            total_return = 0.0
+        if solved is None and threshold is not None and episode >= 99:
+            total = 0.0
             for value in returns[episode - 99 : episode + 1]:
-                total_return += value
-            if total_return / 100 >= threshold:
+                total += value
+            if total / 100 >= threshold:
                 solved = episode + 1
-                break
+                kept = [list(values) for values in agent.kept_table()]
+                if stop_when_solved:
+                    break
     env.close()
-    kept = 0.5 * (q + q_b) if double else q
-    return ReferenceRun(
-        kept.reshape(*sizes, n), visits.reshape(*sizes, n), returns, lengths, solved
-    )
+    if kept is None:
+        kept = agent.kept_table()
+    q_table = np.array(kept, dtype=np.float64).reshape(*state_shape, n)
+    visit_table = np.array(visits, dtype=np.int64).reshape(*state_shape, n)
+    return ReferenceRun(q_table, visit_table, returns, lengths, solved)

@@ -1,0 +1,535 @@
+"""The package's training equals an independent re-derivation of its contract, byte for byte.
+
+``tests/reference_tabular.py`` is written from ``design.md`` and ``docs/algorithms.md`` alone
+(it imports nothing from ``cartpole_q``). Here every algorithm (each trace kind and update
+kind) is trained by the package, through its public API, on CartPole (the default grid, with
+``env.physics``, with ``env.randomize``), other Box worlds (MountainCar, Acrobot), Discrete
+worlds (FrozenLake, Taxi, CliffWalking) and a Tuple world (Blackjack), on every engine the
+world has, and compared with the re-derivation: the kept ``q_table`` bytes, the visits, the
+returns, the lengths and the solve episode.
+
+Algorithms the package does not register yet are skipped; the re-derivation's own
+self-tests (the equalities docs/algorithms.md states, and that every algorithm learns) run
+regardless.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+import yaml
+from gymnasium import spaces
+
+from cartpole_q import load_config, train
+from cartpole_q.rl.algorithms import names
+from tests.reference_tabular import (
+    ReferenceRun,
+    constant,
+    exponential,
+    make_indexer,
+    reference_train,
+    schedule,
+)
+
+DEFAULT = yaml.safe_load(
+    (Path(__file__).resolve().parents[1] / "cartpole_q" / "default.yaml").read_text("utf-8")
+)
+DEFAULT_AGENT = {
+    "gamma": DEFAULT["agent"]["gamma"],
+    "alpha": DEFAULT["agent"]["alpha"],
+    "epsilon": DEFAULT["agent"]["epsilon"],
+    "q_init": DEFAULT["agent"]["q_init"],
+}
+
+# Every algorithm, with each trace kind and update kind: id -> (algorithm, its agent keys).
+VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    "q_learning": ("q_learning", {}),
+    "sarsa": ("sarsa", {}),
+    "expected_sarsa": ("expected_sarsa", {}),
+    "double_q_learning": ("double_q_learning", {}),
+    "n_step_sarsa": ("n_step_sarsa", {"n": 3}),
+    "n_step_tree_backup": ("n_step_tree_backup", {"n": 3}),
+    **{
+        f"{name}-{trace}": (name, {"lambda": 0.8, "trace": trace})
+        for name in ("sarsa_lambda", "watkins_q_lambda")
+        for trace in ("accumulating", "replacing", "dutch")
+    },
+    "true_online_sarsa_lambda": ("true_online_sarsa_lambda", {"lambda": 0.8}),
+    "dyna_q": ("dyna_q", {"planning_steps": 5}),
+    "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
+    **{
+        f"{name}-{update}": (name, {"update": update})
+        for name in ("monte_carlo", "off_policy_monte_carlo")
+        for update in ("sample_average", "constant_alpha")
+    },
+}
+ONE_STEP = ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
+
+# Edge settings: defaults filled by the package, the special cases docs/algorithms.md names,
+# traces dropped at 0.0 (lambda = 0, or underflow with gamma * lambda ~ 0.1), an n longer
+# than any episode (every update in the final flush), no exploration bonus.
+EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    **{
+        f"{name}-defaults": (name, {})
+        for name in (
+            "n_step_sarsa",
+            "n_step_tree_backup",
+            "sarsa_lambda",
+            "watkins_q_lambda",
+            "true_online_sarsa_lambda",
+            "dyna_q",
+            "dyna_q_plus",
+            "monte_carlo",
+            "off_policy_monte_carlo",
+        )
+    },
+    "n_step_sarsa-n1": ("n_step_sarsa", {"n": 1}),
+    "n_step_tree_backup-n1": ("n_step_tree_backup", {"n": 1}),
+    "n_step_sarsa-n150": ("n_step_sarsa", {"n": 150}),
+    "n_step_tree_backup-n150": ("n_step_tree_backup", {"n": 150}),
+    "sarsa_lambda-dutch-lambda0": ("sarsa_lambda", {"lambda": 0.0, "trace": "dutch"}),
+    "sarsa_lambda-accumulating-lambda0.1": (
+        "sarsa_lambda",
+        {"lambda": 0.1, "trace": "accumulating"},
+    ),
+    "watkins_q_lambda-replacing-lambda0": ("watkins_q_lambda", {"lambda": 0.0}),
+    "watkins_q_lambda-dutch-lambda1": ("watkins_q_lambda", {"lambda": 1.0, "trace": "dutch"}),
+    "true_online_sarsa_lambda-lambda0": ("true_online_sarsa_lambda", {"lambda": 0.0}),
+    "true_online_sarsa_lambda-lambda1": ("true_online_sarsa_lambda", {"lambda": 1.0}),
+    "dyna_q-planning0": ("dyna_q", {"planning_steps": 0}),
+    "dyna_q_plus-kappa0": ("dyna_q_plus", {"planning_steps": 3, "kappa": 0.0}),
+}
+# n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
+LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")
+ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS}
+
+# The worlds: name -> everything but the algorithm (env, grid, agent, episodes, seed, ...).
+CASES: dict[str, dict[str, Any]] = {
+    # The default config (log epsilon schedule); it solves near episode 180 and goes on.
+    "cartpole": {
+        "env": {"id": "CartPole-v1"},
+        "discretization": DEFAULT["discretization"],
+        "agent": DEFAULT_AGENT,
+        "episodes": 250,
+        "seed": 1,
+    },
+    "cartpole_solve": {
+        "env": {"id": "CartPole-v1"},
+        "discretization": DEFAULT["discretization"],
+        "agent": DEFAULT_AGENT,
+        "episodes": 1000,
+        "seed": 3,
+        "stop_when_solved": True,
+    },
+    # A 200-step time limit scales the threshold to 475 * 200 / 500 = 190.
+    "cartpole_short": {
+        "env": {"id": "CartPole-v1", "kwargs": {"max_episode_steps": 200}},
+        "discretization": DEFAULT["discretization"],
+        "agent": DEFAULT_AGENT,
+        "episodes": 600,
+        "seed": 1,
+        "stop_when_solved": True,
+    },
+    "cartpole_physics": {
+        "env": {
+            "id": "CartPole-v1",
+            "physics": {
+                "length": 0.75,
+                "masspole": 0.2,
+                "kinematics_integrator": "semi-implicit euler",
+            },
+        },
+        "discretization": DEFAULT["discretization"],
+        "agent": DEFAULT_AGENT,
+        "episodes": 150,
+        "seed": 2,
+    },
+    # Keys listed out of the drawing order; a range with low == high is drawn too.
+    "cartpole_randomize": {
+        "env": {
+            "id": "CartPole-v1",
+            "physics": {"force_mag": 12.0, "length": 0.6},
+            "randomize": {
+                "length": [0.3, 0.9],
+                "tau": [0.02, 0.02],
+                "gravity": [8.0, 11.0],
+                "masspole": [0.05, 0.4],
+            },
+        },
+        "discretization": {
+            "bins": [3, 1, 4, 8],
+            "low": [-2.4, -3.0, -0.2095, -2.5],
+            "high": [2.4, 3.0, 0.2095, 2.5],
+        },
+        "agent": {
+            "gamma": 0.99,
+            "alpha": {"type": "exponential", "start": 0.5, "decay": 0.99, "end": 0.1},
+            "epsilon": {"type": "log", "k": 20, "end": 0.02, "start": 0.8},
+            "q_init": 0.0,
+        },
+        "episodes": 150,
+        "seed": 5,
+    },
+    "mountaincar": {
+        "env": {"id": "MountainCar-v0"},
+        "discretization": {"bins": [6, 5], "low": [-1.2, -0.07], "high": [0.6, 0.07]},
+        "agent": {
+            "gamma": 0.99,
+            "alpha": {"type": "log", "k": 4, "end": 0.1, "start": 0.5},
+            "epsilon": 0.2,
+            "q_init": 0.0,
+        },
+        "episodes": 15,
+        "seed": 4,
+    },
+    "acrobot": {
+        "env": {"id": "Acrobot-v1", "kwargs": {"max_episode_steps": 200}},
+        "discretization": {
+            "bins": [2, 1, 2, 1, 4, 4],
+            "low": [-1.0, -1.0, -1.0, -1.0, -6.0, -12.0],
+            "high": [1.0, 1.0, 1.0, 1.0, 6.0, 12.0],
+        },
+        "agent": {"gamma": 0.99, "alpha": 0.2, "epsilon": 0.1, "q_init": 0.0},
+        "episodes": 10,
+        "seed": 6,
+    },
+    "frozenlake": {
+        "env": {"id": "FrozenLake-v1"},
+        "agent": {
+            "gamma": 0.99,
+            "alpha": {"type": "exponential", "start": 0.5, "decay": 0.995, "end": 0.05},
+            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.995, "end": 0.1},
+            "q_init": 0.0,
+        },
+        "episodes": 400,
+        "seed": 7,
+    },
+    "taxi": {
+        "env": {"id": "Taxi-v4"},
+        "agent": {
+            "gamma": 0.95,
+            "alpha": {"type": "constant", "value": 0.5},
+            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.97, "end": 0.05},
+            "q_init": 0.0,
+        },
+        "episodes": 120,
+        "seed": 8,
+    },
+    # No time limit: Monte Carlo's buffer is 10,000 steps long.
+    "cliffwalking": {
+        "env": {"id": "CliffWalking-v1"},
+        "agent": {"gamma": 1.0, "alpha": 0.5, "epsilon": 0.2, "q_init": 0.0},
+        "episodes": 30,
+        "seed": 9,
+    },
+    "blackjack": {
+        "env": {"id": "Blackjack-v1"},
+        "agent": {
+            "gamma": 1.0,
+            "alpha": 0.1,
+            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.995, "end": 0.05},
+            "q_init": 0.0,
+        },
+        "episodes": 600,
+        "seed": 10,
+    },
+}
+# Worlds with a compiled twin train on both engines.
+NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
+NUMBA_WORLDS |= {"cartpole_randomize"}
+NUMBA_WORLDS |= {"mountaincar", "acrobot"}
+
+
+def _config(case: dict[str, Any], algorithm: str, params: dict[str, Any], engine: str) -> Any:
+    """The package's config of one world, algorithm and engine (small final evaluation)."""
+    mapping: dict[str, Any] = {
+        "name": "rederivation",
+        "seed": case["seed"],
+        "engine": engine,
+        "env": {
+            "id": case["env"]["id"],
+            "kwargs": case["env"].get("kwargs", {}),
+            "physics": case["env"].get("physics", {}),
+            "randomize": case["env"].get("randomize", {}),
+        },
+        "agent": {"algorithm": algorithm, **case["agent"], **params},
+        "train": {
+            "episodes": case["episodes"],
+            "stop_when_solved": case.get("stop_when_solved", False),
+            "reward_threshold": None,
+            "eval_every": 0,
+            "checkpoint_every": 0,
+        },
+        "eval": {"episodes": 1},
+    }
+    if "discretization" in case:
+        mapping["discretization"] = case["discretization"]
+    return load_config(mapping)
+
+
+@functools.cache
+def _reference(world: str, variant: str, **overrides: Any) -> ReferenceRun:
+    """The re-derivation of one world and variant (computed once per session)."""
+    case = CASES[world]
+    algorithm, params = ALL_VARIANTS[variant]
+    options: dict[str, Any] = {
+        "algorithm": algorithm,
+        "params": params,
+        "episodes": case["episodes"],
+        "seed": case["seed"],
+        "kwargs": case["env"].get("kwargs"),
+        "physics": case["env"].get("physics"),
+        "randomize": case["env"].get("randomize"),
+        "discretization": case.get("discretization"),
+        "stop_when_solved": case.get("stop_when_solved", False),
+        **case["agent"],
+    }
+    options.update(overrides)
+    return reference_train(case["env"]["id"], **options)
+
+
+def _skip_unless_registered(variant: str) -> None:
+    algorithm = ALL_VARIANTS[variant][0]
+    if algorithm not in names():
+        pytest.skip(f"{algorithm} is not implemented yet")
+
+
+def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
+    """Train with the package and assert every output equals the re-derivation's."""
+    _skip_unless_registered(variant)
+    algorithm, params = ALL_VARIANTS[variant]
+    result = train(_config(CASES[world], algorithm, params, engine))
+    expected = _reference(world, variant)
+    assert result.engine == engine
+    assert result.returns.tolist() == expected.returns
+    assert result.lengths.tolist() == expected.lengths
+    assert result.solved_episode == expected.solved_episode
+    assert result.visits.shape == expected.visits.shape
+    assert result.visits.tobytes() == expected.visits.tobytes()
+    assert result.q_table.shape == expected.q_table.shape
+    assert result.q_table.dtype == np.float64
+    assert result.q_table.tobytes() == expected.q_table.tobytes()
+    return expected
+
+
+def _params(worlds: list[str], variants: list[str], slow: str = "none") -> list[Any]:
+    """``(world, variant, engine)`` for every engine of each world.
+
+    Args:
+        worlds: Names in ``CASES``.
+        variants: Names in ``ALL_VARIANTS``.
+        slow: Which to mark ``slow``: ``"none"``, ``"all"``, or ``"beyond_one_step"`` (all
+            but design.md's four one-step algorithms).
+
+    Returns:
+        The ``pytest.param`` list, one per world, variant and engine.
+    """
+    out = []
+    for world in worlds:
+        engines = ["numba", "gymnasium"] if world in NUMBA_WORLDS else ["gymnasium"]
+        for variant in variants:
+            marked = slow == "all" or (slow == "beyond_one_step" and variant not in ONE_STEP)
+            marks = [pytest.mark.slow] if marked else []
+            for engine in engines:
+                name = f"{world}-{variant}-{engine}"
+                out.append(pytest.param(world, variant, engine, marks=marks, id=name))
+    return out
+
+
+@pytest.mark.parametrize(("world", "variant", "engine"), _params(["cartpole"], list(VARIANTS)))
+def test_cartpole_default_grid(world: str, variant: str, engine: str) -> None:
+    """CartPole-v1, the default config's grid and agent, 250 episodes past the solve point."""
+    expected = _assert_same(world, variant, engine)
+    assert sum(expected.lengths) > 2000  # not a few short episodes
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    _params(["frozenlake", "taxi", "blackjack"], list(VARIANTS)),
+)
+def test_discrete_and_tuple_worlds(world: str, variant: str, engine: str) -> None:
+    """Discrete observations (FrozenLake, Taxi) and a Tuple of Discrete (Blackjack)."""
+    _assert_same(world, variant, engine)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    _params(["cartpole_physics", "cartpole_randomize"], list(VARIANTS), slow="beyond_one_step"),
+)
+def test_cartpole_physics_and_randomized_physics(world: str, variant: str, engine: str) -> None:
+    """``env.physics`` set after make; ``env.randomize`` drawn before every episode's reset."""
+    _assert_same(world, variant, engine)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    _params(["mountaincar", "acrobot", "cliffwalking"], list(VARIANTS), slow="beyond_one_step"),
+)
+def test_other_worlds(world: str, variant: str, engine: str) -> None:
+    """Other Box grids (MountainCar, Acrobot with a 200-step limit); CliffWalking: no limit."""
+    _assert_same(world, variant, engine)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    [
+        *_params(["frozenlake"], list(EDGE_VARIANTS)),
+        *_params(["cartpole"], [v for v in EDGE_VARIANTS if v not in LONG_N], slow="all"),
+    ],
+)
+def test_edge_parameters(world: str, variant: str, engine: str) -> None:
+    """Defaults, special cases, traces dropped at 0.0, an n beyond every episode."""
+    _assert_same(world, variant, engine)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    _params(["cartpole_solve", "cartpole_short"], ["q_learning", "expected_sarsa"]),
+)
+def test_a_run_that_solves_stops_there(world: str, variant: str, engine: str) -> None:
+    """``stop_when_solved: true``: training ends with the solve episode."""
+    expected = _assert_same(world, variant, engine)
+    assert expected.solved_episode is not None
+    assert len(expected.returns) == expected.solved_episode < CASES[world]["episodes"]
+    if world == "cartpole_short":  # solved below 475: the threshold was scaled to 190
+        assert 190 <= sum(expected.returns[-100:]) / 100 < 200
+
+
+def test_the_default_run_solves_then_keeps_the_solve_point_table() -> None:
+    """With stop_when_solved false, training goes on but the table kept is the solve point's."""
+    expected = _reference("cartpole", "q_learning")
+    assert expected.solved_episode is not None
+    assert expected.solved_episode < len(expected.returns) == CASES["cartpole"]["episodes"]
+    last = _reference("cartpole", "q_learning", threshold=None)
+    assert last.solved_episode is None and last.returns == expected.returns
+    assert last.q_table.tobytes() != expected.q_table.tobytes()
+
+
+# The re-derivation's own checks: docs/algorithms.md's stated equalities, and learning.
+
+EQUALITIES: dict[str, tuple[str, dict[str, Any], str]] = {
+    "n_step_sarsa n=1 is sarsa": ("n_step_sarsa", {"n": 1}, "sarsa"),
+    "n_step_tree_backup n=1 is expected_sarsa": ("n_step_tree_backup", {"n": 1}, "expected_sarsa"),
+    **{
+        f"sarsa_lambda {trace} lambda=0 is sarsa": (
+            "sarsa_lambda",
+            {"lambda": 0.0, "trace": trace},
+            "sarsa",
+        )
+        for trace in ("accumulating", "replacing", "dutch")
+    },
+    **{
+        f"watkins_q_lambda {trace} lambda=0 is q_learning": (
+            "watkins_q_lambda",
+            {"lambda": 0.0, "trace": trace},
+            "q_learning",
+        )
+        for trace in ("accumulating", "replacing", "dutch")
+    },
+    "dyna_q planning_steps=0 is q_learning": ("dyna_q", {"planning_steps": 0}, "q_learning"),
+}
+
+
+@pytest.mark.parametrize("world", ["frozenlake", "cartpole_randomize"])
+@pytest.mark.parametrize("equality", list(EQUALITIES))
+def test_reference_equalities_stated_in_the_docs(equality: str, world: str) -> None:
+    """The re-derivation's special cases equal their one-step methods byte for byte."""
+    algorithm, params, twin = EQUALITIES[equality]
+    case = CASES[world]
+    common: dict[str, Any] = {
+        "episodes": 60,
+        "seed": case["seed"],
+        "physics": case["env"].get("physics"),
+        "randomize": case["env"].get("randomize"),
+        "discretization": case.get("discretization"),
+        "stop_when_solved": False,
+        **case["agent"],
+    }
+    left = reference_train(case["env"]["id"], algorithm=algorithm, params=params, **common)
+    right = reference_train(case["env"]["id"], algorithm=twin, **common)
+    assert left.q_table.tobytes() == right.q_table.tobytes()
+    assert left.visits.tobytes() == right.visits.tobytes()
+    assert left.returns == right.returns and left.lengths == right.lengths
+
+
+@pytest.mark.parametrize("variant", list(VARIANTS))
+def test_reference_algorithms_learn_on_frozenlake(variant: str) -> None:
+    """Every re-derived algorithm runs, reaches the goal and values the start state."""
+    algorithm, params = VARIANTS[variant]
+    run = reference_train(
+        "FrozenLake-v1",
+        algorithm=algorithm,
+        params=params,
+        gamma=0.99,
+        alpha=0.1,
+        epsilon={"type": "exponential", "start": 1.0, "decay": 0.998, "end": 0.1},
+        q_init=0.0,
+        episodes=1500,
+        seed=11,
+        stop_when_solved=False,
+    )
+    assert run.visits.sum() == sum(run.lengths)
+    assert sum(run.returns) > 20  # the goal (reward 1) is reached again and again
+    assert run.q_table[0].max() > 0.0  # value reached the start state
+    assert np.isfinite(run.q_table).all()
+
+
+def test_reference_binning_rule_by_hand() -> None:
+    """design.md: ``clip(floor((x - low) / (high - low) * bins), 0, bins - 1)``, NaN in bin 0."""
+    space = spaces.Box(-np.inf, np.inf, shape=(3,), dtype=np.float32)
+    grid: dict[str, Any] = {"bins": [4, 1, 3], "low": [-1.0, -5.0, 0.0], "high": [1.0, 5.0, 3.0]}
+    shape, row = make_indexer(space, grid)
+    assert shape == (4, 1, 3)
+    assert row(np.array([0.0, 100.0, 1.0], dtype=np.float32)) == 2 * 3 + 1
+    assert row(np.array([-7.0, np.nan, 99.0], dtype=np.float32)) == 0 * 3 + 2
+    assert row(np.array([np.nan, 0.0, -np.inf], dtype=np.float32)) == 0
+    assert row(np.array([np.inf, 0.0, 2.999], dtype=np.float32)) == 3 * 3 + 2
+    # The float32 value, widened: float32(0.1) is a little above 0.1, so it lands in bin 1.
+    one: dict[str, Any] = {"bins": [10], "low": [0.0], "high": [1.0]}
+    assert (
+        make_indexer(spaces.Box(0.0, 1.0, shape=(1,)), one)[1](np.array([0.1], dtype=np.float32))
+        == 1
+    )
+    assert (
+        make_indexer(spaces.Box(0.0, 1.0, shape=(1,)), one)[1](np.array([0.3], dtype=np.float32))
+        == 3
+    )
+
+
+def test_reference_schedules_by_hand() -> None:
+    """design.md's three schedule forms (and the README's ``{type: constant, value}``)."""
+    assert schedule(0.25)(7) == 0.25
+    assert schedule({"type": "constant", "value": 0.2})(3) == 0.2
+    assert schedule({"type": "exponential", "start": 1.0, "decay": 0.5, "end": 0.1})(3) == 0.125
+    assert schedule({"type": "exponential", "start": 1.0, "decay": 0.5, "end": 0.1})(4) == 0.1
+    log = schedule({"type": "log", "k": 10, "end": 0.05})
+    assert log(0) == 1.0 and log(9) == 1.0 and log(99) == 0.05
+    assert log(19) == 1 - math.log10(2.0)
+    assert schedule({"type": "log", "k": 10, "end": 0.0, "start": 0.5})(0) == 0.5
+
+
+def test_reference_takes_schedule_functions_and_a_threshold() -> None:
+    """The older call (tests/test_discrete.py): schedule functions and a number threshold."""
+    common: dict[str, Any] = {"algorithm": "sarsa", "gamma": 0.95, "q_init": 0.5, "seed": 3}
+    old = reference_train(
+        "FrozenLake-v1",
+        alpha=constant(0.3),
+        epsilon=exponential(1.0, 0.99, 0.05),
+        episodes=150,
+        threshold=0.7,
+        **common,
+    )
+    new = reference_train(
+        "FrozenLake-v1",
+        alpha=0.3,
+        epsilon={"type": "exponential", "start": 1.0, "decay": 0.99, "end": 0.05},
+        episodes=150,
+        **common,
+    )
+    assert old.q_table.tobytes() == new.q_table.tobytes()
+    assert old.returns == new.returns and old.solved_episode == new.solved_episode
