@@ -8,7 +8,11 @@ Rows:
   gymnasium engine  cartpole-q's Python loop on gymnasium.make, same grid
   numba engine      the compiled twin and agent, same grid (one thread, compile excluded)
   + progress bar    the gymnasium engine with the live rich progress bar drawing
-  algorithms        each agent.algorithm on the numba engine, against Q-learning
+  algorithms        every registered agent.algorithm on the numba engine, against Q-learning:
+                    env steps/s and Q-entry updates/s (env steps/s times the mean number of
+                    Q entries written per env step, counted on the tests' plain-Python
+                    re-derivation of the same config: a trace method writes every traced
+                    pair, Dyna 1 + planning_steps, Monte Carlo one per first visit)
   environments      MountainCar-v0 and Acrobot-v1: their twins against the gymnasium engine
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
@@ -21,7 +25,10 @@ import argparse
 import io
 import math
 import statistics
+import sys
 import time
+from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -30,7 +37,11 @@ from rich.console import Console
 from cartpole_q.config import load_config
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.progress import RichReporter
+from cartpole_q.rl.algorithms import names as algorithm_names
 from cartpole_q.training import train
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+import reference_tabular  # the tests' plain-Python re-derivation of the contract
 
 BLOG_BINS = (10, 10, 10, 10)
 BLOG_LOW = (-4.8, -1.0, -0.418, -1.0)
@@ -102,6 +113,47 @@ def engine_rate(
         if reporter is not None:
             reporter.close()
     return result.env_steps, result.train_seconds
+
+
+class CountingRow(list):  # type: ignore[type-arg]
+    """A Q-table row that counts the writes made to it."""
+
+    writes = 0
+
+    def __setitem__(self, index: Any, value: Any) -> None:
+        CountingRow.writes += 1
+        super().__setitem__(index, value)
+
+
+def updates_per_step(algorithm: str, episodes: int = 40, seed: int = 0) -> float:
+    """Q entries written per env step by ``algorithm`` on the default config (plain Python).
+
+    The writes to every Q-table the algorithm keeps (Double Q's two) are counted on the
+    re-derivation in ``tests/reference_tabular.py``, which follows the same contract.
+    """
+    config = load_config(None, {"agent.algorithm": algorithm}).to_dict()
+    agent, disc = config["agent"], config["discretization"]
+    base = reference_tabular.ALGORITHMS[algorithm]
+
+    class Counting(base):  # type: ignore[valid-type, misc]
+        def __init__(self, *args: Any) -> None:
+            super().__init__(*args)
+            for name in ("q", "q_b"):
+                if hasattr(self, name):
+                    setattr(self, name, [CountingRow(row) for row in getattr(self, name)])
+
+    reference_tabular.ALGORITHMS[algorithm] = Counting
+    CountingRow.writes = 0
+    try:
+        params = {key: agent[key] for key in reference_tabular.PARAMETER_DEFAULTS if key in agent}
+        run = reference_tabular.reference_train(
+            config["env"]["id"], algorithm=algorithm, gamma=agent["gamma"], alpha=agent["alpha"],
+            epsilon=agent["epsilon"], q_init=agent["q_init"], episodes=episodes, seed=seed,
+            stop_when_solved=False, discretization=disc, params=params,
+        )  # fmt: skip
+    finally:
+        reference_tabular.ALGORITHMS[algorithm] = base
+    return CountingRow.writes / sum(run.lengths)
 
 
 def median_rate(measure, repeats: int) -> float:  # type: ignore[no-untyped-def]
@@ -178,16 +230,21 @@ def main() -> None:
     # Each algorithm on the numba engine, default config, against Q-learning in the same run.
     print()
     print(
-        f"{'algorithm, numba engine, default config':40s} {'env steps/s':>14s} {'vs q_learning':>13s}"
+        f"{'algorithm, numba engine, default config':40s} {'env steps/s':>14s} "
+        f"{'vs q_learning':>13s} {'updates/step':>13s} {'updates/s':>14s}"
     )
     q_learning = rows[4][1]
-    for algorithm in ("q_learning", "sarsa", "expected_sarsa", "double_q_learning"):
+    for algorithm in algorithm_names():
         engine_rate(None, "numba", 5, 0, algorithm=algorithm)  # compile or load the cache
         rate = median_rate(
             lambda a=algorithm: engine_rate(None, "numba", numba_episodes // 10, 0, algorithm=a),
             args.repeats,
         )
-        print(f"{algorithm:40s} {rate:14,.0f} {rate / q_learning:12.0%}")
+        per_step = updates_per_step(algorithm)
+        print(
+            f"{algorithm:40s} {rate:14,.0f} {rate / q_learning:12.0%} {per_step:13.2f} "
+            f"{rate * per_step:14,.0f}"
+        )
 
     # The other twins: numba against the gymnasium engine on the same config.
     print()
