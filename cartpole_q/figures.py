@@ -152,6 +152,52 @@ def _draw_reward_curves(
     axes.legend(loc="best", fontsize="small")
 
 
+@dataclass(frozen=True)
+class MetricBand:
+    """One run set's learning curve of a metric: per seed, and aggregated with a band."""
+
+    label: str
+    x: np.ndarray
+    per_seed: np.ndarray
+    """``(seeds, len(x))``, NaN where a seed has no value"""
+    centre: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    aggregate: str
+    """``mean`` or ``iqm``"""
+
+
+def metric_curve_figure(
+    bands: Sequence[MetricBand], x_label: str, y_label: str, title: str, log_y: bool = False
+) -> Figure:
+    """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
+
+    One run (a single seed) is drawn as its line alone.
+    """
+    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    for band, colour in zip(bands, _colours(len(bands)), strict=True):
+        seeds = band.per_seed.shape[0]
+        if seeds == 1:
+            axes.plot(band.x, band.centre, color=colour, linewidth=1.6, label=band.label)
+            continue
+        if seeds <= 50:  # more faint lines only grey the figure
+            for row in band.per_seed:
+                axes.plot(band.x, row, color=colour, alpha=0.12, linewidth=0.6)
+        axes.fill_between(band.x, band.low, band.high, color=colour, alpha=0.3, linewidth=0)
+        name = "mean" if band.aggregate == "mean" else "IQM"
+        axes.plot(band.x, band.centre, color=colour, linewidth=2.0,
+                  label=f"{band.label}: {name} of {seeds} seeds, 95% CI")  # fmt: skip
+    if log_y:
+        axes.set_yscale("log")
+    axes.set_xlabel(x_label)
+    axes.set_ylabel(y_label)
+    axes.set_title(title, fontsize="medium")
+    axes.grid(alpha=0.3, which="both" if log_y else "major")
+    axes.legend(loc="best", fontsize="small")
+    return figure
+
+
 def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
     bands = sum(isinstance(item, SeedBand) for item in curves)
     average = f"{SOLVE_WINDOW}-episode average"

@@ -162,12 +162,71 @@ def plot(
             show_default="the seeds' majority action and their agreement",
         ),
     ] = None,
+    metric: Annotated[
+        str | None,
+        typer.Option(
+            metavar="METRIC",
+            help="Draw learning curves of this per-episode metric instead of the reward "
+            "figure: return, length (steps per episode), cumulative-return or episodes "
+            "(episodes completed), each seed faint, the seeds' aggregate bold with a 95% "
+            "bootstrap band.",
+            show_default="the reward figure (return, 100-episode average, solve marks)",
+        ),
+    ] = None,
+    x_axis: Annotated[
+        str,
+        typer.Option("--x", metavar="AXIS", help="With --metric: against episode or env-steps."),
+    ] = "episode",
+    aggregate: Annotated[
+        str,
+        typer.Option(
+            metavar="AGG",
+            help="With --metric: combine seeds by their mean or iqm (interquartile mean).",
+        ),
+    ] = "mean",
+    smooth: Annotated[
+        int,
+        typer.Option(
+            metavar="N",
+            min=1,
+            help="With --metric return or length: a trailing N-episode moving average per seed.",
+        ),
+    ] = 1,
+    log_y: Annotated[
+        bool, typer.Option("--log-y", help="With --metric: a logarithmic y axis.")
+    ] = False,
 ) -> None:
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with exit_codes():
-        from cartpole_q.experiments.plots import plot_policy, plot_rewards
+        from cartpole_q.experiments.plots import plot_metric, plot_policy, plot_rewards
+        from cartpole_q.learning_curves import AGGREGATES, METRICS, X_AXES
         from cartpole_q.store.rundir import CURVE_FILE
 
+        curve_options = x_axis != "episode" or aggregate != "mean" or smooth != 1 or log_y
+        if metric is None and curve_options:
+            raise UserError("--x, --aggregate, --smooth and --log-y apply to --metric only.")
+        for option, value, choices in (
+            ("--metric", metric, METRICS), ("--x", x_axis, X_AXES),
+            ("--aggregate", aggregate, AGGREGATES),
+        ):  # fmt: skip
+            if value is not None and value not in choices:
+                raise UserError(f"{option} {value}: not one of {', '.join(choices)}.")
+        if metric is not None:
+            if policy:
+                raise UserError(
+                    "--metric draws learning curves; --policy a policy map: one of them."
+                )
+            if dims is not None or seed is not None:
+                raise UserError("--dims and --seed only apply to --policy.")
+            name = Path(f"{metric}_by_{x_axis}.png")
+            default = run_dirs[0] / name if len(run_dirs) == 1 else name
+            replace = force or (out is None and len(run_dirs) == 1)
+            path = plot_metric(
+                run_dirs, out or default, metric, x_axis, aggregate, smooth, log_y, replace,
+                on_note=note,
+            )  # fmt: skip
+            typer.echo(str(path))
+            return
         if policy:
             if len(run_dirs) != 1:
                 raise UserError("--policy draws one run: give exactly one run directory.")

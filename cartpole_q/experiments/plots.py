@@ -19,6 +19,7 @@ from cartpole_q.figures import (
     FIGURE_FORMATS,
     Curve,
     GridMap,
+    MetricBand,
     SeedBand,
     action_names,
     blackjack_policy_figure,
@@ -26,10 +27,12 @@ from cartpole_q.figures import (
     dimension_names,
     figure_bytes,
     grid_policy_figure,
+    metric_curve_figure,
     policy_figure,
     reward_and_paths_figure,
     reward_curve_figure,
 )
+from cartpole_q.learning_curves import METRIC_LABELS, X_LABELS, aggregate_band, seed_curves
 from cartpole_q.profiles import profile_for
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
@@ -91,6 +94,65 @@ def plot_rewards(
         figure = reward_and_paths_figure(items, None, title, grid, paths)
     else:
         figure = reward_curve_figure(items, None, title)
+    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
+    return out
+
+
+def plot_metric(
+    run_dirs: Sequence[Path],
+    out: Path,
+    metric: str,
+    x: str,
+    aggregate: str = "mean",
+    window: int = 1,
+    log_y: bool = False,
+    force: bool = False,
+    on_note: Callable[[str], None] | None = None,
+) -> Path:
+    """Draw a metric's learning curves of runs, multi-seed runs and sweep points.
+
+    Args:
+        run_dirs: Run directories, multi-seed runs or sweep points, one curve each.
+        out: A ``.png``, ``.svg`` or ``.pdf`` file.
+        metric: One of :data:`cartpole_q.learning_curves.METRICS`.
+        x: One of :data:`cartpole_q.learning_curves.X_AXES`.
+        aggregate: ``mean`` or ``iqm`` over seeds.
+        window: Trailing moving average of per-episode values (``return``, ``length``).
+        log_y: A logarithmic y axis (S&B Fig. 10.2's steps per episode).
+        force: Replace ``out`` if it exists.
+        on_note: Told what is unfinished or left out.
+
+    Raises:
+        RunError: A directory is not a complete run, or a sweep point kept no curves.
+        WriteError: ``out`` cannot be written (checked before the figure is drawn).
+    """
+    bands = []
+    for path in run_dirs:
+        run_set = load_run_set(path)
+        for note in run_set.notes:
+            if on_note is not None:
+                on_note(note)
+        runs = run_set.runs
+        if not any(run.metrics.returns.size for run in runs):
+            raise RunError(
+                f"{path}: this sweep kept no learning curves (its sweep file says curves: "
+                "false, or it predates them); there is nothing to draw."
+            )
+        curves = seed_curves(
+            [run.metrics.returns for run in runs], [run.metrics.lengths for run in runs],
+            metric, x, window,
+        )  # fmt: skip
+        centre, low, high = aggregate_band(curves.values, aggregate, np.random.default_rng(0))
+        label = f"point {path.name}" if run_set.kind == "sweep point" else path.name
+        bands.append(MetricBand(label, curves.x, curves.values, centre, low, high, aggregate))
+    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    y_label = METRIC_LABELS[metric]
+    if window > 1 and metric in ("return", "length"):
+        y_label += f" ({window}-episode average)"
+    title = f"{METRIC_LABELS[metric].capitalize()} by {X_LABELS[x]}"
+    if len(run_dirs) == 1:
+        title += f": {run_dirs[0].name}"
+    figure = metric_curve_figure(bands, X_LABELS[x], y_label, title, log_y)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 

@@ -1,0 +1,133 @@
+"""Learning curves of any metric across seeds, and ``plot --metric``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from matplotlib.image import imread
+
+from cartpole_q.learning_curves import (
+    aggregate_band,
+    interquartile_mean,
+    per_episode,
+    seed_curves,
+    smooth,
+)
+from tests.conftest import invoke
+
+
+def test_per_episode_metrics_by_hand() -> None:
+    returns, lengths = np.array([1.0, -2.0, 4.0]), np.array([10, 20, 5])
+    assert per_episode(returns, lengths, "return").tolist() == [1.0, -2.0, 4.0]
+    assert per_episode(returns, lengths, "length").tolist() == [10.0, 20.0, 5.0]
+    assert per_episode(returns, lengths, "cumulative-return").tolist() == [1.0, -1.0, 3.0]
+    assert per_episode(returns, lengths, "episodes").tolist() == [1.0, 2.0, 3.0]
+    with pytest.raises(ValueError, match="unknown metric"):
+        per_episode(returns, lengths, "reward")
+
+
+def test_an_env_steps_grid_is_a_step_function_of_finished_episodes() -> None:
+    # seed 0 finishes episodes at steps 10, 30, 35; seed 1 at 5, 10 and then stops
+    curves = seed_curves(
+        [np.array([1.0, 2.0, 3.0]), np.array([5.0, 6.0])],
+        [np.array([10, 20, 5]), np.array([5, 5])],
+        "cumulative-return",
+        "env-steps",
+    )
+    assert curves.x[0] == 0.0 and curves.x[-1] == 35.0
+    at = {float(x): i for i, x in enumerate(curves.x)}
+    first = curves.values[0]
+    assert first[0] == 0.0  # nothing finished: a running total of 0
+    assert first[-1] == 6.0
+    # before step 10 seed 0 has finished nothing; from 10 to 30 one episode
+    for i, x in enumerate(curves.x):
+        expected = 0.0 if x < 10 else 1.0 if x < 30 else 3.0 if x < 35 else 6.0
+        assert first[i] == expected, x
+    second = curves.values[1]
+    assert np.isnan(second[curves.x > 10]).all()  # it stopped training at step 10
+    assert second[at[0.0]] == 0.0
+    # a per-episode metric has no value before its first episode ends
+    lengths = seed_curves([np.array([1.0])], [np.array([10])], "length", "env-steps")
+    assert np.isnan(lengths.values[0][lengths.x < 10]).all()
+    assert (lengths.values[0][lengths.x >= 10] == 10.0).all()
+
+
+def test_an_episode_grid_pads_shorter_seeds_with_nan_and_smooths_per_seed() -> None:
+    curves = seed_curves(
+        [np.array([2.0, 4.0, 6.0]), np.array([1.0])],
+        [np.array([1, 1, 1]), np.array([1])],
+        "return",
+        "episode",
+        window=2,
+    )
+    assert curves.x.tolist() == [1.0, 2.0, 3.0]
+    assert curves.values[0].tolist() == [2.0, 3.0, 5.0]
+    assert curves.values[1][0] == 1.0 and np.isnan(curves.values[1][1:]).all()
+    assert smooth(np.array([1.0, 2.0]), 1).tolist() == [1.0, 2.0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(-1e6, 1e6), min_size=1, max_size=40))
+def test_the_interquartile_mean_is_the_mean_of_the_middle_half(values: list[float]) -> None:
+    ordered = sorted(values)
+    cut = len(values) // 4
+    expected = float(np.mean(ordered[cut : len(values) - cut]))
+    got = interquartile_mean(np.array(values)[:, None])[0]
+    assert got == pytest.approx(expected, rel=1e-12, abs=1e-9)
+    # NaN (a seed without a value there) is left out, as if the seed were absent
+    with_nan = np.array([*values, np.nan])[:, None]
+    assert interquartile_mean(with_nan)[0] == pytest.approx(expected, rel=1e-12, abs=1e-9)
+
+
+@pytest.mark.parametrize("aggregate", ["mean", "iqm"])
+def test_the_band_holds_the_aggregate_and_collapses_for_equal_seeds(aggregate: str) -> None:
+    rng = np.random.default_rng(3)
+    curves = rng.normal(size=(30, 12))
+    centre, low, high = aggregate_band(curves, aggregate, np.random.default_rng(0), 200)
+    assert (low <= centre + 1e-12).all() and (centre <= high + 1e-12).all()
+    assert (high - low > 0).all()
+    if aggregate == "mean":
+        assert centre == pytest.approx(curves.mean(axis=0))
+    same = np.tile(np.arange(5.0), (8, 1))
+    centre, low, high = aggregate_band(same, aggregate, np.random.default_rng(0), 50)
+    assert centre.tolist() == low.tolist() == high.tolist() == [0.0, 1.0, 2.0, 3.0, 4.0]
+    with pytest.raises(ValueError, match="unknown aggregate"):
+        aggregate_band(same, "median", np.random.default_rng(0))
+
+
+def test_plot_metric_draws_seeds_against_env_steps(in_tmp: Path) -> None:
+    trained = invoke(
+        "train", "--seeds", "0-2", "--episodes", "30", "--workers", "1", "-q", "--out", "runs/m",
+        "--set", "train.stop_when_solved=false",
+    )  # fmt: skip
+    assert trained.exit_code == 0, trained.output
+    result = invoke("plot", "runs/m", "--metric", "length", "--x", "env-steps", "--log-y")
+    assert result.exit_code == 0, result.output
+    written = Path(result.output.strip())
+    assert written == Path("runs/m/length_by_env-steps.png")
+    assert imread(written).shape[:2] == (450, 800)
+    result = invoke("plot", "runs/m", "--metric", "return", "--aggregate", "iqm", "--smooth",
+                    "10", "--out", "r.svg")  # fmt: skip
+    assert result.exit_code == 0 and Path("r.svg").read_text().startswith("<?xml")
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--x", "env-steps"], "apply to --metric only"),
+        (["--metric", "reward"], "--metric reward: not one of return, length"),
+        (["--metric", "length", "--x", "time"], "--x time: not one of episode, env-steps"),
+        (["--metric", "length", "--policy"], "one of them"),
+    ],
+)
+def test_plot_metric_refuses_bad_options_before_drawing(
+    in_tmp: Path, args: list[str], message: str
+) -> None:
+    Path("runs").mkdir()
+    result = invoke("plot", "runs", *args)
+    assert result.exit_code == 2
+    assert message in result.output
