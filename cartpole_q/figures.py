@@ -168,11 +168,17 @@ class MetricBand:
 
 
 def metric_curve_figure(
-    bands: Sequence[MetricBand], x_label: str, y_label: str, title: str, log_y: bool = False
+    bands: Sequence[MetricBand],
+    x_label: str,
+    y_label: str,
+    title: str,
+    log_y: bool = False,
+    reference: tuple[float, str] | None = None,
 ) -> Figure:
     """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
 
-    One run (a single seed) is drawn as its line alone.
+    One run (a single seed) is drawn as its line alone. ``reference`` is a dashed
+    horizontal line and its legend label (an optimum, the book's figure).
     """
     figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
@@ -188,6 +194,9 @@ def metric_curve_figure(
         name = "mean" if band.aggregate == "mean" else "IQM"
         axes.plot(band.x, band.centre, color=colour, linewidth=2.0,
                   label=f"{band.label}: {name} of {seeds} seeds, 95% CI")  # fmt: skip
+    if reference is not None:
+        axes.axhline(reference[0], color="black", linestyle="--", linewidth=1.0,
+                     label=reference[1])  # fmt: skip
     if log_y:
         axes.set_yscale("log")
     axes.set_xlabel(x_label)
@@ -389,13 +398,14 @@ class GridMap:
     rows: int
     columns: int
     cells: Sequence[str]
-    """per state ``row * columns + column``: ``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal"""
+    """per state ``row * columns + column``: ``S`` start, ``F`` free, ``H`` hole, ``C`` cliff,
+    ``G`` goal, ``#`` wall, ``E`` an end that is not the goal"""
     moves: Sequence[tuple[int, int]]
-    """per action: ``(row step, column step)``"""
+    """per action: ``(row step, column step)``; ``(0, 0)`` stays"""
 
 
-_CELL_COLOURS = {"H": "#30405a", "C": "#3a3a3a", "G": "#3c9a4a"}
-_CELL_NAMES = {"H": "hole", "C": "cliff", "G": "goal", "S": "start"}
+_CELL_COLOURS = {"H": "#30405a", "C": "#3a3a3a", "G": "#3c9a4a", "#": "#6b6b6b", "E": "#9a3c3c"}
+_CELL_NAMES = {"H": "hole", "C": "cliff", "G": "goal", "S": "start", "#": "wall", "E": "end"}
 
 
 def _draw_grid(axes: Axes, grid: GridMap, values: np.ndarray | None = None) -> None:
@@ -454,6 +464,9 @@ def grid_policy_figure(
             continue
         row, column = divmod(state, grid.columns)
         d_row, d_col = grid.moves[int(np.argmax(q[state]))]
+        if (d_row, d_col) == (0, 0):  # an arrow of no length would not show: a dot stays
+            axes.plot(column, row, marker="o", color="white", markersize=5, zorder=3)
+            continue
         axes.annotate("", xy=(column + 0.32 * d_col, row + 0.32 * d_row),
                       xytext=(column - 0.32 * d_col, row - 0.32 * d_row),
                       arrowprops={"arrowstyle": "->", "color": "white", "linewidth": 1.8},

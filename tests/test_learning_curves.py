@@ -102,7 +102,7 @@ def test_the_band_holds_the_aggregate_and_collapses_for_equal_seeds(aggregate: s
 def test_plot_metric_draws_seeds_against_env_steps(in_tmp: Path) -> None:
     trained = invoke(
         "train", "--seeds", "0-2", "--episodes", "30", "--workers", "1", "-q", "--out", "runs/m",
-        "--set", "train.stop_when_solved=false",
+        "--set", "train.stop_when_solved=false", "--engine", "gymnasium",
     )  # fmt: skip
     assert trained.exit_code == 0, trained.output
     result = invoke("plot", "runs/m", "--metric", "length", "--x", "env-steps", "--log-y")
@@ -131,3 +131,57 @@ def test_plot_metric_refuses_bad_options_before_drawing(
     result = invoke("plot", "runs", *args)
     assert result.exit_code == 2
     assert message in result.output
+
+
+def _sweep_file(path: Path, figure: object) -> Path:
+    from tests.conftest import write_yaml
+
+    return write_yaml(path, {
+        "name": "fig",
+        "base": {
+            "engine": "gymnasium",
+            "train": {"episodes": 20, "stop_when_solved": False, "eval_every": 0},
+        },
+        "seeds": "0-2",
+        "grid": {"agent.alpha": [0.1, 0.5]},
+        "figure": figure,
+    })  # fmt: skip
+
+
+def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
+    figure = {
+        "metric": "length", "x": "env-steps", "title": "Steps per episode", "scale": 2.0,
+        "reference": 15, "reference_label": "optimum", "file": "fig.svg",
+    }  # fmt: skip
+    result = invoke("sweep", _sweep_file(in_tmp / "s.yaml", figure), "--out", "sw", "--workers", "1")
+    assert result.exit_code == 0, result.output
+    assert "the sweep file's figure: sw/fig.svg" in result.output
+    svg = Path("sw/fig.svg").read_text()
+    assert "alpha 0.1: mean of 3 seeds" in svg and "alpha 0.5: mean of 3 seeds" in svg
+    assert "optimum" in svg and "Steps per episode" in svg
+    # the resolved sweep.yaml keeps the section, every key filled
+    import yaml
+
+    resolved = yaml.safe_load(Path("sw/sweep.yaml").read_text())
+    assert resolved["figure"]["aggregate"] == "mean" and resolved["figure"]["scale"] == 2.0
+
+
+@pytest.mark.parametrize(
+    ("figure", "message"),
+    [
+        ({"x": "episode"}, "figure.metric: is missing"),
+        ({"metric": "steps"}, "figure.metric: \"steps\" is not one of return, length"),
+        ({"metric": "length", "colour": "red"}, "colour"),
+        ({"metric": "length", "scale": "x"}, "figure.scale: \"x\" is not a int or float"),
+        ({"metric": "length", "smooth": 0}, "figure.smooth: must be at least 1"),
+        ({"metric": "length", "file": "../f.png"}, "figure.file"),
+        ([1], "figure: must be a mapping"),
+    ],
+)
+def test_a_bad_figure_section_is_refused_before_anything_runs(
+    in_tmp: Path, figure: object, message: str
+) -> None:
+    result = invoke("sweep", _sweep_file(in_tmp / "s.yaml", figure), "--out", "sw", "-q")
+    assert result.exit_code == 2, result.output
+    assert message in result.output
+    assert not Path("sw").exists()

@@ -271,3 +271,5 @@ def print_sweep_summary(outcome: Any) -> None:
     for line in sweep_table(spec.axes, rows):
         print(line)
     print(f"points.csv, results.csv and sweep.png in {directory}")
+    if getattr(outcome, "figure", None) is not None:
+        print(f"the sweep file's figure: {outcome.figure}")

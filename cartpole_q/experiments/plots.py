@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -98,6 +99,21 @@ def plot_rewards(
     return out
 
 
+@dataclass(frozen=True)
+class CurveStyle:
+    """How :func:`plot_metric` labels and transforms the curves (a sweep's ``figure``)."""
+
+    labels: Sequence[str] | None = None
+    """one legend label per directory"""
+    title: str | None = None
+    y_label: str | None = None
+    offset: float = 0.0
+    scale: float = 1.0
+    """each value is drawn as ``(value + offset) * scale``"""
+    reference: tuple[float, str] | None = None
+    """a dashed horizontal line and its label"""
+
+
 def plot_metric(
     run_dirs: Sequence[Path],
     out: Path,
@@ -108,6 +124,7 @@ def plot_metric(
     log_y: bool = False,
     force: bool = False,
     on_note: Callable[[str], None] | None = None,
+    style: CurveStyle | None = None,
 ) -> Path:
     """Draw a metric's learning curves of runs, multi-seed runs and sweep points.
 
@@ -121,13 +138,16 @@ def plot_metric(
         log_y: A logarithmic y axis (S&B Fig. 10.2's steps per episode).
         force: Replace ``out`` if it exists.
         on_note: Told what is unfinished or left out.
+        style: Labels, a transform of the values and a reference line (a sweep file's
+            ``figure``); default: the directories' names, the values as they are.
 
     Raises:
         RunError: A directory is not a complete run, or a sweep point kept no curves.
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
+    style = style or CurveStyle()
     bands = []
-    for path in run_dirs:
+    for number, path in enumerate(run_dirs):
         run_set = load_run_set(path)
         for note in run_set.notes:
             if on_note is not None:
@@ -142,17 +162,21 @@ def plot_metric(
             [run.metrics.returns for run in runs], [run.metrics.lengths for run in runs],
             metric, x, window,
         )  # fmt: skip
-        centre, low, high = aggregate_band(curves.values, aggregate, np.random.default_rng(0))
-        label = f"point {path.name}" if run_set.kind == "sweep point" else path.name
-        bands.append(MetricBand(label, curves.x, curves.values, centre, low, high, aggregate))
+        values = (curves.values + style.offset) * style.scale
+        centre, low, high = aggregate_band(values, aggregate, np.random.default_rng(0))
+        if style.labels is not None:
+            label = style.labels[number]
+        else:
+            label = f"point {path.name}" if run_set.kind == "sweep point" else path.name
+        bands.append(MetricBand(label, curves.x, values, centre, low, high, aggregate))
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    y_label = METRIC_LABELS[metric]
+    y_label = style.y_label or METRIC_LABELS[metric]
     if window > 1 and metric in ("return", "length"):
         y_label += f" ({window}-episode average)"
-    title = f"{METRIC_LABELS[metric].capitalize()} by {X_LABELS[x]}"
-    if len(run_dirs) == 1:
+    title = style.title or f"{METRIC_LABELS[metric].capitalize()} by {X_LABELS[x]}"
+    if len(run_dirs) == 1 and style.title is None:
         title += f": {run_dirs[0].name}"
-    figure = metric_curve_figure(bands, X_LABELS[x], y_label, title, log_y)
+    figure = metric_curve_figure(bands, X_LABELS[x], y_label, title, log_y, style.reference)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 

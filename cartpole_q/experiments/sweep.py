@@ -27,6 +27,7 @@ from cartpole_q.config import (
     shown_value,
 )
 from cartpole_q.errors import RunError
+from cartpole_q.experiments.plots import CurveStyle, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.progress import NullSweepProgress, SweepProgress
@@ -87,6 +88,8 @@ class SweepOutcome:
     complete: bool
     points: list[PointRow] = field(default_factory=list)
     """the ``points.csv`` rows (only when complete)"""
+    figure: Path | None = None
+    """the sweep file's ``figure``, drawn when complete"""
 
 
 # -- the worker side ---------------------------------------------------------------------
@@ -273,7 +276,29 @@ def run_sweep(
     outcome = SweepOutcome(directory, spec, spec.runs, len(book.rows), len(book.rows) == spec.runs)
     if outcome.complete:
         outcome.points = summarize_sweep(spec, directory, book.sorted_rows())
+        if spec.figure is not None:
+            outcome.figure = draw_sweep_figure(spec, directory)
     return outcome
+
+
+def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
+    """Draw the sweep file's ``figure`` of every point into the sweep directory."""
+    figure = spec.figure
+    assert figure is not None
+    labels = [
+        ", ".join(f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}" for key, value in point.values.items())
+        or spec.name
+        for point in spec.points
+    ]
+    reference = None
+    if figure.reference is not None:
+        reference = (figure.reference, figure.reference_label)
+    style = CurveStyle(labels, figure.title, figure.y_label, figure.offset, figure.scale, reference)
+    paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
+    return plot_metric(
+        paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
+        figure.smooth, figure.log_y, force=True, style=style,
+    )  # fmt: skip
 
 
 def plan_tasks(

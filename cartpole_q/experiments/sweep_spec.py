@@ -30,7 +30,7 @@ from cartpole_q.config import (
 from cartpole_q.store import sweepdir
 from cartpole_q.store.sweepdir import axis_cell
 
-SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip", "curves")
+SWEEP_KEYS = ("name", "base", "seeds", "grid", "zip", "curves", "figure")
 """the keys a sweep file may have"""
 FORBIDDEN_AXES = ("seed", "train.seeds")
 """config keys a sweep cannot vary: its ``seeds`` say which seeds every point runs"""
@@ -50,6 +50,41 @@ class Point:
     """the point's resolved config (its ``seed`` is the base's; runs override it)"""
 
 
+FIGURE_KEYS = (
+    "metric", "x", "aggregate", "smooth", "log_y", "title", "y_label", "offset", "scale",
+    "reference", "reference_label", "file",
+)  # fmt: skip
+"""the keys of a sweep file's ``figure`` section"""
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """The learning-curve figure a sweep draws of its points when it completes.
+
+    The same curves as ``cartpole-q plot POINT ... --metric`` (one band per point, labelled
+    with the point's axis values), with a textbook figure's own labels, a linear transform
+    of the values (``(value + offset) * scale``) and an optional reference line.
+    """
+
+    metric: str
+    x: str = "episode"
+    aggregate: str = "mean"
+    smooth: int = 1
+    log_y: bool = False
+    title: str | None = None
+    y_label: str | None = None
+    offset: float = 0.0
+    scale: float = 1.0
+    reference: float | None = None
+    reference_label: str = "reference"
+    file: str = "figure.png"
+    """written in the sweep directory: ``.png``, ``.svg`` or ``.pdf``"""
+
+    def to_dict(self) -> dict[str, Any]:
+        """The section as the resolved ``sweep.yaml`` holds it (every key)."""
+        return {key: getattr(self, key) for key in FIGURE_KEYS}
+
+
 @dataclass(frozen=True)
 class SweepSpec:
     """A checked sweep: everything ``sweep.yaml`` holds, and the points it expands to."""
@@ -63,6 +98,8 @@ class SweepSpec:
     points: tuple[Point, ...]
     curves: bool = True
     """keep every run's per-episode returns and lengths in ``points/<p>/curves.npz``"""
+    figure: FigureSpec | None = None
+    """the learning-curve figure drawn when the sweep completes"""
 
     @property
     def axes(self) -> list[str]:
@@ -94,6 +131,8 @@ class SweepSpec:
             resolved["zip"] = self.zip
         if not self.curves:
             resolved["curves"] = False
+        if self.figure is not None:
+            resolved["figure"] = self.figure.to_dict()
         return resolved
 
 
@@ -156,7 +195,62 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     check_overlaps([*grid, *zipped], where)
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
-    return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves)
+    figure = _figure(raw.get("figure"), curves, where)
+    return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
+
+
+def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
+    """Check a sweep file's ``figure`` section (None when it has none)."""
+    from cartpole_q.learning_curves import AGGREGATES, METRICS, X_AXES
+
+    if raw is None:
+        return None
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            f"{where}: figure: must be a mapping such as {{metric: length, x: episode}}, got "
+            f"{json.dumps(raw, default=str)}."
+        )
+    check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
+    if not curves:
+        raise ConfigError(
+            f"{where}: figure: is drawn from the learning curves, but the sweep says curves: "
+            "false; keep the curves or leave the figure out."
+        )
+    values = dict(raw)
+    choices = {"metric": METRICS, "x": X_AXES, "aggregate": AGGREGATES}
+    if "metric" not in values:
+        raise ConfigError(f"{where}: figure.metric: is missing; one of {', '.join(METRICS)}.")
+    for key, allowed in choices.items():
+        if key in values and values[key] not in allowed:
+            raise ConfigError(
+                f"{where}: figure.{key}: {json.dumps(values[key], default=str)} is not one of "
+                f"{', '.join(allowed)}."
+            )
+    kinds: dict[str, tuple[type, ...]] = {
+        "smooth": (int,), "log_y": (bool,), "title": (str,), "y_label": (str,),
+        "offset": (int, float), "scale": (int, float), "reference": (int, float),
+        "reference_label": (str,), "file": (str,),
+    }  # fmt: skip
+    for key, kind in kinds.items():
+        value = values.get(key)
+        wrong_bool = isinstance(value, bool) and bool not in kind
+        if value is not None and (not isinstance(value, kind) or wrong_bool):
+            raise ConfigError(
+                f"{where}: figure.{key}: {json.dumps(value, default=str)} is not a "
+                f"{' or '.join(k.__name__ for k in kind)}."
+            )
+    if values.get("smooth", 1) < 1:
+        raise ConfigError(f"{where}: figure.smooth: must be at least 1, got {values['smooth']}.")
+    file = values.get("file", "figure.png")
+    if "/" in file or Path(file).suffix.lower() not in (".png", ".svg", ".pdf"):
+        raise ConfigError(
+            f"{where}: figure.file: {file!r} must be a file name in the sweep directory "
+            "ending in .png, .svg or .pdf."
+        )
+    for key in ("offset", "scale", "reference"):
+        if values.get(key) is not None:
+            values[key] = float(values[key])
+    return FigureSpec(**values)
 
 
 def check_top_keys(raw: Mapping[str, Any], valid: tuple[str, ...], where: str) -> None:
