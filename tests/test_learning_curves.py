@@ -153,7 +153,9 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         "metric": "length", "x": "env-steps", "title": "Steps per episode", "scale": 2.0,
         "reference": 15, "reference_label": "optimum", "file": "fig.svg",
     }  # fmt: skip
-    result = invoke("sweep", _sweep_file(in_tmp / "s.yaml", figure), "--out", "sw", "--workers", "1")
+    result = invoke(
+        "sweep", _sweep_file(in_tmp / "s.yaml", figure), "--out", "sw", "--workers", "1"
+    )
     assert result.exit_code == 0, result.output
     assert "the sweep file's figure: sw/fig.svg" in result.output
     svg = Path("sw/fig.svg").read_text()
@@ -170,9 +172,9 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
     ("figure", "message"),
     [
         ({"x": "episode"}, "figure.metric: is missing"),
-        ({"metric": "steps"}, "figure.metric: \"steps\" is not one of return, length"),
+        ({"metric": "steps"}, 'figure.metric: "steps" is not one of return, length'),
         ({"metric": "length", "colour": "red"}, "colour"),
-        ({"metric": "length", "scale": "x"}, "figure.scale: \"x\" is not a int or float"),
+        ({"metric": "length", "scale": "x"}, 'figure.scale: "x" is not a int or float'),
         ({"metric": "length", "smooth": 0}, "figure.smooth: must be at least 1"),
         ({"metric": "length", "file": "../f.png"}, "figure.file"),
         ([1], "figure: must be a mapping"),

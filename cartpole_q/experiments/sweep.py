@@ -286,7 +286,9 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
     figure = spec.figure
     assert figure is not None
     labels = [
-        ", ".join(f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}" for key, value in point.values.items())
+        ", ".join(
+            f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}" for key, value in point.values.items()
+        )
         or spec.name
         for point in spec.points
     ]
