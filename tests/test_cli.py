@@ -476,3 +476,16 @@ def test_resolved_config_shows_every_key(trained_run: Path) -> None:
     assert resolved.keys() == default.keys()
     for section in ("env", "discretization", "agent", "train", "eval"):
         assert resolved[section].keys() == default[section].keys()
+
+
+def test_the_version_is_one_the_command_the_package_and_its_metadata_agree_on() -> None:
+    import importlib.metadata
+
+    import cartpole_q
+
+    result = invoke("--version")
+    assert result.exit_code == 0
+    assert result.output.strip() == f"cartpole-q {cartpole_q.__version__}"
+    assert importlib.metadata.version("cartpole-q") == cartpole_q.__version__
+    changelog = (Path(__file__).resolve().parents[1] / "CHANGELOG.md").read_text()
+    assert f"## [{cartpole_q.__version__}]" in changelog
