@@ -89,6 +89,7 @@ def seed_curves(
     metric: str,
     x: str,
     window: int = 1,
+    x_max: float | None = None,
 ) -> SeedCurves:
     """Every seed's ``metric`` on a common grid of episodes or env steps.
 
@@ -99,6 +100,8 @@ def seed_curves(
         x: One of :data:`X_AXES`.
         window: Trailing moving average applied to each seed's per-episode values first
             (``return`` and ``length`` only; running totals are not smoothed).
+        x_max: The grid's end (the book's figures stop at a fixed step or episode);
+            default: the longest seed's.
 
     Returns:
         The grid and the ``(seeds, points)`` values. On ``episode``, a seed's value at
@@ -116,13 +119,17 @@ def seed_curves(
         per_seed.append(values)
     if x == "episode":
         longest = max((len(values) for values in per_seed), default=0)
+        if x_max is not None:
+            longest = int(x_max)
         grid = np.arange(1, longest + 1, dtype=np.float64)
         table = np.full((len(per_seed), longest), np.nan)
         for row, values in zip(table, per_seed, strict=True):
-            row[: len(values)] = values
+            row[: min(len(values), longest)] = values[:longest]
         return SeedCurves(grid, table)
     ends = [np.cumsum(np.asarray(seed_lengths, dtype=np.int64)) for seed_lengths in lengths]
     last = max((int(end[-1]) for end in ends if end.size), default=0)
+    if x_max is not None:
+        last = int(x_max)
     grid = np.linspace(0.0, float(last), STEP_POINTS) if last else np.zeros(1)
     table = np.full((len(per_seed), grid.size), np.nan)
     for row, values, end in zip(table, per_seed, ends, strict=True):

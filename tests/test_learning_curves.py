@@ -187,3 +187,13 @@ def test_a_bad_figure_section_is_refused_before_anything_runs(
     assert result.exit_code == 2, result.output
     assert message in result.output
     assert not Path("sw").exists()
+
+
+def test_x_max_ends_the_grid_where_the_book_does() -> None:
+    returns, lengths = [np.array([1.0, 1.0, 1.0])], [np.array([10, 10, 10])]
+    steps = seed_curves(returns, lengths, "cumulative-return", "env-steps", x_max=15)
+    assert steps.x[-1] == 15.0 and steps.values[0][-1] == 1.0
+    episodes = seed_curves(returns, lengths, "return", "episode", x_max=2)
+    assert episodes.x.tolist() == [1.0, 2.0] and episodes.values.shape == (1, 2)
+    longer = seed_curves(returns, lengths, "return", "episode", x_max=5)
+    assert np.isnan(longer.values[0][3:]).all()

@@ -112,6 +112,8 @@ class CurveStyle:
     """each value is drawn as ``(value + offset) * scale``"""
     reference: tuple[float, str] | None = None
     """a dashed horizontal line and its label"""
+    x_max: float | None = None
+    """where the x axis ends (default: the longest seed's training)"""
 
 
 def plot_metric(
@@ -160,7 +162,7 @@ def plot_metric(
             )
         curves = seed_curves(
             [run.metrics.returns for run in runs], [run.metrics.lengths for run in runs],
-            metric, x, window,
+            metric, x, window, style.x_max,
         )  # fmt: skip
         values = (curves.values + style.offset) * style.scale
         centre, low, high = aggregate_band(values, aggregate, np.random.default_rng(0))

@@ -295,7 +295,9 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
     reference = None
     if figure.reference is not None:
         reference = (figure.reference, figure.reference_label)
-    style = CurveStyle(labels, figure.title, figure.y_label, figure.offset, figure.scale, reference)
+    style = CurveStyle(
+        labels, figure.title, figure.y_label, figure.offset, figure.scale, reference, figure.x_max
+    )
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     return plot_metric(
         paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,

@@ -52,7 +52,7 @@ class Point:
 
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "title", "y_label", "offset", "scale",
-    "reference", "reference_label", "file",
+    "reference", "reference_label", "x_max", "file",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -77,6 +77,8 @@ class FigureSpec:
     scale: float = 1.0
     reference: float | None = None
     reference_label: str = "reference"
+    x_max: float | None = None
+    """where the x axis ends: the book's last step or episode (default: the longest seed's)"""
     file: str = "figure.png"
     """written in the sweep directory: ``.png``, ``.svg`` or ``.pdf``"""
 
@@ -229,7 +231,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     kinds: dict[str, tuple[type, ...]] = {
         "smooth": (int,), "log_y": (bool,), "title": (str,), "y_label": (str,),
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
-        "reference_label": (str,), "file": (str,),
+        "reference_label": (str,), "x_max": (int, float), "file": (str,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)
@@ -247,7 +249,9 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             f"{where}: figure.file: {file!r} must be a file name in the sweep directory "
             "ending in .png, .svg or .pdf."
         )
-    for key in ("offset", "scale", "reference"):
+    if values.get("x_max") is not None and values["x_max"] <= 0:
+        raise ConfigError(f"{where}: figure.x_max: must be positive, got {values['x_max']}.")
+    for key in ("offset", "scale", "reference", "x_max"):
         if values.get(key) is not None:
             values[key] = float(values[key])
     return FigureSpec(**values)
