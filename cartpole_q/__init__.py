@@ -8,12 +8,17 @@ The Python API, for notebooks and scripts (imported lazily, so the command line 
   :func:`load_config` takes), returning a :class:`~cartpole_q.training.TrainResult`;
 - :func:`evaluate` -- play a Q-table's greedy policy in ``gymnasium.make``;
 - :func:`write_run` / :func:`load_run` -- save a result as a run directory, read one back.
+
+Importing the package registers Sutton & Barto's worlds (``cartpole_q/WindyGridworld-v0``
+and others, :mod:`cartpole_q.worlds`) with Gymnasium, once Gymnasium is imported.
 """
 
 from __future__ import annotations
 
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
+
+from cartpole_q.worlds import register_when_gymnasium_is_imported
 
 __version__ = "0.1.0"
 __all__ = ["__version__", "evaluate", "load_config", "load_run", "train", "write_run"]
@@ -55,6 +60,10 @@ def train(
     if not isinstance(config, Config):
         config = load_config(config)
     return train_config(config, **options)
+
+
+# Every use of the package (the command line imports it too) can make the worlds' ids.
+register_when_gymnasium_is_imported()
 
 
 def __getattr__(name: str) -> Any:

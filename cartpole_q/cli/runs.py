@@ -410,7 +410,10 @@ def optimum_command(
             typer.echo(line)
         layout = found.layout
         if layout is not None:
-            marks = {state: cell for state, cell in enumerate(layout.cells) if cell in "HCG"}
-            typer.echo("optimal first actions (S start, H hole, C cliff, G goal):")
+            marks = {state: cell for state, cell in enumerate(layout.cells) if cell in "HCG#E"}
+            legend = "S start, H hole, C cliff, G goal"
+            legend += ", # wall" if "#" in layout.cells else ""
+            legend += ", E end" if "E" in layout.cells else ""
+            typer.echo(f"optimal first actions ({legend}):")
             policy = list(found.exact.optimal_policy)
             typer.echo(policy_grid(policy, layout.rows, layout.columns, layout.arrows(), marks))

@@ -221,20 +221,28 @@ class GridLayout:
     rows: int
     columns: int
     cells: tuple[str, ...]
-    """per state: ``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal"""
+    """per state: ``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal, ``#`` wall,
+    ``E`` an end that is not the goal"""
     moves: tuple[tuple[int, int], ...]
     """per action: ``(row step, column step)``"""
 
     def arrows(self) -> str:
-        """One arrow character per action."""
-        names = {(0, -1): "<", (1, 0): "v", (0, 1): ">", (-1, 0): "^"}
-        return "".join(names[move] for move in self.moves)
+        """One arrow character per action (king's moves' diagonals, ``o`` for staying)."""
+        return "".join(_ARROWS[move] for move in self.moves)
+
+
+_ARROWS = {
+    (0, -1): "<", (1, 0): "v", (0, 1): ">", (-1, 0): "^",
+    (-1, -1): "↖", (-1, 1): "↗", (1, 1): "↘", (1, -1): "↙", (0, 0): "o",
+}  # fmt: skip
+"""the text arrow of each move (a king's diagonal moves have theirs)"""
 
 
 def grid_layout(env: EnvConfig) -> GridLayout | None:
     """A grid world's map, as its profile says to read it; ``None`` for other environments.
 
-    FrozenLake's from its ``desc``, CliffWalking's from its cliff.
+    FrozenLake's from its ``desc``, CliffWalking's from its cliff, Sutton & Barto's worlds'
+    from their layout.
     """
     from cartpole_q.envs.gym import make_env
 

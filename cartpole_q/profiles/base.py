@@ -91,8 +91,9 @@ class EnvProfile:
     """the first map dimension is a grid world's rows, drawn downwards (Taxi)"""
     grid: Callable[[Any], GridCells] | None = None
     """a grid world's map, read from ``env.unwrapped``: ``(rows, columns, cells, moves)``, with
-    a letter per cell (``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal, row by
-    row) and a ``(row step, column step)`` per action"""
+    a letter per cell (``S`` start, ``F`` free, ``H`` hole, ``C`` cliff, ``G`` goal, ``#``
+    wall, ``E`` an end that is not the goal, row by row) and a ``(row step, column step)``
+    per action"""
     twin: str | None = None
     """the module of its compiled twin (``cartpole_q.envs.twins.cartpole``), if any"""
     model: str | None = None

@@ -1,0 +1,95 @@
+"""Sutton & Barto's worlds (:mod:`cartpole_q.worlds`).
+
+The windy gridworlds, the Dyna mazes, the maximization-bias MDP and the 19-state random
+walk. Each has a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
+exactly; the grid worlds and the walk draw their policy maps as grids. The maps are read
+from the environment (``env.unwrapped``), so a changed argument (``stay``, ``change_at``)
+shows.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from cartpole_q.profiles.base import EnvProfile, GridCells
+
+_GRIDS = "cartpole_q.worlds.gridworlds"
+_COMPASS = ("up", "down", "left", "right")
+
+
+def gridworld_grid(world: Any) -> GridCells:
+    """A grid world's map: its start, goal and walls (``#``), from the world's attributes."""
+    cells = []
+    for row in range(world.rows):
+        for column in range(world.columns):
+            cell = (row, column)
+            letter = "S" if cell == world.start else "G" if cell == world.goal else "F"
+            cells.append("#" if cell in world.walls else letter)
+    return world.rows, world.columns, tuple(cells), tuple(world.moves)
+
+
+def random_walk_grid(world: Any) -> GridCells:
+    """The walk as one row: its left end (``E``, -1), the start, its right end (``G``, +1)."""
+    states = int(world.observation_space.n)
+    start = int(world.initial_state_distrib.argmax())
+    cells = ["E" if state == 0 else "G" if state == states - 1 else "F" for state in range(states)]
+    cells[start] = "S"
+    return 1, states, tuple(cells), ((0, -1), (0, 1))
+
+
+WINDY_GRIDWORLD = EnvProfile(
+    name="WindyGridworld",
+    description="reach the goal against an upward wind, -1 per step (Sutton & Barto's Example 6.5)",
+    ids=("cartpole_q/WindyGridworld-v0",),
+    entry_points=(f"{_GRIDS}:WindyGridworldEnv",),
+    action_names=_COMPASS,
+    policy_map="grid",
+    grid=gridworld_grid,
+    model="transition_table",
+)
+
+KINGS_WINDY_GRIDWORLD = EnvProfile(
+    name="KingsWindyGridworld",
+    description="the windy gridworld with king's moves, its wind steady or varying "
+    "(Exercises 6.9 and 6.10)",
+    ids=("cartpole_q/KingsWindyGridworld-v0", "cartpole_q/StochasticWindyGridworld-v0"),
+    entry_points=(f"{_GRIDS}:KingsWindyGridworldEnv", f"{_GRIDS}:StochasticWindyGridworldEnv"),
+    action_names=(*_COMPASS, "up-left", "up-right", "down-left", "down-right"),
+    policy_map="grid",
+    grid=gridworld_grid,
+    model="transition_table",
+)
+
+DYNA_MAZE = EnvProfile(
+    name="DynaMaze",
+    description="find the way through a maze, +1 at the goal; the blocking and shortcut "
+    "mazes change after 1000 and 3000 steps (Examples 8.1-8.3)",
+    ids=("cartpole_q/DynaMaze-v0", "cartpole_q/BlockingMaze-v0", "cartpole_q/ShortcutMaze-v0"),
+    entry_points=tuple(
+        f"{_GRIDS}:{name}" for name in ("DynaMazeEnv", "BlockingMazeEnv", "ShortcutMazeEnv")
+    ),
+    action_names=_COMPASS,
+    policy_map="grid",
+    grid=gridworld_grid,
+    model="transition_table",
+)
+
+MAXIMIZATION_BIAS = EnvProfile(
+    name="MaximizationBias",
+    description="left from A to B's noisy rewards (mean -0.1) or right to 0 "
+    "(Sutton & Barto's Example 6.7)",
+    ids=("cartpole_q/MaximizationBias-v0",),
+    entry_points=("cartpole_q.worlds.bias:MaximizationBiasEnv",),
+    model="transition_table",
+)
+
+RANDOM_WALK = EnvProfile(
+    name="RandomWalk",
+    description="a walk of 19 states between a -1 end and a +1 end (Sutton & Barto's Example 7.1)",
+    ids=("cartpole_q/RandomWalk-v0",),
+    entry_points=("cartpole_q.worlds.random_walk:RandomWalkEnv",),
+    action_names=("left", "right"),
+    policy_map="grid",
+    grid=random_walk_grid,
+    model="transition_table",
+)

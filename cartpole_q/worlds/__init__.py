@@ -1,0 +1,145 @@
+"""Sutton & Barto's worlds as Gymnasium environments, registered under ``cartpole_q/``.
+
+=========================================  ==================================================
+id                                         world
+=========================================  ==================================================
+``cartpole_q/WindyGridworld-v0``           Example 6.5 (:mod:`~cartpole_q.worlds.gridworlds`)
+``cartpole_q/KingsWindyGridworld-v0``      Exercise 6.9: king's moves (``stay=True``: a 9th)
+``cartpole_q/StochasticWindyGridworld-v0`` Exercise 6.10: king's moves, a varying wind
+``cartpole_q/DynaMaze-v0``                 Example 8.1, Figure 8.2
+``cartpole_q/BlockingMaze-v0``             Example 8.2, Figure 8.4 (``change_at=1000``)
+``cartpole_q/ShortcutMaze-v0``             Example 8.3, Figure 8.5 (``change_at=3000``)
+``cartpole_q/MaximizationBias-v0``         Example 6.7, Figure 6.5 (:mod:`~cartpole_q.worlds.bias`)
+``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2 (:mod:`~cartpole_q.worlds.random_walk`)
+=========================================  ==================================================
+
+**Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
+in 1.0), so the ids are registered by this package: importing ``cartpole_q`` (which the
+command line does) registers them as soon as Gymnasium is imported, before or after, and
+without importing Gymnasium itself (``cartpole-q --help`` stays light). In a fresh
+interpreter, ``gymnasium.make("cartpole_q.worlds:cartpole_q/WindyGridworld-v0")`` works
+too: Gymnasium imports the module before the ``:``.
+
+**Time limits.** The book gives none; the tool needs episodes to end (a greedy policy can
+walk in circles), so each id has a generous one, far above what any episode of the book's
+experiments takes: 10,000 steps in the grid worlds, 1,000 in the random walk (a random
+walk lasts 100 steps on average and more than 1,000 about once in 170,000 episodes). The
+maximization-bias world needs none: every episode ends within two steps.
+``env.kwargs.max_episode_steps`` changes them.
+"""
+
+from __future__ import annotations
+
+import importlib.abc
+import importlib.machinery
+import importlib.util
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType, ModuleType
+from typing import Any
+
+NAMESPACE = "cartpole_q"
+"""the Gymnasium namespace of the worlds' ids"""
+
+
+@dataclass(frozen=True)
+class World:
+    """One registered world: its id and what ``gymnasium.register`` takes."""
+
+    id: str
+    entry_point: str
+    """``module:Class``"""
+    max_episode_steps: int | None
+    """the time limit registered with it"""
+    kwargs: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    """the ``gymnasium.make`` arguments registered with it"""
+
+
+_GRIDS = "cartpole_q.worlds.gridworlds"
+GRID_TIME_LIMIT = 10_000
+"""steps before a grid world's episode is truncated"""
+WALK_TIME_LIMIT = 1_000
+"""steps before a random walk's episode is truncated"""
+
+WORLDS: Sequence[World] = (
+    World(f"{NAMESPACE}/WindyGridworld-v0", f"{_GRIDS}:WindyGridworldEnv", GRID_TIME_LIMIT),
+    World(
+        f"{NAMESPACE}/KingsWindyGridworld-v0", f"{_GRIDS}:KingsWindyGridworldEnv", GRID_TIME_LIMIT
+    ),
+    World(
+        f"{NAMESPACE}/StochasticWindyGridworld-v0",
+        f"{_GRIDS}:StochasticWindyGridworldEnv",
+        GRID_TIME_LIMIT,
+    ),
+    World(f"{NAMESPACE}/DynaMaze-v0", f"{_GRIDS}:DynaMazeEnv", GRID_TIME_LIMIT),
+    World(f"{NAMESPACE}/BlockingMaze-v0", f"{_GRIDS}:BlockingMazeEnv", GRID_TIME_LIMIT),
+    World(f"{NAMESPACE}/ShortcutMaze-v0", f"{_GRIDS}:ShortcutMazeEnv", GRID_TIME_LIMIT),
+    World(f"{NAMESPACE}/MaximizationBias-v0", "cartpole_q.worlds.bias:MaximizationBiasEnv", None),
+    World(
+        f"{NAMESPACE}/RandomWalk-v0", "cartpole_q.worlds.random_walk:RandomWalkEnv", WALK_TIME_LIMIT
+    ),
+)
+"""every world this package registers"""
+
+
+def register_worlds() -> None:
+    """Register every world with Gymnasium (an id registered already is left as it is)."""
+    import gymnasium
+
+    for world in WORLDS:
+        if world.id not in gymnasium.registry:
+            gymnasium.register(
+                world.id,
+                entry_point=world.entry_point,
+                max_episode_steps=world.max_episode_steps,
+                kwargs=dict(world.kwargs),
+            )
+
+
+def register_when_gymnasium_is_imported() -> None:
+    """Register the worlds now if Gymnasium is imported, else right after its import.
+
+    Importing Gymnasium costs a tenth of a second that a command such as ``--help`` need not
+    pay; a finder at the head of ``sys.meta_path`` waits for Gymnasium's import instead, and
+    registers the worlds when it has run.
+    """
+    if "gymnasium" in sys.modules:
+        register_worlds()
+    elif not any(isinstance(finder, _AfterGymnasium) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _AfterGymnasium())
+
+
+class _AfterGymnasium(importlib.abc.MetaPathFinder):
+    """Finds nothing itself: it makes Gymnasium's own loader register the worlds after it."""
+
+    def __init__(self) -> None:
+        self._searching = False
+
+    def find_spec(
+        self,
+        fullname: str,
+        path: Sequence[str] | None,
+        target: ModuleType | None = None,
+    ) -> importlib.machinery.ModuleSpec | None:
+        """Gymnasium's own spec, its loader made to register the worlds after loading it."""
+        if fullname != "gymnasium" or self._searching:
+            return None
+        self._searching = True  # the search below asks this finder too
+        try:
+            spec = importlib.util.find_spec(fullname)
+        finally:
+            self._searching = False
+        if spec is None or spec.loader is None or not hasattr(spec.loader, "exec_module"):
+            return spec
+        load = spec.loader.exec_module
+
+        def load_then_register(module: ModuleType) -> None:
+            load(module)
+            if self in sys.meta_path:
+                sys.meta_path.remove(self)
+            register_worlds()
+
+        # Only this spec's loader is changed, for the one import it makes.
+        setattr(spec.loader, "exec_module", load_then_register)  # noqa: B010
+        return spec
