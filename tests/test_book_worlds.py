@@ -341,6 +341,16 @@ def test_the_command_line_trains_a_world_and_draws_its_policy_map(tmp_path: Path
     assert (tmp_path / "run" / "policy_map.png").stat().st_size > 0
 
 
+def test_the_shipped_config_is_example_6_5(tmp_path: Path) -> None:
+    config = load_config("windy_gridworld")
+    assert (config.env.id, config.agent.algorithm) == ("cartpole_q/WindyGridworld-v0", "sarsa")
+    agent = config.to_dict()["agent"]
+    assert (agent["alpha"], agent["epsilon"], agent["gamma"], agent["q_init"]) == (0.5, 0.1, 1, 0)
+    path = write_yaml(tmp_path / "short.yaml", {**WINDY, "train": {"episodes": 5}})
+    result = invoke("train", "-c", path, "--out", tmp_path / "run", "-q")
+    assert result.exit_code == 0, result.output
+
+
 def test_the_maze_walls_are_drawn(tmp_path: Path) -> None:
     maze = {**WINDY, "env": {"id": "cartpole_q/DynaMaze-v0"},
             "agent": {"algorithm": "q_learning", "q_init": 0.01, "gamma": 0.95},
