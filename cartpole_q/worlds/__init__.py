@@ -30,14 +30,14 @@ maximization-bias world needs none: every episode ends within two steps.
 
 from __future__ import annotations
 
-import importlib.abc
-import importlib.machinery
-import importlib.util
 import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType, ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from importlib.machinery import ModuleSpec
 
 NAMESPACE = "cartpole_q"
 """the Gymnasium namespace of the worlds' ids"""
@@ -110,8 +110,12 @@ def register_when_gymnasium_is_imported() -> None:
         sys.meta_path.insert(0, _AfterGymnasium())
 
 
-class _AfterGymnasium(importlib.abc.MetaPathFinder):
-    """Finds nothing itself: it makes Gymnasium's own loader register the worlds after it."""
+class _AfterGymnasium:
+    """Finds nothing itself: it makes Gymnasium's own loader register the worlds after it.
+
+    A meta path finder needs only ``find_spec``; ``importlib.util`` is imported when
+    Gymnasium is, not when the package is (the command line's start stays light).
+    """
 
     def __init__(self) -> None:
         self._searching = False
@@ -121,10 +125,12 @@ class _AfterGymnasium(importlib.abc.MetaPathFinder):
         fullname: str,
         path: Sequence[str] | None,
         target: ModuleType | None = None,
-    ) -> importlib.machinery.ModuleSpec | None:
+    ) -> ModuleSpec | None:
         """Gymnasium's own spec, its loader made to register the worlds after loading it."""
         if fullname != "gymnasium" or self._searching:
             return None
+        import importlib.util
+
         self._searching = True  # the search below asks this finder too
         try:
             spec = importlib.util.find_spec(fullname)
