@@ -34,7 +34,7 @@ def _compare_trajectory(env_kwargs: dict, seed: int, steps: int, choose) -> int:
         )
         action = choose(step, gym_observation)
         gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(action)
-        reward, terminated = twin.step(state, action, observation, settings.params)
+        reward, terminated = twin.step(state, action, observation, rng, settings.params)
         length += 1
         truncated = length >= settings.max_episode_steps
         assert (reward, terminated, truncated) == (gym_reward, gym_terminated, gym_truncated), step

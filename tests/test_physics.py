@@ -46,7 +46,7 @@ def test_twin_with_physics_follows_gymnasium_exactly(physics: dict) -> None:
         assert observation.tobytes() == gym_observation.tobytes(), step
         action = int(actions[step])
         gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(action)
-        reward, terminated = twin.step(state, action, observation, settings.params)
+        reward, terminated = twin.step(state, action, observation, rng, settings.params)
         length += 1
         assert (reward, terminated, length >= 500) == (gym_reward, gym_terminated, gym_truncated)
         if terminated or length >= 500:

@@ -59,7 +59,7 @@ def _make_recorder(twin: ModuleType) -> Any:
             else:
                 action = random_actions[t]
             actions[t] = action
-            rewards[t], terminated[t] = step(state, action, observation, params)
+            rewards[t], terminated[t] = step(state, action, observation, rng, params)
             states[t + 1], observations[t + 1] = state, observation
             length += 1
             truncated[t] = length >= max_steps
@@ -193,7 +193,7 @@ def test_twin_called_from_python_is_exact(twin: ModuleType) -> None:
         assert _same_state(state, _gym_state(env)), f"state differs before step {t}"
         assert observation.tobytes() == gym_observation.tobytes(), f"observation, step {t}"
         gym_observation, gym_reward, gym_terminated, gym_truncated, _ = env.step(int(action))
-        reward, terminated = twin.step(state, int(action), observation, params)
+        reward, terminated = twin.step(state, int(action), observation, rng, params)
         length += 1
         truncated = length >= twin.MAX_EPISODE_STEPS
         assert (reward, terminated, truncated) == (gym_reward, gym_terminated, gym_truncated), t
@@ -215,6 +215,7 @@ def test_acrobot_velocity_bounds_and_wraps_are_exact() -> None:
         acrobot.MAX_VEL_1 * 1.2,
         acrobot.MAX_VEL_2 * 1.2,
     ]
+    rng = np.random.default_rng(3)  # the step draws nothing from it
     clipped = 0
     for start in starts:
         for action in range(acrobot.N_ACTIONS):
@@ -222,7 +223,7 @@ def test_acrobot_velocity_bounds_and_wraps_are_exact() -> None:
             state, observation = start.copy(), np.empty(6, dtype=np.float32)
             for _ in range(3):
                 gym_observation, gym_reward, gym_terminated, _, _ = env.step(action)
-                reward, terminated = acrobot.step(state, action, observation, params)
+                reward, terminated = acrobot.step(state, action, observation, rng, params)
                 assert _same_state(state, _gym_state(env))
                 assert observation.tobytes() == gym_observation.tobytes()
                 assert (reward, terminated) == (gym_reward, gym_terminated)
@@ -308,7 +309,7 @@ def _make_random_loop(twin: ModuleType) -> Any:
         reset(state, observation, rng, params)
         total, length = 0.0, 0
         for _ in range(steps):
-            reward, terminated = step(state, rng.integers(0, n_actions), observation, params)
+            reward, terminated = step(state, rng.integers(0, n_actions), observation, rng, params)
             total += reward
             length += 1
             if terminated or length >= max_steps:

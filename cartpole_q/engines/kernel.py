@@ -6,6 +6,8 @@ calls compiled functions once per step (:mod:`cartpole_q.engines.gymnasium_engin
 way an episode is: epsilon and alpha of the episode; reset; the algorithm's ``start`` on the
 reset state; then per step the environment's step, the observation's row,
 ``visits[s, a] += 1``, and the algorithm's ``step``; at the end, the algorithm's ``end``.
+The row rule is the gymnasium engine's (:mod:`cartpole_q.engines.rows`), for the twin's
+kind of observation.
 
 The functions below are templates: their upper-case globals (``ALGORITHM_STEP``,
 ``TWIN_STEP``, ...) are placeholders that :func:`~cartpole_q.engines.compile.specialise`
@@ -23,9 +25,9 @@ import numpy as np
 
 from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid
 from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.rows import ARRAY_ROW_RULES
 from cartpole_q.envs.registry import Twin
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.binning import state_index
 from cartpole_q.rl.schedules import schedule_value
 from cartpole_q.rl.solve import SOLVE_WINDOW
 from cartpole_q.rl.tabular import ENDED, best_action, compilable
@@ -37,6 +39,9 @@ ALGORITHM_END: Any = None
 TWIN_RESET: Any = None
 TWIN_STEP: Any = None
 TWIN_RANDOMIZE: Any = None
+TWIN_STATE_DTYPE: Any = None
+TWIN_OBSERVATION_DTYPE: Any = None
+OBSERVATION_ROW: Any = None
 EXPLORING_EPISODE: Any = None
 GREEDY_EPISODE: Any = None
 GREEDY: bool = False
@@ -82,9 +87,9 @@ def record_episode(
 
 def twin_episode(
     q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, low: np.ndarray,
-    high: np.ndarray, bins: np.ndarray, gamma: float, alpha: float, epsilon: float,
-    rng: np.random.Generator, env_rng: np.random.Generator, env_params: Any, max_steps: int,
-    env_state: np.ndarray, observation: np.ndarray,
+    high: np.ndarray, bins: np.ndarray, starts: np.ndarray, gamma: float, alpha: float,
+    epsilon: float, rng: np.random.Generator, env_rng: np.random.Generator, env_params: Any,
+    max_steps: int, env_state: np.ndarray, observation: np.ndarray,
 ) -> tuple[float, int]:  # fmt: skip
     """Reset the twin, then play and learn one episode; return its return and length.
 
@@ -96,14 +101,14 @@ def twin_episode(
     if GREEDY:
         epsilon = 0.0
     TWIN_RESET(env_state, observation, env_rng, env_params)
-    state = state_index(observation, low, high, bins)
+    state = OBSERVATION_ROW(observation, low, high, bins, starts)
     action = ALGORITHM_START(q, memory, params, state, epsilon, rng)
     episode_return, length = 0.0, 0
     while action != ENDED:
-        reward, terminated = TWIN_STEP(env_state, action, observation, env_params)
+        reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, env_params)
         length += 1
         episode_return += reward
-        next_state = state_index(observation, low, high, bins)
+        next_state = OBSERVATION_ROW(observation, low, high, bins, starts)
         visits[state, action] += 1
         action = ALGORITHM_STEP(
             q, memory, params, state, action, reward, next_state, terminated,
@@ -131,8 +136,9 @@ def train_episodes(
         agent: the hyperparameters and the solve threshold.
         metrics: per-episode metrics, written at each episode's index.
         agent_rng: the agent's generator (exploration, and the algorithm's own draws).
-        env_rng: the twin's generator (resets).
-        env: ``(max_episode_steps, state_size, observation_size, params)`` of the twin.
+        env_rng: the twin's generator (resets, and the steps of a world that draws).
+        env: ``(max_episode_steps, state_size, observation_size, params)`` of the twin
+            (no time limit: the largest int64).
         start: the first episode (0-based) to train.
         stop: train up to this episode, excluded.
         check_solved: stop right after the first solving episode.
@@ -145,9 +151,9 @@ def train_episodes(
     """
     max_steps, state_size, observation_size, base_params = env
     keys, lows, highs = randomize
-    low, high, bins = grid.low, grid.high, grid.bins
-    env_state = np.empty(state_size, dtype=np.float64)
-    observation = np.empty(observation_size, dtype=np.float32)
+    low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
+    env_state = np.empty(state_size, dtype=TWIN_STATE_DTYPE)
+    observation = np.empty(observation_size, dtype=TWIN_OBSERVATION_DTYPE)
     gamma = agent.gamma
     env_steps = 0
     for episode in range(start, stop):
@@ -159,13 +165,13 @@ def train_episodes(
         # epsilon, without the generator calls they would skip anyway: a third faster.
         if epsilon > 0.0:
             episode_return, length = EXPLORING_EPISODE(
-                q, visits, memory, params, low, high, bins, gamma, alpha, epsilon, agent_rng,
-                env_rng, env_params, max_steps, env_state, observation,
+                q, visits, memory, params, low, high, bins, starts, gamma, alpha, epsilon,
+                agent_rng, env_rng, env_params, max_steps, env_state, observation,
             )  # fmt: skip
         else:
             episode_return, length = GREEDY_EPISODE(
-                q, visits, memory, params, low, high, bins, gamma, alpha, 0.0, agent_rng,
-                env_rng, env_params, max_steps, env_state, observation,
+                q, visits, memory, params, low, high, bins, starts, gamma, alpha, 0.0,
+                agent_rng, env_rng, env_params, max_steps, env_state, observation,
             )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
         env_steps += length
@@ -177,18 +183,22 @@ def train_episodes(
 def greedy_returns(
     q: np.ndarray, grid: Grid, env_rng: np.random.Generator, env: Any, episodes: int
 ) -> np.ndarray:
-    """The greedy policy's return in each of ``episodes`` twin episodes."""
+    """The greedy policy's return in each of ``episodes`` twin episodes.
+
+    ``env`` as :func:`train_episodes` takes it, with the greedy step cap as the time limit
+    of an environment that has none.
+    """
     max_steps, state_size, observation_size, params = env
-    low, high, bins = grid.low, grid.high, grid.bins
-    env_state = np.empty(state_size, dtype=np.float64)
-    observation = np.empty(observation_size, dtype=np.float32)
+    low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
+    env_state = np.empty(state_size, dtype=TWIN_STATE_DTYPE)
+    observation = np.empty(observation_size, dtype=TWIN_OBSERVATION_DTYPE)
     returns = np.zeros(episodes, dtype=np.float64)
     for episode in range(episodes):
         TWIN_RESET(env_state, observation, env_rng, params)
         for length in range(1, max_steps + 1):
-            state = state_index(observation, low, high, bins)
+            state = OBSERVATION_ROW(observation, low, high, bins, starts)
             action = best_action(q, state)
-            reward, terminated = TWIN_STEP(env_state, action, observation, params)
+            reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, params)
             returns[episode] += reward
             if terminated or length >= max_steps:
                 break
@@ -230,8 +240,7 @@ def _training_kernel(
         "ALGORITHM_START": algorithm.start,
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
-        "TWIN_RESET": twin.reset,
-        "TWIN_STEP": twin.step,
+        **twin_bindings(twin),
     }
     # The two episode loops are compiled (and cached) on their own, not inlined into the
     # outer loop: each is a smaller compilation, and they can be compiled side by side.
@@ -246,6 +255,8 @@ def _training_kernel(
             "GREEDY_EPISODE": greedy,
             "TWIN_RANDOMIZE": twin.randomize,
             "RANDOMIZED": randomized,
+            "TWIN_STATE_DTYPE": twin.state_dtype,
+            "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
         },
     )
     return TrainingKernel(name, outer, exploring, greedy)
@@ -254,8 +265,15 @@ def _training_kernel(
 @functools.cache
 def greedy_kernel(twin: Twin) -> Any:
     """The compiled greedy play of one twin (see :func:`training_kernel`)."""
-    return specialise(
-        greedy_returns,
-        f"greedy_returns__{twin.key}",
-        {"TWIN_RESET": twin.reset, "TWIN_STEP": twin.step},
-    )
+    return specialise(greedy_returns, f"greedy_returns__{twin.key}", twin_bindings(twin))
+
+
+def twin_bindings(twin: Twin) -> dict[str, Any]:
+    """What a loop template's ``TWIN_...`` placeholders and its row rule are for ``twin``."""
+    return {
+        "TWIN_RESET": twin.reset,
+        "TWIN_STEP": twin.step,
+        "TWIN_STATE_DTYPE": twin.state_dtype,
+        "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
+        "OBSERVATION_ROW": ARRAY_ROW_RULES[twin.observation_kind],
+    }

@@ -16,9 +16,13 @@ from gymnasium.utils import seeding
 
 from cartpole_q.engines.base import AgentParams, TrainingState
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
+from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
 from cartpole_q.numba_cache import is_cached
 from cartpole_q.profiles import profile_for
+
+NO_TIME_LIMIT = 2**63 - 1
+"""the compiled loop's time limit for an environment without one: never reached"""
 
 
 class NumbaEngine:
@@ -38,12 +42,17 @@ class NumbaEngine:
         self._kernel = training_kernel(params.algorithm, settings.twin, bool(randomize))
         self._train_episodes = self._kernel.train_episodes
         self._greedy_returns = greedy_kernel(settings.twin)
+        self._twin = settings.twin
+        limit = settings.max_episode_steps
         self._env = (
-            settings.max_episode_steps,
+            NO_TIME_LIMIT if limit is None else limit,
             settings.state_size,
             settings.observation_size,
             settings.params,
         )
+        # Greedy play stops at the step cap where the environment has no time limit, as
+        # the gymnasium engine's evaluations do (a greedy policy may walk in circles).
+        self._greedy_env = (GREEDY_STEP_CAP if limit is None else limit, *self._env[1:])
         self._params = params
         ranges = randomize or {}
         physics = profile_for(settings.twin.env_ids[0]).physics
@@ -113,18 +122,20 @@ class NumbaEngine:
         p = self._params
         q, visits, memory = state.tables
         _, state_size, observation_size, params = self._env
+        twin = self._twin
         episode(
             q.copy(), visits.copy(), tuple(array.copy() for array in memory), p.params,
-            p.grid.low, p.grid.high, p.grid.bins, p.agent.gamma, 0.5, epsilon,
+            p.grid.low, p.grid.high, p.grid.bins, p.grid.starts, p.agent.gamma, 0.5, epsilon,
             np.random.default_rng(0), np.random.default_rng(1), params, 1,
-            np.zeros(state_size, dtype=np.float64), np.zeros(observation_size, dtype=np.float32),
+            np.zeros(state_size, dtype=twin.state_dtype),
+            np.zeros(observation_size, dtype=twin.observation_dtype),
         )  # fmt: skip
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
         env_rng = seeding.np_random(seed)[0]
         returns: np.ndarray = self._greedy_returns(
-            q, self._params.grid, env_rng, self._env, episodes
+            q, self._params.grid, env_rng, self._greedy_env, episodes
         )
         return returns
 

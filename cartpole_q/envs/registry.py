@@ -49,13 +49,22 @@ class Twin:
     reset: Any
     """compiled ``reset(state, observation, rng, params)``"""
     step: Any
-    """compiled ``step(state, action, observation, params) -> (reward, terminated)``"""
+    """compiled ``step(state, action, observation, rng, params) -> (reward, terminated)``"""
     randomize: Any
     """compiled ``randomize(params, rng, keys, lows, highs) -> params`` (``env.randomize``)"""
-    params: Callable[..., tuple[float, ...] | str]
-    """``params(kwargs[, physics])``: the twin's parameters, or why it cannot reproduce them"""
+    params: Callable[..., tuple[Any, ...] | str]
+    """``params(kwargs[, physics])``, or ``params(kwargs, env_id)`` when
+    :attr:`reads_environment`: the twin's parameters, or why it cannot reproduce them"""
+    reads_environment: bool
+    """its parameters are read from the environment ``gymnasium.make`` builds"""
     state_size: int
+    state_dtype: Any
+    """the NumPy type of the state's array (``np.float64``, ``np.int64``)"""
     observation_size: int
+    observation_dtype: Any
+    """the NumPy type of the observation's array (``np.float32``, ``np.int64``)"""
+    observation_kind: str
+    """how an observation becomes a Q-table row: ``box``, ``discrete`` or ``tuple``"""
 
     @classmethod
     def of(cls, module: ModuleType, profile: EnvProfile) -> Twin:
@@ -70,8 +79,12 @@ class Twin:
             step=module.step,
             randomize=getattr(module, "randomized", unchanged),
             params=module.twin_params,
+            reads_environment=bool(module.READS_ENVIRONMENT),
             state_size=int(module.STATE_SIZE),
+            state_dtype=module.STATE_DTYPE,
             observation_size=int(module.OBSERVATION_SIZE),
+            observation_dtype=module.OBSERVATION_DTYPE,
+            observation_kind=str(module.OBSERVATION_KIND),
         )
 
 
@@ -102,11 +115,12 @@ class TwinSettings:
     """Everything the compiled loop needs to run one environment's twin."""
 
     twin: Twin
-    max_episode_steps: int
-    """the time limit (truncation), as ``gymnasium.make`` applies it"""
-    params: tuple[float, ...]
-    """the twin's parameters (the ``gymnasium.make`` arguments it reproduces): a tuple,
-    which compiled code passes by value, without the reference counting of an array"""
+    max_episode_steps: int | None
+    """the time limit (truncation), as ``gymnasium.make`` applies it (``None``: none)"""
+    params: tuple[Any, ...]
+    """the twin's parameters (the ``gymnasium.make`` arguments it reproduces): a tuple of
+    floats, which compiled code passes by value, without the reference counting of an
+    array; or the arrays of a transition table"""
 
     @property
     def state_size(self) -> int:
@@ -135,7 +149,8 @@ def twin_settings(
     Args:
         env_id: the Gymnasium id.
         kwargs: the ``gymnasium.make`` arguments.
-        spec_max_steps: the registered time limit, used when ``kwargs`` gives none.
+        spec_max_steps: the registered time limit, used when ``kwargs`` gives none
+            (``None``: the environment has none).
         physics: ``env.physics`` (CartPole only; the config refuses it elsewhere).
 
     Returns:
@@ -145,10 +160,17 @@ def twin_settings(
     twin = twin_for(env_id)
     if twin is None:
         return f"env.id {env_id!r} has no compiled twin (only {', '.join(twin_ids())} do)"
-    params = twin.params(kwargs, physics) if physics else twin.params(kwargs)
+    max_steps = kwargs.get("max_episode_steps", spec_max_steps)
+    if max_steps is not None and (
+        isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1
+    ):
+        return f"env.kwargs key 'max_episode_steps' must be a positive integer, got {max_steps!r}"
+    if twin.reads_environment:
+        params = twin.params(kwargs, env_id)
+    elif physics:
+        params = twin.params(kwargs, physics)
+    else:
+        params = twin.params(kwargs)
     if isinstance(params, str):
         return params
-    max_steps = kwargs.get("max_episode_steps", spec_max_steps)
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
-        return f"env.kwargs key 'max_episode_steps' must be a positive integer, got {max_steps!r}"
     return TwinSettings(twin, max_steps, params)

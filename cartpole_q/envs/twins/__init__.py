@@ -1,12 +1,25 @@
 """Compiled twins of Gymnasium environments, bit-identical to them.
 
-Each module defines ``STATE_SIZE``, ``OBSERVATION_SIZE``, ``N_ACTIONS``,
-``MAX_EPISODE_STEPS``, the compiled ``reset(state, observation, rng, params)`` and
-``step(state, action, observation, params) -> (reward, terminated)``, and the plain function
-``twin_params(kwargs)`` that turns ``gymnasium.make`` arguments into ``params`` (a tuple of
-floats) or says which
-one the twin cannot reproduce. The environments a twin reproduces are named by their
-profiles (:mod:`cartpole_q.profiles`), which name the twin's module.
+Each module defines:
+
+- ``STATE_SIZE`` and ``STATE_DTYPE``: the twin's state, an array the compiled loop
+  allocates (float64 for the classic-control twins, int64 for the tabular ones);
+- ``OBSERVATION_SIZE``, ``OBSERVATION_DTYPE`` and ``OBSERVATION_KIND``: the array ``reset``
+  and ``step`` write the observation into, and how it becomes a Q-table row (``box``: the
+  binning rule on float32 values; ``discrete``: one integer; ``tuple``: one integer per
+  ``Discrete`` component; see :mod:`cartpole_q.engines.rows`);
+- the compiled ``reset(state, observation, rng, params)`` and
+  ``step(state, action, observation, rng, params) -> (reward, terminated)``, where ``rng``
+  is the environment's generator (``env.np_random``), from which they draw exactly what
+  Gymnasium draws, in the same order (the classic-control steps draw nothing);
+- the plain function ``twin_params`` that turns ``gymnasium.make`` arguments into
+  ``params`` (a tuple, of floats or of arrays), or says which one the twin cannot
+  reproduce: ``twin_params(kwargs)`` (CartPole's also takes ``env.physics``), or, with
+  ``READS_ENVIRONMENT = True``, ``twin_params(kwargs, env_id)``, which reads what it needs
+  from the environment ``gymnasium.make(env_id, **kwargs)`` builds (a transition table).
+
+The environments a twin reproduces are named by their profiles (:mod:`cartpole_q.profiles`),
+which name the twin's module.
 """
 
 from collections.abc import Iterable, Mapping

@@ -48,6 +48,10 @@ MAX_EPISODE_STEPS = 500
 """the time limit ``Acrobot-v1`` is registered with"""
 STATE_SIZE = 4
 OBSERVATION_SIZE = 6
+OBSERVATION_DTYPE = np.float32
+OBSERVATION_KIND = "box"
+STATE_DTYPE = np.float64
+READS_ENVIRONMENT = False
 N_ACTIONS = 3
 PARAM_NAMES: tuple[str, ...] = ()
 """the ``gymnasium.make`` arguments in ``params`` (none)"""
@@ -283,9 +287,13 @@ def reset(
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
+    state: np.ndarray,
+    action: int,
+    observation: np.ndarray,
+    rng: np.random.Generator,
+    params: tuple[float, ...],
 ) -> tuple[float, bool]:
-    """Advance ``state`` by one RK4 step in place; write the observation.
+    """Advance ``state`` by one RK4 step in place (nothing drawn); write the observation.
 
     Returns:
         The reward (-1, or 0 on the step that terminates) and whether the tip rose above

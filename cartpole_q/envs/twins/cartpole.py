@@ -27,6 +27,10 @@ configure_numba_cache()  # before any cache=True function is defined
 
 STATE_SIZE = 4
 OBSERVATION_SIZE = 4
+OBSERVATION_DTYPE = np.float32
+OBSERVATION_KIND = "box"
+STATE_DTYPE = np.float64
+READS_ENVIRONMENT = False
 N_ACTIONS = 2
 PARAM_NAMES = (
     "sutton_barto_reward",
@@ -150,9 +154,13 @@ def reset(
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
+    state: np.ndarray,
+    action: int,
+    observation: np.ndarray,
+    rng: np.random.Generator,
+    params: tuple[float, ...],
 ) -> tuple[float, bool]:
-    """Advance ``state`` by one step in place; write the observation.
+    """Advance ``state`` by one step in place (nothing drawn from ``rng``); write the observation.
 
     Returns:
         The reward and whether the step terminated the episode (the pole fell or the cart

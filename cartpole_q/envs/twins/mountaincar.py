@@ -31,6 +31,10 @@ MAX_EPISODE_STEPS = 200
 """the time limit ``MountainCar-v0`` is registered with"""
 STATE_SIZE = 2
 OBSERVATION_SIZE = 2
+OBSERVATION_DTYPE = np.float32
+OBSERVATION_KIND = "box"
+STATE_DTYPE = np.float64
+READS_ENVIRONMENT = False
 N_ACTIONS = 3
 PARAM_NAMES = ("goal_velocity",)
 """the ``gymnasium.make`` arguments in ``params``, in order"""
@@ -80,9 +84,13 @@ def reset(
 
 @njit(cache=True, nogil=True, inline="always")
 def step(
-    state: np.ndarray, action: int, observation: np.ndarray, params: tuple[float, ...]
+    state: np.ndarray,
+    action: int,
+    observation: np.ndarray,
+    rng: np.random.Generator,
+    params: tuple[float, ...],
 ) -> tuple[float, bool]:
-    """Advance ``state`` by one step in place; write the observation.
+    """Advance ``state`` by one step in place (nothing drawn from ``rng``); write the observation.
 
     Returns:
         The reward (always -1) and whether the car reached the goal at ``goal_velocity``
