@@ -18,6 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
+from cartpole_q.learning_curves import aggregate_band, smooth
 from cartpole_q.profiles import profile_for
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
@@ -63,13 +64,7 @@ def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray
     >>> moving_average(np.array([1.0, 3.0, 5.0, 7.0]), window=2).tolist()
     [1.0, 2.0, 4.0, 6.0]
     """
-    values = np.asarray(values, dtype=np.float64)
-    if values.size == 0:
-        return values
-    cumulative = np.concatenate([[0.0], np.cumsum(values)])
-    index = np.arange(1, values.size + 1)
-    start = np.maximum(index - window, 0)
-    return np.asarray((cumulative[index] - cumulative[start]) / (index - start))
+    return smooth(values, window)
 
 
 def bootstrap_band(
@@ -85,18 +80,7 @@ def bootstrap_band(
     Returns:
         ``(mean, low, high)``, each of length ``n_episodes``.
     """
-    n_seeds = curves.shape[0]
-    mean = np.nanmean(curves, axis=0)
-    picks = rng.integers(0, n_seeds, size=(resamples, n_seeds))
-    # A resample's mean is (how often each seed was picked) @ (the seeds' values): one
-    # matrix product instead of a (resamples, seeds, episodes) array.
-    counts = np.zeros((resamples, n_seeds))
-    np.add.at(counts, (np.arange(resamples)[:, None], picks), 1.0)
-    present = ~np.isnan(curves)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        resampled = (counts @ np.where(present, curves, 0.0)) / (counts @ present)
-    low, high = np.nanpercentile(resampled, [2.5, 97.5], axis=0)
-    return mean, low, high
+    return aggregate_band(curves, "mean", rng, resamples)
 
 
 def reward_curve_figure(
