@@ -9,8 +9,9 @@ world has, and compared with the re-derivation: the kept ``q_table`` bytes, the 
 returns, the lengths and the solve episode.
 
 Every algorithm runs on both engines on CartPole (its twin and ``gymnasium.make``); on the
-other twins (MountainCar, Acrobot) every algorithm runs on the gymnasium engine and one of
-each family on the numba engine: a twin's own exactness is proven in ``test_twins.py``, and
+other twins (MountainCar, Acrobot, FrozenLake, Taxi, CliffWalking, Blackjack) every
+algorithm runs on the gymnasium engine and one of each family on the numba engine: a twin's
+own exactness is proven in ``test_twins_classic.py`` and ``test_twins_tabular.py``, and
 each new (algorithm, twin) pair costs a compilation of several seconds.
 """
 
@@ -244,8 +245,9 @@ CASES: dict[str, dict[str, Any]] = {
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot"}
+NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack"}
 # On the twins other than CartPole's, the numba engine runs one variant of each family.
-OTHER_TWINS = {"mountaincar", "acrobot"}
+OTHER_TWINS = {"mountaincar", "acrobot", "frozenlake", "taxi", "cliffwalking", "blackjack"}
 TWIN_FAMILY_VARIANTS = {
     "q_learning",
     "n_step_tree_backup",

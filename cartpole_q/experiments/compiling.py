@@ -19,11 +19,12 @@ from cartpole_q.experiments.workers import JobHandle, default_workers, execute
 from cartpole_q.rl.algorithms import names as algorithm_names
 
 ENGINE_CONFIGS = {
-    "numba": ("default", "mountaincar", "acrobot"),
+    "numba": ("default", "mountaincar", "acrobot", "frozenlake", "taxi", "blackjack"),
     "gymnasium": ("default", "frozenlake", "blackjack"),
 }
-"""shipped configs that cover every twin (numba) and every observation kind (gymnasium:
-a Box, a Discrete, a Tuple of Discrete)"""
+"""shipped configs that cover every twin (numba: CartPole, MountainCar, Acrobot, the
+transition-table twin of FrozenLake and CliffWalking, Taxi, Blackjack) and every
+observation kind (gymnasium: a Box, a Discrete, a Tuple of Discrete)"""
 
 
 @dataclass(frozen=True)

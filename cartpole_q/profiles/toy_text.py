@@ -2,7 +2,9 @@
 
 Each has an exact model, so ``cartpole-q optimum`` and ``eval`` compute the best return:
 FrozenLake, Taxi and CliffWalking from their transition table (``env.unwrapped.P``),
-Blackjack from its rules.
+Blackjack from its rules. Each has a compiled twin: FrozenLake and CliffWalking the one of
+any world that moves by its transition table, Taxi that one with its fickle passenger,
+Blackjack its own.
 """
 
 from __future__ import annotations
@@ -42,6 +44,7 @@ FROZENLAKE = EnvProfile(
     policy_map="grid",
     grid=frozenlake_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )
 
 TAXI = EnvProfile(
@@ -55,6 +58,7 @@ TAXI = EnvProfile(
     component_names=("taxi row", "taxi column", "passenger", "destination"),
     rows_down=True,
     model="transition_table",
+    twin="cartpole_q.envs.twins.taxi",
 )
 
 CLIFFWALKING = EnvProfile(
@@ -66,6 +70,7 @@ CLIFFWALKING = EnvProfile(
     policy_map="grid",
     grid=cliffwalking_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )
 
 BLACKJACK = EnvProfile(
@@ -77,4 +82,5 @@ BLACKJACK = EnvProfile(
     action_names=("stick", "hit"),
     policy_map="blackjack",
     model="blackjack",
+    twin="cartpole_q.envs.twins.blackjack",
 )
