@@ -75,6 +75,12 @@ SETTINGS: dict[str, tuple[str, dict[str, Any], float]] = {
     "blackjack-no-sab": ("Blackjack-v1", {"sab": False}, 0.7),
     "blackjack-natural": ("Blackjack-v1", {"sab": False, "natural": True}, 0.7),
     "blackjack-sab-natural": ("Blackjack-v1", {"natural": True}, 0.7),
+    # Sutton & Barto's worlds that play their table (cartpole_q/worlds/)
+    "windy": ("cartpole_q/WindyGridworld-v0", {}, 0.5),
+    "kings-stay": ("cartpole_q/KingsWindyGridworld-v0", {"stay": True}, 0.5),
+    "windy-stochastic": ("cartpole_q/StochasticWindyGridworld-v0", {}, 0.5),
+    "dyna-maze": ("cartpole_q/DynaMaze-v0", {"max_episode_steps": 30}, 0.5),
+    "random-walk": ("cartpole_q/RandomWalk-v0", {}, 0.0),
 }
 STEPS = 10_000
 
@@ -229,6 +235,18 @@ def test_what_the_twins_refuse_and_auto_picks() -> None:
                    "CliffWalkingSlippery-v1", "Blackjack-v1"):  # fmt: skip
         auto = load_config(overrides={"env.id": env_id})
         assert resolve_engine(auto, inspect_env(auto)) == "numba", env_id
+    for env_id in ("cartpole_q/WindyGridworld-v0", "cartpole_q/DynaMaze-v0"):
+        auto = load_config(overrides={"env.id": env_id})
+        assert resolve_engine(auto, inspect_env(auto)) == "numba", env_id
+    # A world whose table changes while it is played, or whose rewards are drawn, is not
+    # played by a table baked once: the gymnasium engine plays it.
+    for env_id in (
+        "cartpole_q/BlockingMaze-v0", "cartpole_q/ShortcutMaze-v0", "cartpole_q/MaximizationBias-v0"
+    ):  # fmt: skip
+        reason = transition_table.twin_params({}, env_id)
+        assert isinstance(reason, str) and "does not play its transition table" in reason
+        auto = load_config(overrides={"env.id": env_id})
+        assert resolve_engine(auto, inspect_env(auto)) == "gymnasium", env_id
     rendered = load_config(overrides={"env.id": "Taxi-v4", "env.kwargs": {"render_mode": "ansi"}})
     assert resolve_engine(rendered, inspect_env(rendered)) == "gymnasium"
 
@@ -256,11 +274,17 @@ WORLDS: dict[str, dict[str, Any]] = {
         "q_init": 0.0,
     },
 }
+WORLDS["windy-stochastic"] = {
+    "env": {"id": "cartpole_q/StochasticWindyGridworld-v0", "kwargs": {"max_episode_steps": 300}},
+    "episodes": 40,
+    "q_init": 0.0,
+}
 MULTI_STEP = {
     "lake-custom": "sarsa_lambda",
     "taxi-rainy-fickle": "n_step_tree_backup",
     "cliff-slippery": "dyna_q",
     "blackjack-natural": "monte_carlo",
+    "windy-stochastic": "true_online_sarsa_lambda",
 }
 
 

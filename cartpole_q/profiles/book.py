@@ -46,6 +46,7 @@ WINDY_GRIDWORLD = EnvProfile(
     policy_map="grid",
     grid=gridworld_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )
 
 KINGS_WINDY_GRIDWORLD = EnvProfile(
@@ -58,6 +59,7 @@ KINGS_WINDY_GRIDWORLD = EnvProfile(
     policy_map="grid",
     grid=gridworld_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )
 
 DYNA_MAZE = EnvProfile(
@@ -72,6 +74,7 @@ DYNA_MAZE = EnvProfile(
     policy_map="grid",
     grid=gridworld_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )
 
 MAXIMIZATION_BIAS = EnvProfile(
@@ -92,4 +95,5 @@ RANDOM_WALK = EnvProfile(
     policy_map="grid",
     grid=random_walk_grid,
     model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
 )

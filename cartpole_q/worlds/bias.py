@@ -45,6 +45,8 @@ class MaximizationBiasEnv(TableWorld):
             evenly between left and right.
     """
 
+    plays_its_table = False  # P holds B's mean reward; a step draws a normal one
+
     def __init__(self, b_actions: int = 10) -> None:
         if isinstance(b_actions, bool) or not isinstance(b_actions, int):
             raise ValueError(f"`b_actions` must be an even whole number, got {b_actions!r}")

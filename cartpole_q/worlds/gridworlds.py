@@ -246,6 +246,8 @@ class ChangingMaze(GridWorld):
         change_at: the steps taken in the first layout (0: the second from the start).
     """
 
+    plays_its_table = False  # P changes after change_at steps: a table baked once is wrong
+
     def __init__(self, before: frozenset[Cell], after: frozenset[Cell], change_at: Any) -> None:
         if isinstance(change_at, bool) or not isinstance(change_at, int) or change_at < 0:
             raise ValueError(f"`change_at` must be a whole number of steps >= 0, got {change_at!r}")

@@ -32,6 +32,9 @@ class TableWorld(gymnasium.Env[Any, Any]):
     """
 
     metadata = {"render_modes": [], "render_fps": 4}  # noqa: RUF012 - gymnasium.Env declares it
+    plays_its_table = True
+    """every step is one draw of ``P`` as it was when the environment was made; a compiled
+    twin baked from ``P`` then plays it exactly (see ``envs/twins/transition_table.py``)"""
 
     def __init__(self, n_states: int, n_actions: int, start: int) -> None:
         self.observation_space = spaces.Discrete(n_states)

@@ -155,6 +155,11 @@ def read_environment(
 
 def table_params(env: Any) -> tuple[np.ndarray, ...] | str:
     """The arrays of :data:`PARAM_NAMES` of an unwrapped environment, or why there are none."""
+    if not getattr(env, "plays_its_table", True):
+        return (
+            "the environment does not play its transition table as made (its table changes "
+            "while it is played, or its rewards are drawn rather than tabulated)"
+        )
     transitions = getattr(env, "P", None)
     initial = getattr(env, "initial_state_distrib", None)
     if not isinstance(transitions, Mapping) or initial is None:
