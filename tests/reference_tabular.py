@@ -259,14 +259,25 @@ class Agent:
     # -- drawing and updating
 
     def draw(self, x: int) -> int:
-        """design.md's epsilon-greedy action for ``x``."""
+        """design.md's epsilon-greedy action for ``x`` (ties as ``agent.tie_break`` says)."""
         if self.epsilon <= 0.0:
-            return argmax(self.policy_row(x))
+            return self.exploit(x)
         if self.epsilon >= 1.0:
             return int(self.rng.integers(0, self.n))
         if self.rng.random() < self.epsilon:
             return int(self.rng.integers(0, self.n))
-        return argmax(self.policy_row(x))
+        return self.exploit(x)
+
+    def exploit(self, x: int) -> int:
+        """The greedy branch: the lowest best action, or with ``tie_break: random`` one of the
+        ``k`` tied best, the ``rng.integers(0, k)``-th in action order (no draw when k = 1)."""
+        row = self.policy_row(x)
+        lowest = argmax(row)
+        if self.params.get("tie_break", "lowest") == "random":
+            tied = [b for b in range(self.n) if row[b] == row[lowest]]
+            if len(tied) > 1:
+                return tied[int(self.rng.integers(0, len(tied)))]
+        return lowest
 
     def update(self, x: int, b: int, y: float) -> None:
         """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))``."""
@@ -741,6 +752,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "planning_steps": 10,
     "kappa": 0.001,
     "update": "sample_average",
+    "tie_break": "lowest",  # agent.tie_break, a key of every algorithm
 }
 
 

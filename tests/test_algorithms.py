@@ -20,7 +20,7 @@ VARIANTS = ["python", "compiled"]
 def learn_step(algorithm: str, variant: str, q, memory, *transition):  # type: ignore[no-untyped-def]
     """The algorithm's step hook, as it is or compiled."""
     step = get(algorithm).step
-    return (step if variant == "python" else jit(step))(q, memory, (), *transition)
+    return (step if variant == "python" else jit(step))(q, memory, (0.0,), *transition)
 
 
 def _tables() -> np.ndarray:
@@ -145,5 +145,36 @@ def test_double_q_learning_acts_on_the_sum_of_its_tables(variant: str) -> None:
     rng = np.random.default_rng(0)
     start = double_q_learning.start if variant == "python" else jit(double_q_learning.start)
     epsilon_greedy = tabular.epsilon_greedy if variant == "python" else jit(tabular.epsilon_greedy)
-    assert start(q_a, (q_b,), (), 0, 0.0, rng) == 0
+    assert start(q_a, (q_b,), (0.0,), 0, 0.0, rng) == 0
     assert epsilon_greedy(q_a, 0, 0.0, rng) == 1
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_random_ties_draw_one_of_the_tied_best_actions_and_only_then(variant: str) -> None:
+    behaviour = tabular.behaviour_action if variant == "python" else jit(tabular.behaviour_action)
+    q = np.array([[1.0, 3.0, 3.0, 0.0, 3.0], [1.0, 4.0, 3.0, 0.0, 3.0]])
+    seen = set()
+    for seed in range(40):
+        rng = np.random.default_rng(seed)
+        expected_pick = [1, 2, 4][int(np.random.default_rng(seed).integers(0, 3))]
+        assert behaviour(q, (0.0, 1.0), 0, 0.0, rng) == expected_pick  # own param, then the rule
+        seen.add(expected_pick)
+    assert seen == {1, 2, 4}
+    rng = np.random.default_rng(0)
+    before = rng.bit_generator.state
+    assert behaviour(q, (1.0,), 1, 0.0, rng) == 1  # one best action: nothing drawn
+    assert behaviour(q, (0.0,), 0, 0.0, rng) == 1  # lowest: the first of the tied
+    assert rng.bit_generator.state == before
+    # the exploration draw comes first, as in epsilon_greedy
+    rng, again = np.random.default_rng(5), np.random.default_rng(5)
+    explored = again.random() < 0.5
+    action = behaviour(q, (1.0,), 0, 0.5, rng)
+    if explored:
+        assert action == int(again.integers(0, 5))
+    else:
+        assert action == [1, 2, 4][int(again.integers(0, 3))]
+    # Double Q-learning breaks ties on A + B the same way
+    start = double_q_learning.start if variant == "python" else jit(double_q_learning.start)
+    q_a, q_b = np.array([[0.0, 3.0, 1.0]]), np.array([[3.0, 0.0, 1.0]])  # sums 3, 3, 2
+    picks = {start(q_a, (q_b,), (1.0,), 0, 0.0, np.random.default_rng(s)) for s in range(20)}
+    assert picks == {0, 1}

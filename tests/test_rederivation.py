@@ -105,6 +105,21 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "true_online_sarsa_lambda-lambda1": ("true_online_sarsa_lambda", {"lambda": 1.0}),
     "dyna_q-planning0": ("dyna_q", {"planning_steps": 0}),
     "dyna_q_plus-kappa0": ("dyna_q_plus", {"planning_steps": 3, "kappa": 0.0}),
+    # agent.tie_break: random, where ties are common (q_init 0 on FrozenLake; CartPole's
+    # optimistic start)
+    **{
+        f"{name}-random-ties": (name, {"tie_break": "random"})
+        for name in (
+            "q_learning",
+            "sarsa",
+            "double_q_learning",
+            "n_step_tree_backup",
+            "sarsa_lambda",
+            "watkins_q_lambda",
+            "dyna_q_plus",
+            "off_policy_monte_carlo",
+        )
+    },
 }
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
 LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")

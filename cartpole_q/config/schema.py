@@ -24,6 +24,7 @@ import yaml
 
 from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
+from cartpole_q.rl.tabular import TIE_BREAKS
 
 ENGINES = ("auto", "numba", "gymnasium")
 """``engine`` values"""
@@ -279,6 +280,15 @@ class AgentConfig:
     max_q_table_bytes: int = field(
         metadata=spec(
             "int", "refuse a Q-table larger than this many bytes, before allocating it", low=1
+        )
+    )
+    tie_break: str = field(
+        metadata=spec(
+            "choice",
+            "{choices}: which of equally valued best actions epsilon-greedy exploits: the "
+            "lowest (design.md), or one drawn at random, as Sutton & Barto's figures do "
+            "(docs/algorithms.md)",
+            choices=TIE_BREAKS,
         )
     )
 

@@ -146,7 +146,7 @@ class AgentParams:
                 epsilon=ScheduleRecord.of(config.agent.epsilon),
                 threshold=math.inf if threshold is None else float(threshold),
             ),
-            params=algorithm.hook_params(config.agent.params),
+            params=algorithm.hook_params(config.agent.params, config.agent.tie_break),
         )
 
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cartpole_q.rl.tabular import first_action, no_episode_end
+from cartpole_q.rl.tabular import TIE_BREAKS, first_action, no_episode_end
 
 ParamValue = float | int | str
 
@@ -145,6 +145,13 @@ class Algorithm:
                 return param
         raise KeyError(key)
 
-    def hook_params(self, values: Mapping[str, ParamValue]) -> tuple[float, ...]:
-        """The parameters as the hooks take them: floats, in declaration order."""
-        return tuple(param.as_float(values[param.key]) for param in self.params)
+    def hook_params(
+        self, values: Mapping[str, ParamValue], tie_break: str = "lowest"
+    ) -> tuple[float, ...]:
+        """The parameters as the hooks take them: floats, in declaration order, then the tie rule.
+
+        The last is ``agent.tie_break`` as its index in ``TIE_BREAKS`` (``random``: 1.0),
+        which every algorithm's epsilon-greedy reads (``behaviour_action``).
+        """
+        own = tuple(param.as_float(values[param.key]) for param in self.params)
+        return (*own, float(TIE_BREAKS.index(tie_break)))

@@ -41,6 +41,10 @@ Params = tuple[float, ...]
 """an algorithm's parameters as floats, in :attr:`~cartpole_q.rl.algorithm.Algorithm.params` order"""
 Rng = np.random.Generator
 """the agent's random generator (numba compiles numpy's ``Generator`` methods)"""
+TIE_BREAKS = ("lowest", "random")
+"""``agent.tie_break``: which of equally valued best actions epsilon-greedy exploits"""
+RANDOM_TIES = 1.0
+"""``agent.tie_break: random`` as the hooks get it (the last of their parameters)"""
 
 Function = TypeVar("Function", bound=Callable[..., Any])
 
@@ -86,6 +90,49 @@ def epsilon_greedy(q: Table, state: int, epsilon: float, rng: Rng) -> int:
 
 
 @compilable
+def tied_best_action(q: Table, state: int, rng: Rng) -> int:
+    """One of the actions with the largest ``Q(state, .)``, uniformly at random.
+
+    Among the ``k`` actions whose value equals the largest, the ``rng.integers(0, k)``-th in
+    action order; nothing is drawn when one action is best (or none compares equal: NaN).
+    """
+    best = best_value(q, state)
+    tied = 0
+    for action in range(q.shape[1]):
+        if q[state, action] == best:
+            tied += 1
+    if tied <= 1:
+        return best_action(q, state)
+    pick = int(rng.integers(0, tied))
+    for action in range(q.shape[1]):
+        if q[state, action] == best:
+            if pick == 0:
+                return action
+            pick -= 1
+    return best_action(q, state)
+
+
+@compilable
+def random_ties(params: Params) -> bool:
+    """Whether ``agent.tie_break`` is ``random``: the last of the hooks' parameters."""
+    return params[-1] == RANDOM_TIES
+
+
+@compilable
+def behaviour_action(q: Table, params: Params, state: int, epsilon: float, rng: Rng) -> int:
+    """Epsilon-greedy as :func:`epsilon_greedy` draws it, ties broken as ``agent.tie_break`` says.
+
+    With ``agent.tie_break: random`` the greedy branch takes :func:`tied_best_action` (after
+    the exploration draw); with ``lowest`` it is :func:`epsilon_greedy` exactly.
+    """
+    if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
+        return int(rng.integers(0, q.shape[1]))
+    if random_ties(params):
+        return tied_best_action(q, state, rng)
+    return best_action(q, state)
+
+
+@compilable
 def update(q: Table, state: int, action: int, target: float, alpha: float) -> None:
     """``Q(s, a) += alpha * (target - Q(s, a))``."""
     q[state, action] += alpha * (target - q[state, action])
@@ -123,7 +170,7 @@ def first_action(
     q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng
 ) -> int:
     """The default first action of an episode: epsilon-greedy on ``Q``."""
-    return epsilon_greedy(q, state, epsilon, rng)
+    return behaviour_action(q, params, state, epsilon, rng)
 
 
 @compilable

@@ -9,7 +9,7 @@ action, an episode's first included, is epsilon-greedy on ``A + B``. ``q_table.n
 
 >>> import numpy as np
 >>> a, b = np.zeros((2, 2)), np.array([[0.0, 0.0], [1.0, 3.0]])
->>> step(a, (b,), (), 0, 0, 1.0, 1, False, False, 1.0, 1.0, 0.0, np.random.default_rng(2))
+>>> step(a, (b,), (0.0,), 0, 0, 1.0, 1, False, False, 1.0, 1.0, 0.0, np.random.default_rng(2))
 1
 >>> float(a[0, 0]), float(b[0, 0])  # the coin picked A: 1 + B(1, argmax A(1, .) = 0) = 2
 (2.0, 0.0)
@@ -20,7 +20,17 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, best_action, compilable, update
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    best_action,
+    compilable,
+    random_ties,
+    update,
+)  # fmt: skip
 
 
 @compilable
@@ -36,18 +46,40 @@ def best_action_of_sum(q_a: Table, q_b: Table, state: int) -> int:
 
 
 @compilable
-def epsilon_greedy_on_sum(q_a: Table, q_b: Table, state: int, epsilon: float, rng: Rng) -> int:
-    """Epsilon-greedy on ``A + B``, with the draws of ``epsilon_greedy``."""
-    if epsilon <= 0.0:
-        return best_action_of_sum(q_a, q_b, state)
-    if epsilon >= 1.0 or rng.random() < epsilon:
+def tied_best_action_of_sum(q_a: Table, q_b: Table, state: int, rng: Rng) -> int:
+    """One of the actions with the largest ``A + B``, as ``tied_best_action`` picks on ``Q``."""
+    best = best_action_of_sum(q_a, q_b, state)
+    best_sum = q_a[state, best] + q_b[state, best]
+    tied = 0
+    for action in range(q_a.shape[1]):
+        if q_a[state, action] + q_b[state, action] == best_sum:
+            tied += 1
+    if tied <= 1:
+        return best
+    pick = int(rng.integers(0, tied))
+    for action in range(q_a.shape[1]):
+        if q_a[state, action] + q_b[state, action] == best_sum:
+            if pick == 0:
+                return action
+            pick -= 1
+    return best
+
+
+@compilable
+def epsilon_greedy_on_sum(
+    q_a: Table, q_b: Table, params: Params, state: int, epsilon: float, rng: Rng
+) -> int:
+    """Epsilon-greedy on ``A + B``, with the draws of ``behaviour_action``."""
+    if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
         return int(rng.integers(0, q_a.shape[1]))
+    if random_ties(params):
+        return tied_best_action_of_sum(q_a, q_b, state, rng)
     return best_action_of_sum(q_a, q_b, state)
 
 
 def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng) -> int:
     """The first action: epsilon-greedy on ``A + B``."""
-    return epsilon_greedy_on_sum(q, memory[0], state, epsilon, rng)
+    return epsilon_greedy_on_sum(q, memory[0], params, state, epsilon, rng)
 
 
 def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
@@ -69,7 +101,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         update(q_b, state, action, target, alpha)
     if terminated or truncated:
         return ENDED
-    return epsilon_greedy_on_sum(q, q_b, next_state, epsilon, rng)
+    return epsilon_greedy_on_sum(q, q_b, params, next_state, epsilon, rng)
 
 
 def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:

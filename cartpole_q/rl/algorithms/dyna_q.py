@@ -9,7 +9,7 @@ remembered transition; the next action is drawn from the table after planning. W
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> memory = dyna_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (3.0,), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+>>> step(q, memory, (3.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
 0
 >>> float(q[0, 1])  # once for real, three times from the model: 1 - 0.5 ** 4
 0.9375
@@ -27,8 +27,8 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     best_value,
-    epsilon_greedy,
     update,
 )
 
@@ -45,7 +45,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     plan_dyna_q(q, memory, int(params[0]), alpha, gamma, rng)
     if terminated or truncated:
         return ENDED
-    return epsilon_greedy(q, next_state, epsilon, rng)
+    return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 def dyna_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:

@@ -9,7 +9,7 @@ contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> memory = dyna_plus_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (0.0, 0.1), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+>>> step(q, memory, (0.0, 0.1, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0,
 ...      np.random.default_rng(0))
 0
 >>> float(q[0, 1]), int(memory[6][1]), int(memory[7][1])
@@ -30,9 +30,9 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     best_value,
     compilable,
-    epsilon_greedy,
     update,
 )
 
@@ -78,7 +78,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     plan_with_bonus(q, memory, last_tried, int(params[0]), params[1], alpha, gamma, rng)
     if terminated or truncated:
         return ENDED
-    return epsilon_greedy(q, next_state, epsilon, rng)
+    return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 def dyna_plus_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:

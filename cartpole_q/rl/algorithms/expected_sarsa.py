@@ -6,7 +6,7 @@ terminated); update, then draw the next action from the updated table.
 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
->>> step(q, (), (), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5, np.random.default_rng(0)) in (0, 1)
+>>> step(q, (), (0.0,), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5, np.random.default_rng(0)) in (0, 1)
 True
 >>> float(q[0, 0])  # 0.5 * 4 + 0.25 * 6
 3.5
@@ -21,7 +21,7 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
-    epsilon_greedy,
+    behaviour_action,
     expected_value,
     update,
 )
@@ -37,7 +37,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     update(q, state, action, target, alpha)
     if terminated or truncated:
         return ENDED
-    return epsilon_greedy(q, next_state, epsilon, rng)
+    return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 ALGORITHM = Algorithm(

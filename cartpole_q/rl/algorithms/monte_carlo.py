@@ -11,9 +11,9 @@ bootstrapped from ``Q`` with the epsilon-greedy policy's value of the last state
 >>> q = np.zeros((2, 2))
 >>> memory = mc_memory(MemoryContext(2, 2, 0.0, {}, 5))
 >>> rng = np.random.default_rng(0)
->>> step(q, memory, (0.0,), 0, 1, 1.0, 1, False, False, 0.5, 0.5, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 0.5, 0.0, rng)
 0
->>> step(q, memory, (0.0,), 1, 0, 2.0, 0, True, False, 0.5, 0.5, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), 1, 0, 2.0, 0, True, False, 0.5, 0.5, 0.0, rng)
 -1
 >>> float(q[0, 1]), float(q[1, 0])  # returns 1 + 0.5 * 2 and 2, first visits, averaged
 (2.0, 2.0)
@@ -30,7 +30,7 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
-    epsilon_greedy,
+    behaviour_action,
     expected_value,
     update,
 )
@@ -53,7 +53,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         first_visit[flat] = t
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
-        return epsilon_greedy(q, next_state, epsilon, rng)
+        return behaviour_action(q, params, next_state, epsilon, rng)
     averaging = params[0] == 0.0
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value under the policy

@@ -9,7 +9,7 @@ draws it). With ``n = 1`` this is SARSA, byte for byte. The contract: docs/algor
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = queue_memory(1)
->>> step(q, memory, (1.0,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+>>> step(q, memory, (1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
 1
 >>> float(q[0, 0])  # as SARSA: 0 + 0.5 * (1 + 4 - 0)
 2.5
@@ -27,8 +27,8 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     compilable,
-    epsilon_greedy,
     update,
 )
 
@@ -60,7 +60,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     push(states, actions, rewards, counter, state, action, reward)
     next_action = ENDED
     if not terminated:
-        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        next_action = behaviour_action(q, params, next_state, epsilon, rng)
     if terminated or truncated:
         while counter[1] > 0:
             settle_oldest(q, states, actions, rewards, counter, next_state, next_action,

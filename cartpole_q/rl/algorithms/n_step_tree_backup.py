@@ -9,7 +9,7 @@ action is drawn after the update, as Expected SARSA does. The contract: docs/alg
 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
->>> step(q, queue_memory(1), (1.0,), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5,
+>>> step(q, queue_memory(1), (1.0, 0.0), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5,
 ...      np.random.default_rng(0)) in (0, 1)
 True
 >>> float(q[0, 0])  # as Expected SARSA: 0.5 * 4 + 0.25 * 6
@@ -28,9 +28,9 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     best_action,
     compilable,
-    epsilon_greedy,
     expected_value,
     policy_probability,
     update,
@@ -81,7 +81,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     if counter[1] == states.shape[0]:
         settle_oldest(q, states, actions, rewards, counter, next_state, False, alpha, gamma,
                       epsilon)  # fmt: skip
-    return epsilon_greedy(q, next_state, epsilon, rng)
+    return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:

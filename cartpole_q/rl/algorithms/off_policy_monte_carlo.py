@@ -12,9 +12,9 @@ docs/algorithms.md.
 >>> q = np.zeros((2, 2))
 >>> memory = off_policy_memory(MemoryContext(2, 2, 0.0, {}, 5))
 >>> rng = np.random.default_rng(0)
->>> step(q, memory, (0.0,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, rng)
 0
->>> step(q, memory, (0.0,), 1, 0, 2.0, 0, True, False, 0.5, 1.0, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), 1, 0, 2.0, 0, True, False, 0.5, 1.0, 0.0, rng)
 -1
 >>> float(q[0, 0]), float(q[1, 0])  # greedy all along: W stays 1
 (3.0, 2.0)
@@ -31,9 +31,9 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     best_action,
     best_value,
-    epsilon_greedy,
     policy_probability,
 )
 
@@ -59,7 +59,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     behaviour[t] = policy_probability(action, best_action(q, state), epsilon, n_actions)
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
-        return epsilon_greedy(q, next_state, epsilon, rng)
+        return behaviour_action(q, params, next_state, epsilon, rng)
     averaging = params[0] == 0.0
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value under the greedy target

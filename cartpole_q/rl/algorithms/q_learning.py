@@ -6,7 +6,7 @@ epsilon-greedily from the updated table (not at the episode's end).
 
 >>> import numpy as np
 >>> q = np.array([[1.0, 0.0], [2.0, 3.0]])
->>> step(q, (), (), 0, 0, 1.0, 1, False, True, 0.5, 0.9, 0.0, np.random.default_rng(0))
+>>> step(q, (), (0.0,), 0, 0, 1.0, 1, False, True, 0.5, 0.9, 0.0, np.random.default_rng(0))
 -1
 >>> float(q[0, 0])  # truncated, so it bootstraps: 1 + 0.5 * (1 + 0.9 * 3 - 1) = 2.35
 2.35
@@ -21,8 +21,8 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    behaviour_action,
     best_value,
-    epsilon_greedy,
     update,
 )
 
@@ -37,7 +37,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     update(q, state, action, target, alpha)
     if terminated or truncated:
         return ENDED
-    return epsilon_greedy(q, next_state, epsilon, rng)
+    return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 ALGORITHM = Algorithm(

@@ -6,7 +6,7 @@ is, first (also at truncation, where ``a'`` is not played; not when terminated);
 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
->>> step(q, (), (), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+>>> step(q, (), (0.0,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
 1
 >>> float(q[0, 0])  # 0 + 0.5 * (1 + 4 - 0)
 2.5
@@ -15,7 +15,7 @@ is, first (also at truncation, where ``a'`` is not played; not when terminated);
 from __future__ import annotations
 
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, epsilon_greedy, update
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action, update
 
 
 def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
@@ -25,7 +25,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     target = reward
     next_action = ENDED
     if not terminated:
-        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        next_action = behaviour_action(q, params, next_state, epsilon, rng)
         target = reward + gamma * q[next_state, next_action]
     update(q, state, action, target, alpha)
     if terminated or truncated:

@@ -10,7 +10,7 @@ SARSA, byte for byte. The contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = trace_memory(2, 2)
->>> step(q, memory, (0.5, 1.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+>>> step(q, memory, (0.5, 1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
 ...      np.random.default_rng(0))
 1
 >>> float(q[0, 0]), float(memory[0][0])  # as SARSA; the trace decayed to 0.5
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, epsilon_greedy
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
@@ -44,7 +44,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     next_action = ENDED
     target = reward
     if not terminated:
-        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        next_action = behaviour_action(q, params, next_state, epsilon, rng)
         target = reward + gamma * q[next_state, next_action]
     delta = target - q[state, action]
     give_trace(values, states, actions, slots, count, state, action, kind, alpha, n_actions)

@@ -9,7 +9,7 @@ Per step: ``a'`` drawn first (as SARSA); ``delta = r + gamma * Q(s', a') - Q(s, 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = true_online_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (0.5,), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+>>> step(q, memory, (0.5, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
 ...      np.random.default_rng(0))
 1
 >>> float(q[0, 0]), float(memory[5][0])  # 0.5 * 5 * 1 - 0.5 * 0; q_old = Q(s', a') = 4
@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, epsilon_greedy
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action
 from cartpole_q.rl.traces import (
     LAMBDA,
     apply_traces,
@@ -44,7 +44,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     next_action = ENDED
     q_next = 0.0
     if not terminated:
-        next_action = epsilon_greedy(q, next_state, epsilon, rng)
+        next_action = behaviour_action(q, params, next_state, epsilon, rng)
         q_next = q[next_state, next_action]
     q_sa = q[state, action]
     q_old = q_old_cell[0]

@@ -10,7 +10,7 @@ byte for byte. The contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = trace_memory(2, 2)
->>> step(q, memory, (0.5, 1.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
+>>> step(q, memory, (0.5, 1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
 ...      np.random.default_rng(0))
 1
 >>> float(q[0, 0]), int(memory[4][0])  # as Q-learning; a greedy a' keeps the trace
@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, best_value, epsilon_greedy
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action, best_value
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
@@ -52,7 +52,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         return ENDED
     # Decayed in the same pass; cleared below instead when the next action explores.
     apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
-    next_action = epsilon_greedy(q, next_state, epsilon, rng)
+    next_action = behaviour_action(q, params, next_state, epsilon, rng)
     if q[next_state, next_action] != best_value(q, next_state):
         clear_traces(states, actions, slots, count, n_actions)
     return next_action
