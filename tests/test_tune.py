@@ -375,6 +375,27 @@ def test_resume_refuses_a_tune_yaml_edited_since_the_start(
     assert _trials(out) == before
 
 
+def test_resume_fails_a_trial_its_killed_process_never_named(tmp_path: Path) -> None:
+    """Killed between asking for a trial and naming itself: resume must not count it."""
+    import optuna
+    import yaml
+
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
+    out = tmp_path / "out"
+    assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
+    storage = optuna.storages.JournalStorage(
+        optuna.storages.journal.JournalFileBackend(str(out / tunedir.JOURNAL_FILE))
+    )
+    optuna.load_study(study_name=TUNE["name"], storage=storage).ask()  # RUNNING, no owner
+    tune_yaml = out / tunedir.TUNE_FILE
+    data = yaml.safe_load(tune_yaml.read_text())
+    data["trials"] = 2
+    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    assert invoke("tune", "--resume", out, "-q").exit_code == 0
+    states = [trial.state.name for trial in _journal_trials(out)]
+    assert states == ["COMPLETE", "FAIL", "COMPLETE"]
+
+
 def test_resume_may_raise_the_trials_in_tune_yaml(tmp_path: Path) -> None:
     import yaml
 

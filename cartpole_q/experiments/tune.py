@@ -356,18 +356,27 @@ def _alive_here(owner: str) -> bool:
     return True
 
 
-def fail_abandoned(the_study: Any) -> int:
-    """Mark running trials whose process (on this machine) is gone as failed; count them."""
+def fail_abandoned(the_study: Any, exclusive: bool = False) -> int:
+    """Mark running trials whose process (on this machine) is gone as failed; count them.
+
+    Args:
+        the_study: The study.
+        exclusive: Only this process can be running trials (the study is in the tune
+            directory's own journal, whose lock this process holds): a trial no process
+            has named yet was abandoned by a killed one.
+    """
     optuna = optuna_module()
     failed = 0
     now = datetime.datetime.now()
     for trial in the_study.get_trials(deepcopy=False, states=(optuna.trial.TrialState.RUNNING,)):
         owner = trial.user_attrs.get(OWNER)
         if owner is None:
-            # Its process was killed between asking for it and naming itself, or is about
-            # to name itself: only the first, a minute on, is abandoned.
+            # Its process was killed between asking for it and naming itself, or (in a
+            # shared storage) another is about to name itself: there, only a trial a
+            # minute old is abandoned.
             started = trial.datetime_start
-            abandoned = started is not None and (now - started).total_seconds() > 60
+            old = started is not None and (now - started).total_seconds() > 60
+            abandoned = exclusive or old
         else:
             abandoned = not _alive_here(owner)
         if abandoned:
@@ -421,7 +430,7 @@ def _run_trials(
 ) -> TuneOutcome:  # fmt: skip
     optuna = optuna_module()
     the_study = study(spec, directory, storage_url)
-    fail_abandoned(the_study)
+    fail_abandoned(the_study, exclusive=storage_url is None)
     owner = f"{socket.gethostname()}:{os.getpid()}"
     while not (should_stop is not None and should_stop()):
         if len(counted(the_study)) >= total:
