@@ -32,10 +32,12 @@ def way(function, variant: str):  # type: ignore[no-untyped-def]
 def test_q_learning_picks_the_next_action_from_the_updated_table(variant: str) -> None:
     step = way(q_learning.step, variant)
     q = np.array([[0.0, 0.0], [0.0, 0.1]])
-    action = step(q, (), (), 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0, np.random.default_rng(0))
+    action = step(
+        q, (), (0.0,), 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0, np.random.default_rng(0)
+    )
     # Q(1, 1) becomes 1.0 before the greedy choice in state 1
     assert action == 1 and q[1, 1] == 1.0
-    ended = step(q, (), (), 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0, np.random.default_rng(0))
+    ended = step(q, (), (0.0,), 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0, np.random.default_rng(0))
     assert ended == ENDED  # truncated: the episode ended, no next action is drawn
 
 
