@@ -5,20 +5,27 @@ the same sweep would run the same runs twice and the last writer would win; so t
 command that writes a directory first takes its lock, and a second one is refused with
 the holder's process id. The lock is ``flock`` on the file ``.lock`` in the directory:
 the kernel releases it when the holder exits, however it exits (``kill -9`` included),
-so a stale lock never blocks a later ``--resume``.
+so a stale lock never blocks a later ``--resume``. Forked workers share the lock, so it
+lasts until the last of them has ended; a holder that is dying (its workers take a few
+milliseconds to follow a ``kill -9``) is waited for, briefly, before a second writer is
+refused.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from cartpole_q.errors import RunError
 
 LOCK_FILE = ".lock"
 """the lock file inside a locked directory (it holds the holder's process id)"""
+
+_PATIENCE_SECONDS = 2.0
+"""how long a held lock is retried before a second writer is refused"""
 
 
 @contextlib.contextmanager
@@ -48,9 +55,7 @@ def directory_lock(directory: Path, what: str = "directory") -> Iterator[None]:
             f"{directory}: cannot lock this {what} ({error.strerror}); is it writable?"
         ) from None
     try:
-        try:
-            fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+        if not _try_lock(descriptor, fcntl.flock, fcntl.LOCK_EX | fcntl.LOCK_NB):
             holder = _read_holder(descriptor)
             raise RunError(
                 f"{directory}: another cartpole-q process ({holder}) is writing this {what}; "
@@ -62,6 +67,19 @@ def directory_lock(directory: Path, what: str = "directory") -> Iterator[None]:
         yield
     finally:
         os.close(descriptor)  # releases the lock (forked workers have ended by now)
+
+
+def _try_lock(descriptor: int, flock: Callable[[int, int], None], operation: int) -> bool:
+    """Take the lock, retrying for ``_PATIENCE_SECONDS`` while a holder may be ending."""
+    deadline = time.monotonic() + _PATIENCE_SECONDS
+    while True:
+        try:
+            flock(descriptor, operation)
+            return True
+        except BlockingIOError:
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.02)
 
 
 def _read_holder(descriptor: int) -> str:
