@@ -104,6 +104,14 @@ def train(
             "them together (slower; `cartpole-q plot DIR` draws it later).",
         ),
     ] = False,
+    tensorboard: Annotated[
+        bool,
+        typer.Option(
+            "--tensorboard",
+            help="Also write TensorBoard event files into RUN/tensorboard/ (sets "
+            '`train.tensorboard`; needs `pip install "cartpole-q[tensorboard]"`).',
+        ),
+    ] = False,
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
     with exit_codes():
@@ -113,7 +121,7 @@ def train(
         if resume is not None:
             given = {
                 "--config": config, "--set": set_values, "--seed": seed, "--seeds": seeds,
-                "--engine": engine, "--out": out,
+                "--engine": engine, "--out": out, "--tensorboard": tensorboard or None,
             }  # fmt: skip
             clashing = [name for name, value in given.items() if value is not None]
             if clashing:
@@ -125,6 +133,7 @@ def train(
             with directory_lock(resume, "run") if resume.is_dir() else nullcontext():
                 prepared = runner.prepare_resume(resume, episodes)
                 _check_options(prepared.config.train.seeds, watch, video_every, backend)
+                _check_tensorboard(prepared.config, tensorboard)
                 with backend_connection(backend, workers, address):
                     _train_into(
                         resume, prepared, True, workers, backend, address, quiet, watch,
@@ -133,11 +142,13 @@ def train(
             return
         if seed is not None and seeds is not None:
             raise UserError("give either --seed (one run) or --seeds (several), not both.")
+        assignments = [*(set_values or []), *(["train.tensorboard=true"] if tensorboard else [])]
         prepared = runner.prepare_new(
-            config, set_values or [], seed=seed, seeds=seeds, episodes=episodes,
+            config, assignments, seed=seed, seeds=seeds, episodes=episodes,
             engine=None if engine is None else engine.value,
         )  # fmt: skip
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
+        _check_tensorboard(prepared.config, tensorboard)
         # Connected (or refused) before the run directory is created.
         with backend_connection(backend, workers, address):
             run_dir = runner.start_run(prepared, out)
@@ -166,6 +177,14 @@ def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendCho
         problem = display_problem()
         if problem is not None:
             raise UserError(f"--watch needs a window, but {problem}; use --video-every N instead.")
+
+
+def _check_tensorboard(config: Any, option: bool) -> None:
+    """Refuse TensorBoard output without its writer, before the run directory is created."""
+    if config.train.tensorboard:
+        from cartpole_q.store.tensorboard import require_writer
+
+        require_writer("--tensorboard" if option else "train.tensorboard")
 
 
 def _train_into(

@@ -342,6 +342,13 @@ class TrainConfig:
     checkpoint_every: int = field(
         metadata=spec("int", "a resumable checkpoint every this many episodes (0: never)", low=0)
     )
+    tensorboard: bool = field(
+        metadata=spec(
+            "bool",
+            "also write TensorBoard event files into the run directory's `tensorboard/` "
+            "(`train --tensorboard`; needs the `[tensorboard]` extra); results are unchanged",
+        )
+    )
 
 
 @dataclass(frozen=True)

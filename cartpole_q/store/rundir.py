@@ -10,6 +10,7 @@
 | ``reward_curve.png`` | returns, their 100-episode moving average, the threshold |
 | ``summary.json`` | figures of the run; written last, so its presence means complete |
 | ``checkpoint.npz`` | what ``--resume`` needs, with the config it was trained with: kept while a run is unfinished or interrupted, and after a run that reached ``train.episodes`` (to extend it) |
+| ``tensorboard/`` | with ``train.tensorboard``: TensorBoard event files (:mod:`cartpole_q.store.tensorboard`) |
 
 Every file is written to a temporary file in the same directory and moved into place with
 ``os.replace``, so a reader (or a process killed at any instant) never sees half a file.
@@ -221,6 +222,10 @@ def write_run(
         figure = reward_curve_figure([curve], result.reward_threshold, title=title)
         atomic_write_bytes(run_dir / CURVE_FILE, figure_png(figure))
     summary = summarize(result)
+    if result.config.train.tensorboard:
+        from cartpole_q.store.tensorboard import write_tensorboard
+
+        write_tensorboard(run_dir, result, summary.steps_per_second)
     write_json(run_dir / SUMMARY_FILE, summary.to_json())
     if not result.interrupted and not result.extendable:
         (run_dir / CHECKPOINT_FILE).unlink(missing_ok=True)
