@@ -54,7 +54,8 @@ def eval_command(
         typer.Option(
             metavar="FILE",
             help="Record the first episodes (see --video-episodes) as FILE.gif, or FILE.mp4 "
-            "with imageio-ffmpeg installed; checked before any episode is played.",
+            'with the video extra (`pip install "cartpole-q[video]"`); any environment with '
+            "a renderer; checked before any episode is played.",
         ),
     ] = None,
     video_episodes: Annotated[
@@ -100,6 +101,10 @@ def eval_command(
             if "exact" in result:
                 typer.echo(exact_seeds_line(result["exact"]))
             return
+        if video is not None:
+            from cartpole_q.store.video import check_renderer
+
+            check_renderer(run_set.runs[0].config.env.id, f"{run_dir}: --video")
         evaluation = evaluate_run(
             run_set.runs[0], episodes=episodes, seed=seed, physics=changed, max_steps=max_steps,
             video=video, video_episodes=video_episodes, render=render, force=force,

@@ -133,7 +133,7 @@ def train(
             with directory_lock(resume, "run") if resume.is_dir() else nullcontext():
                 prepared = runner.prepare_resume(resume, episodes)
                 _check_options(prepared.config.train.seeds, watch, video_every, backend)
-                _check_tensorboard(prepared.config, tensorboard)
+                _check_outputs(prepared.config, tensorboard, video_every)
                 with backend_connection(backend, workers, address):
                     _train_into(
                         resume, prepared, True, workers, backend, address, quiet, watch,
@@ -148,7 +148,7 @@ def train(
             engine=None if engine is None else engine.value,
         )  # fmt: skip
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
-        _check_tensorboard(prepared.config, tensorboard)
+        _check_outputs(prepared.config, tensorboard, video_every)
         # Connected (or refused) before the run directory is created.
         with backend_connection(backend, workers, address):
             run_dir = runner.start_run(prepared, out)
@@ -179,12 +179,20 @@ def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendCho
             raise UserError(f"--watch needs a window, but {problem}; use --video-every N instead.")
 
 
-def _check_tensorboard(config: Any, option: bool) -> None:
-    """Refuse TensorBoard output without its writer, before the run directory is created."""
+def _check_outputs(config: Any, tensorboard: bool, video_every: int) -> None:
+    """Refuse outputs that cannot be written, before the run directory is created.
+
+    TensorBoard event files need the optional writer; videos need an environment that
+    renders itself.
+    """
     if config.train.tensorboard:
         from cartpole_q.store.tensorboard import require_writer
 
-        require_writer("--tensorboard" if option else "train.tensorboard")
+        require_writer("--tensorboard" if tensorboard else "train.tensorboard")
+    if video_every:
+        from cartpole_q.store.video import check_renderer
+
+        check_renderer(config.env.id, "--video-every")
 
 
 def _train_into(

@@ -8,8 +8,14 @@ MountainCar, 15 for Acrobot):
 
 - a GIF keeps every third step, each shown for three steps' time, plus the final step
   of every episode, held for half a second;
-- an MP4 keeps every step, at ``render_fps`` frames per second. It needs the optional
-  ``imageio-ffmpeg`` package (``pip install imageio-ffmpeg``).
+- an MP4 keeps every step (a recorded episode of ``n`` steps gives ``n + 1`` frames, its
+  reset included), at ``render_fps`` frames per second, H.264 in ``yuv420p`` so that
+  browsers and phones play it. It needs the optional ``[video]`` extra
+  (``pip install "cartpole-q[video]"``: imageio-ffmpeg, which brings its own FFmpeg).
+
+Every environment whose ``metadata["render_modes"]`` has ``rgb_array`` can be recorded
+(CartPole, MountainCar, Acrobot, FrozenLake, Taxi, CliffWalking, Blackjack); the others
+(Sutton & Barto's worlds under ``cartpole_q/``) are refused before anything is played.
 """
 
 from __future__ import annotations
@@ -49,10 +55,46 @@ def mp4_encoder(path: Path) -> Any:
         imageio_ffmpeg.get_ffmpeg_exe()
     except (ImportError, RuntimeError):
         raise UserError(
-            f"{path}: --video: writing .mp4 needs an FFmpeg encoder: install it with "
-            "`pip install imageio-ffmpeg`, or write a GIF (--video FILE.gif)."
+            f"{path}: --video: writing .mp4 needs an FFmpeg encoder, from the optional video "
+            'extra: install it with `pip install "cartpole-q[video]"` (imageio-ffmpeg), or '
+            "write a GIF (--video FILE.gif)."
         ) from None
     return imageio_ffmpeg
+
+
+def check_renderer(env_id: str, option: str = "--video") -> None:
+    """Refuse to record an environment that cannot draw itself, before anything is played.
+
+    An environment class that declares no ``rgb_array`` among its
+    ``metadata["render_modes"]`` has no renderer. An id whose class cannot be looked up
+    here (a plug-in's ``module:Env``) is left to ``gymnasium.make``, which names the problem.
+
+    Args:
+        env_id: the run's ``env.id``.
+        option: the option that asked for frames, for the message.
+
+    Raises:
+        UserError: the environment has no ``rgb_array`` renderer.
+    """
+    import gymnasium
+    from gymnasium.envs.registration import load_env_creator
+
+    try:
+        entry_point = gymnasium.spec(env_id).entry_point
+        creator = load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
+    except Exception:  # whatever the lookup raises: gymnasium.make will say it better
+        return
+    metadata = getattr(creator, "metadata", None)
+    if not isinstance(metadata, dict) or "render_modes" not in metadata:
+        return
+    modes = list(metadata["render_modes"])
+    if "rgb_array" not in modes:
+        raise UserError(
+            f"{option}: env.id {env_id!r} has no renderer to record (its render_modes are "
+            f"{modes}, without 'rgb_array'); recordings work for environments that draw "
+            "themselves, such as CartPole, MountainCar, Acrobot, FrozenLake, Taxi, "
+            "CliffWalking and Blackjack."
+        )
 
 
 @contextmanager
