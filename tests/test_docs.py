@@ -1,0 +1,225 @@
+"""The documentation is executed: the tutorials' commands run, their figures are remade, links resolve.
+
+Every fenced ``bash`` block of ``docs/tutorials/*.md`` runs, in page order, in one empty
+directory per page, after the page's files (fences with ``title="NAME"``) are written
+there. A block that cannot run here is preceded by ``<!-- not run: REASON -->``. The
+commands run as printed, on smaller settings: a seed range ``A-B`` becomes ``A-(A+1)`` (two
+seeds), and the study files under ``examples/`` are copied with two seeds and a few trials.
+Each figure a tutorial shows must be written by a command printed on its page (its path
+from the repository's root, e.g. ``docs/reward_curves.png``), and is, when the page runs.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+
+import pytest
+import yaml
+
+from tests.conftest import REPO
+
+DOCS = REPO / "docs"
+TUTORIALS = sorted((DOCS / "tutorials").glob("*.md"))
+
+FENCE = re.compile(r"^```(?P<info>[^\n`]*)\n(?P<body>.*?)^```[ \t]*$", re.MULTILINE | re.DOTALL)
+NOT_RUN = re.compile(r"<!-- not run: (?P<reason>[^>]*?) -->\s*\Z")
+TITLE = re.compile(r'title="(?P<title>[^"]+)"')
+IMAGE = re.compile(r"!\[[^\]]*\]\((?P<target>[^)\s]+)\)")
+
+SEED_RANGE = re.compile(r"(?<![\w.:/=-])(?P<low>\d+)-(?P<high>\d+)(?![\w.:/-])")
+"""a seed range such as ``0-99`` or ``1000-1099`` (not a date, a path or a number like 1e-4)"""
+
+STUDY_TRIALS = 4
+"""trials a tune file keeps in the tests: enough for Optuna's importance plot"""
+
+NOT_RUN_ALLOWED = {"ray-cluster.md": 1}
+"""pages that may hold blocks the tests cannot run, and how many (a several-machine cluster)"""
+
+
+@dataclass(frozen=True)
+class Block:
+    """One fenced code block of a page."""
+
+    language: str
+    title: str | None
+    body: str
+    not_run: str | None
+    """why the tests do not run it, or ``None``"""
+
+    @property
+    def runs(self) -> bool:
+        """Whether the tests run it: a ``bash`` block that does not say otherwise."""
+        return self.language == "bash" and self.not_run is None
+
+
+def blocks(page: Path) -> list[Block]:
+    """The fenced blocks of a page, in order."""
+    text = page.read_text(encoding="utf-8")
+    found = []
+    for match in FENCE.finditer(text):
+        info = match["info"].strip()
+        language = info.split()[0] if info else ""
+        title = TITLE.search(info)
+        before = NOT_RUN.search(text[: match.start()])
+        reason = before["reason"].strip() if before else None
+        found.append(Block(language, title["title"] if title else None, match["body"], reason))
+    return found
+
+
+def shrink(command: str) -> str:
+    """The command on small settings: every seed range of more than two seeds cut to two."""
+
+    def two_seeds(match: re.Match[str]) -> str:
+        low, high = int(match["low"]), int(match["high"])
+        return match[0] if high <= low + 1 else f"{low}-{low + 1}"
+
+    return SEED_RANGE.sub(two_seeds, command)
+
+
+def shrink_study(path: Path) -> None:
+    """A sweep or tune file on small settings: two seeds, a few trials (comments dropped)."""
+    data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if not isinstance(data, dict):
+        return
+    if "seeds" in data:
+        data["seeds"] = shrink(str(data["seeds"]))
+    if "trials" in data:
+        data["trials"] = min(int(data["trials"]), STUDY_TRIALS)
+    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+
+
+def figures(page: Path) -> list[str]:
+    """The images a page shows, as paths from the repository's root (``docs/x.png``)."""
+    paths = []
+    for match in IMAGE.finditer(page.read_text(encoding="utf-8")):
+        target = PurePosixPath(page.parent.relative_to(REPO).as_posix()) / match["target"]
+        paths.append(os.path.normpath(target.as_posix()))
+    return paths
+
+
+def test_shrink_cuts_seed_ranges_and_nothing_else() -> None:
+    assert shrink("train --seeds 0-99 --out runs/C-0-99") == "train --seeds 0-1 --out runs/C-0-99"
+    assert shrink("for S in 0-99 1000-1099; do") == "for S in 0-1 1000-1001; do"
+    assert shrink("--seeds 0,3,7 --seeds 4-5") == "--seeds 0,3,7 --seeds 4-5"
+    assert shrink("# 2026-11-22, kappa 1e-4, length=0.1:1.0:10") == (
+        "# 2026-11-22, kappa 1e-4, length=0.1:1.0:10"
+    )
+
+
+def test_blocks_are_found_with_their_titles_and_reasons(tmp_path: Path) -> None:
+    page = tmp_path / "page.md"
+    page.write_text(
+        'text\n\n```bash\necho one\n```\n\n```python title="a.py"\nx = 1\n```\n\n'
+        "<!-- not run: needs three machines -->\n```bash\nray start\n```\n",
+        encoding="utf-8",
+    )
+    found = blocks(page)
+    assert [(b.language, b.title, b.runs) for b in found] == [
+        ("bash", None, True), ("python", "a.py", False), ("bash", None, False),
+    ]  # fmt: skip
+    assert found[2].not_run == "needs three machines"
+    assert found[1].body == "x = 1\n"
+
+
+def test_every_tutorial_has_commands_and_skips_only_what_it_must() -> None:
+    assert len(TUTORIALS) == 7
+    for page in TUTORIALS:
+        found = blocks(page)
+        assert any(block.runs for block in found), f"{page.name} runs no command"
+        skipped = [block for block in found if block.not_run is not None]
+        assert len(skipped) == NOT_RUN_ALLOWED.get(page.name, 0), page.name
+        assert all(block.not_run for block in skipped), f"{page.name}: a skip without a reason"
+
+
+@pytest.mark.parametrize("page", TUTORIALS, ids=lambda page: page.stem)
+def test_every_figure_is_written_by_a_command_on_its_page(page: Path) -> None:
+    commands = "\n".join(block.body for block in blocks(page) if block.runs)
+    for figure in figures(page):
+        assert (REPO / figure).is_file(), f"{page.name} shows {figure}, which does not exist"
+        assert figure in commands, f"{page.name} shows {figure} but no command on it writes it"
+
+
+def _run_page(page: Path, workdir: Path) -> None:
+    """Run a page's commands in ``workdir``, as a reader would, on small settings."""
+    os.symlink(REPO / "configs", workdir / "configs")
+    shutil.copytree(REPO / "examples", workdir / "examples")
+    for study in (workdir / "examples").rglob("*.yaml"):
+        shrink_study(study)
+    for figure in figures(page):
+        (workdir / figure).parent.mkdir(parents=True, exist_ok=True)
+    env = {
+        **os.environ,
+        "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}",
+        "MPLBACKEND": "Agg",
+    }
+    for block in blocks(page):
+        if block.title is not None:
+            (workdir / block.title).write_text(block.body, encoding="utf-8")
+        if not block.runs:
+            continue
+        command = shrink(block.body)
+        done = subprocess.run(
+            ["bash", "-euo", "pipefail", "-c", command],
+            cwd=workdir, env=env, capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        assert done.returncode == 0, (
+            f"{page.name}: this block failed (exit {done.returncode}):\n{command}\n"
+            f"stdout:\n{done.stdout[-3000:]}\nstderr:\n{done.stderr[-3000:]}"
+        )
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", TUTORIALS, ids=lambda page: page.stem)
+def test_a_tutorials_commands_run_and_remake_its_figures(page: Path, tmp_path: Path) -> None:
+    _run_page(page, tmp_path)
+    for figure in figures(page):
+        made = tmp_path / figure
+        assert made.is_file() and made.stat().st_size > 0, f"{page.name}: {figure} not made"
+
+
+def _github_anchor(heading: str) -> str:
+    """The anchor GitHub gives a Markdown heading."""
+    text = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return text.replace(" ", "-")
+
+
+def broken_links(markdown: str, root: Path) -> list[str]:
+    """The relative links and images of a Markdown text that do not resolve from ``root``.
+
+    A path must exist; an anchor alone (``#commands``) must be one of the text's headings.
+    Links to the web are not checked (the tests run offline), nor links inside code blocks.
+    """
+    outside_code = re.sub(r"```.*?```", "", markdown, flags=re.DOTALL)
+    anchors = {_github_anchor(h) for h in re.findall(r"^#+ (.+)$", outside_code, re.MULTILINE)}
+    targets = re.findall(r"\]\(([^)\s]+)\)", outside_code)
+    targets += re.findall(r'(?:src|href)="([^"]+)"', outside_code)
+    broken = []
+    for target in targets:
+        if re.match(r"[a-z]+:", target):
+            continue
+        path, _, anchor = target.partition("#")
+        if (not path and anchor not in anchors) or (path and not (root / path).exists()):
+            broken.append(target)
+    return broken
+
+
+def test_every_relative_link_of_the_readme_resolves() -> None:
+    text = (REPO / "README.md").read_text(encoding="utf-8")
+    assert "](docs/" in text  # the check has links to check
+    assert broken_links(text, REPO) == []
+
+
+def test_the_link_check_finds_missing_files_and_anchors() -> None:
+    text = (
+        "# Title\n## `cartpole-q eval`\n## Sutton & Barto's worlds\n"
+        "[a](README.md) [b](docs/nope.md) [c](#cartpole-q-eval) [d](#sutton--bartos-worlds) "
+        '[e](#nope) [f](https://example.org/x) <img src="docs/missing.gif">\n'
+        "```\n[g](in/code.md)\n```\n"
+    )
+    assert broken_links(text, REPO) == ["docs/nope.md", "#nope", "docs/missing.gif"]
