@@ -1,6 +1,6 @@
 """Training throughput, measured side by side in one run (env steps per second).
 
-    python benchmarks/throughput.py [--repeats 3] [--quick]
+    python benchmarks/throughput.py [--repeats 3] [--quick] [--only SECTION]
 
 Rows:
   blog loop         the tutorial's per-step loop (Python lists for binning,
@@ -14,9 +14,14 @@ Rows:
                     re-derivation of the same config: a trace method writes every traced
                     pair, Dyna 1 + planning_steps, Monte Carlo one per first visit)
   environments      MountainCar-v0 and Acrobot-v1: their twins against the gymnasium engine
+  tabular worlds    FrozenLake8x8-v1 and Taxi-v4 (the shipped configs frozenlake8x8 and taxi):
+                    the numba engine's twin against the gymnasium engine on the same training
+                    (the twins are bit-identical, so both engines play the same env steps)
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
-same run, so they hold across machines even when absolute rates do not.
+same run, so they hold across machines even when absolute rates do not. --only SECTION runs
+one section (cartpole, algorithms, environments, tabular, progress); the algorithms section
+then measures its own Q-learning baseline.
 """
 
 from __future__ import annotations
@@ -181,64 +186,69 @@ ACROBOT = env_config(
 )
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
-    )
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--quick", action="store_true", help="fewer episodes (a rough check)")
-    args = parser.parse_args()
-    scale = 0.2 if args.quick else 1.0
-    python_episodes = max(20, int(400 * scale))
-    numba_episodes = max(1000, int(100_000 * scale))
-    blog = "configs/blog.yaml"
+TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
+           ("Taxi-v4 (taxi)", "taxi", 5_000))  # fmt: skip
+"""the tabular worlds' rows: label, shipped config, its episodes (the whole training)"""
 
+SECTIONS = ("cartpole", "algorithms", "environments", "tabular", "progress")
+"""what --only can pick; by default every section runs, in this order"""
+
+
+def cartpole_rows(repeats: int, python_episodes: int, numba_episodes: int) -> float:
+    """The training loops on CartPole against the blog loop; returns numba's default rate."""
+    blog = "configs/blog.yaml"
     # warm up numba (compile or load the cache) so that no row pays for it
     engine_rate(blog, "numba", 5, 0)
     engine_rate(blog, "gymnasium", 2, 0)
     engine_rate(None, "numba", 5, 0)
 
     rows = [
-        ("blog loop (baseline)", median_rate(lambda: blog_loop(python_episodes, 0), args.repeats)),
+        ("blog loop (baseline)", median_rate(lambda: blog_loop(python_episodes, 0), repeats)),
         (
             "gymnasium engine, blog grid",
-            median_rate(lambda: engine_rate(blog, "gymnasium", python_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(blog, "gymnasium", python_episodes, 0), repeats),
         ),
         (
             "numba engine, blog grid",
-            median_rate(lambda: engine_rate(blog, "numba", numba_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(blog, "numba", numba_episodes, 0), repeats),
         ),
         (
             "gymnasium engine, default config",
-            median_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), args.repeats),
+            median_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), repeats),
         ),
         (
             "numba engine, default config",
-            median_rate(lambda: engine_rate(None, "numba", numba_episodes // 10, 0), args.repeats),
+            median_rate(lambda: engine_rate(None, "numba", numba_episodes // 10, 0), repeats),
         ),
     ]
     baseline = rows[0][1]
     print(
-        f"{'training loop (median of ' + str(args.repeats) + ')':40s} {'env steps/s':>14s} {'vs blog loop':>13s}"
+        f"{'training loop (median of ' + str(repeats) + ')':40s} {'env steps/s':>14s} {'vs blog loop':>13s}"
     )
     for name, rate in rows:
         print(f"{name:40s} {rate:14,.0f} {rate / baseline:12.1f}x")
     gym_default = rows[3][1]
     print(f"numba / gymnasium engine, default config: {rows[4][1] / gym_default:,.0f}x")
     print(f"numba / gymnasium engine, blog grid:      {rows[2][1] / rows[1][1]:,.0f}x")
+    return rows[4][1]
 
-    # Each algorithm on the numba engine, default config, against Q-learning in the same run.
-    print()
+
+def algorithm_rows(repeats: int, numba_episodes: int, q_learning: float | None) -> None:
+    """Each algorithm on the numba engine, default config, against Q-learning."""
+    if q_learning is None:  # run alone: measure the baseline here, in this same run
+        engine_rate(None, "numba", 5, 0)
+        q_learning = median_rate(
+            lambda: engine_rate(None, "numba", numba_episodes // 10, 0), repeats
+        )
     print(
         f"{'algorithm, numba engine, default config':40s} {'env steps/s':>14s} "
         f"{'vs q_learning':>13s} {'updates/step':>13s} {'updates/s':>14s}"
     )
-    q_learning = rows[4][1]
     for algorithm in algorithm_names():
         engine_rate(None, "numba", 5, 0, algorithm=algorithm)  # compile or load the cache
         rate = median_rate(
             lambda a=algorithm: engine_rate(None, "numba", numba_episodes // 10, 0, algorithm=a),
-            args.repeats,
+            repeats,
         )
         per_step = updates_per_step(algorithm)
         print(
@@ -246,8 +256,9 @@ def main() -> None:
             f"{rate * per_step:14,.0f}"
         )
 
-    # The other twins: numba against the gymnasium engine on the same config.
-    print()
+
+def environment_rows(repeats: int, scale: float) -> None:
+    """The other classic-control twins: numba against the gymnasium engine, same config."""
     print(
         f"{'environment (Q-learning, epsilon 0.1)':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s}"
     )
@@ -258,16 +269,51 @@ def main() -> None:
         engine_rate(config, "numba", 2, 0)
         engine_rate(config, "gymnasium", 1, 0)
         gym_rate = median_rate(
-            lambda c=config: engine_rate(c, "gymnasium", max(2, int(20 * scale)), 0), args.repeats
+            lambda c=config: engine_rate(c, "gymnasium", max(2, int(20 * scale)), 0), repeats
         )
         numba_rate = median_rate(
-            lambda c=config: engine_rate(c, "numba", max(200, int(5000 * scale)), 0), args.repeats
+            lambda c=config: engine_rate(c, "numba", max(200, int(5000 * scale)), 0), repeats
         )
         print(f"{name:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x")
 
-    # The progress bar's cost, measured as interleaved pairs so machine drift cancels out.
+
+def tabular_rows(repeats: int, scale: float) -> None:
+    """FrozenLake 8x8 and Taxi: the twin against the gymnasium engine on the same training.
+
+    Both engines train the shipped config from the same seed for the same episodes; the twin
+    is bit-identical to ``gymnasium.make``, so they play the same env steps (checked), and
+    the ratio is the ratio of training times. The numba runs are short (tens of
+    milliseconds), so their median is over at least five.
+    """
+    print(
+        f"{'tabular world (config), whole training':40s} {'gymnasium':>14s} {'numba':>13s} "
+        f"{'ratio':>7s} {'episodes':>9s} {'env steps':>10s}"
+    )
+    for name, config, full in TABULAR:
+        episodes = max(100, int(full * scale))
+        engine_rate(config, "numba", 5, 0)  # compile or load the cache
+        engine_rate(config, "gymnasium", 5, 0)
+        steps, _ = engine_rate(config, "numba", episodes, 0)
+        gym_steps, _ = engine_rate(config, "gymnasium", episodes, 0)
+        if steps != gym_steps:
+            raise SystemExit(f"{name}: the engines played {gym_steps} and {steps} env steps")
+        gym_rate = median_rate(
+            lambda c=config, e=episodes: engine_rate(c, "gymnasium", e, 0), repeats
+        )
+        numba_rate = median_rate(
+            lambda c=config, e=episodes: engine_rate(c, "numba", e, 0), max(5, repeats)
+        )
+        print(
+            f"{name:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x "
+            f"{episodes:9,d} {steps:10,d}"
+        )
+
+
+def progress_row(repeats: int, python_episodes: int) -> None:
+    """The progress bar's cost, measured as interleaved pairs so machine drift cancels out."""
+    engine_rate(None, "gymnasium", 2, 0)
     plain, with_bar = [], []
-    for _ in range(max(3, args.repeats)):
+    for _ in range(max(3, repeats)):
         plain.append(median_rate(lambda: engine_rate(None, "gymnasium", python_episodes, 0), 1))
         with_bar.append(
             median_rate(
@@ -281,6 +327,35 @@ def main() -> None:
         f"(medians of {len(plain)} interleaved runs each)"
     )
     assert math.isfinite(cost)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="fewer episodes (a rough check)")
+    parser.add_argument("--only", choices=SECTIONS, help="run one section of rows")
+    args = parser.parse_args()
+    scale = 0.2 if args.quick else 1.0
+    python_episodes = max(20, int(400 * scale))
+    numba_episodes = max(1000, int(100_000 * scale))
+    sections = (args.only,) if args.only else SECTIONS
+
+    q_learning = None
+    for number, section in enumerate(sections):
+        if number:
+            print()
+        if section == "cartpole":
+            q_learning = cartpole_rows(args.repeats, python_episodes, numba_episodes)
+        elif section == "algorithms":
+            algorithm_rows(args.repeats, numba_episodes, q_learning)
+        elif section == "environments":
+            environment_rows(args.repeats, scale)
+        elif section == "tabular":
+            tabular_rows(args.repeats, scale)
+        else:
+            progress_row(args.repeats, python_episodes)
 
 
 if __name__ == "__main__":
