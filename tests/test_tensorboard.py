@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from tests.conftest import invoke
+from tests.conftest import invoke, write_yaml
 from tests.test_cli import assert_refused
 
 pytest.importorskip("tensorboardX")
@@ -81,7 +81,7 @@ def test_scalars_have_cleanrl_and_sb3_names_and_the_values_of_metrics_csv(boarde
     scalars = _scalars(boarded / "tensorboard")
     assert sorted(scalars) == sorted(
         [*PER_EPISODE, "rollout/ep_rew_mean", "rollout/ep_len_mean", "eval/mean_reward",
-         "charts/SPS", "summary/eval_mean"]
+         "charts/SPS", "summary/eval_mean", "summary/success"]
     )  # fmt: skip
     metrics = _csv_columns(boarded / "metrics.csv")
     env_steps = np.cumsum([int(length) for length in metrics["length"]]).tolist()
@@ -111,6 +111,8 @@ def test_scalars_have_cleanrl_and_sb3_names_and_the_values_of_metrics_csv(boarde
         [env_steps[-1]],
         _float32([str(summary["eval"]["mean"])]),
     )
+    success = summary["eval"]["mean"] >= summary["reward_threshold"]
+    assert scalars["summary/success"] == ([env_steps[-1]], [float(success)])
 
 
 def test_the_config_is_logged_as_hyperparameters(boarded: Path) -> None:
@@ -199,3 +201,68 @@ def test_tensorboard_is_a_boolean_and_off_by_default(in_tmp: Path) -> None:
 
 def test_resume_takes_the_run_as_it_was_configured(boarded: Path) -> None:
     assert_refused(invoke("train", "--resume", boarded, "--tensorboard"), "--tensorboard")
+
+
+STUDY_BASE = {
+    "name": "board",
+    "train": {"episodes": 30, "stop_when_solved": False, "eval_every": 0, "tensorboard": True},
+    "eval": {"episodes": 2},
+}
+
+
+def test_a_sweep_writes_one_hparams_session_per_point_and_seed(tmp_path: Path) -> None:
+    from cartpole_q.store.sweepdir import read_curves
+
+    sweep = write_yaml(
+        tmp_path / "s.yaml",
+        {"name": "board", "base": STUDY_BASE, "seeds": "0-1", "grid": {"agent.alpha": [0.1, 0.5]}},
+    )
+    result = invoke("sweep", sweep, "--out", tmp_path / "out", "--workers", "1", "-q")
+    assert result.exit_code == 0, result.output
+    board = tmp_path / "out" / "tensorboard"
+    sessions = sorted(path.relative_to(board).as_posix() for path in board.glob("*/*"))
+    assert sessions == ["000/seed-000", "000/seed-001", "001/seed-000", "001/seed-001"]
+    for point, alpha in (("000", 0.1), ("001", 0.5)):
+        curves = read_curves(tmp_path / "out", point)
+        for seed in (0, 1):
+            directory = board / point / f"seed-{seed:03d}"
+            hparams = _hparams(directory)
+            assert (hparams["agent.alpha"], hparams["seed"]) == (alpha, float(seed))
+            scalars = _scalars(directory)
+            returns, lengths = curves[f"seed-{seed:03d}"]
+            assert scalars["charts/episodic_return"] == (
+                np.cumsum(lengths).tolist(), [float(np.float32(value)) for value in returns]
+            )  # fmt: skip
+            assert "summary/eval_mean" in scalars and "charts/epsilon" not in scalars
+
+
+def test_a_tune_study_writes_one_hparams_session_per_trial_and_seed(tmp_path: Path) -> None:
+    pytest.importorskip("optuna")
+    tune = write_yaml(
+        tmp_path / "t.yaml",
+        {
+            "name": "board", "base": STUDY_BASE, "seeds": "0-1", "trials": 2,
+            "space": {"agent.alpha": {"low": 0.05, "high": 1.0}},
+            "sampler": {"type": "random", "seed": 3},
+        },
+    )  # fmt: skip
+    result = invoke("tune", tune, "--out", tmp_path / "out", "--workers", "1", "-q")
+    assert result.exit_code == 0, result.output
+    board = tmp_path / "out" / "tensorboard"
+    sessions = sorted(path.relative_to(board).as_posix() for path in board.glob("*/*"))
+    assert sessions == [
+        "trial-0000/seed-000", "trial-0000/seed-001", "trial-0001/seed-000", "trial-0001/seed-001"
+    ]  # fmt: skip
+    alphas = {_hparams(board / "trial-0000" / "seed-000")["agent.alpha"]}
+    alphas.add(_hparams(board / "trial-0001" / "seed-001")["agent.alpha"])
+    assert len(alphas) == 2  # each trial's own sampled value
+    assert _hparams(board / "trial-0001" / "seed-001")["seed"] == 1.0
+
+
+def test_a_study_without_the_extra_is_refused_before_it_starts(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "tensorboardX", None)
+    sweep = write_yaml(tmp_path / "s.yaml", {"name": "board", "base": STUDY_BASE, "seeds": "0"})
+    assert_refused(invoke("sweep", sweep, "--out", tmp_path / "out"), "cartpole-q[tensorboard]")
+    assert not (tmp_path / "out").exists()

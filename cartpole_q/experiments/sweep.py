@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import (
+    Config,
     ConfigError,
     config_differences,
     format_seeds,
@@ -34,6 +35,7 @@ from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
 from cartpole_q.store.sweepdir import PointRow, ResultRow, axis_cell
+from cartpole_q.store.tensorboard import TENSORBOARD_DIR
 
 MAX_RUNS_PER_TASK = 100
 """a task is at most this many runs (about a second for the default config); each run
@@ -144,6 +146,7 @@ def check_points(spec: SweepSpec, where: str) -> None:
     """
     from cartpole_q.experiments.run import prepare
 
+    check_tensorboard([point.config for point in spec.points])
     checked: dict[str, None] = {}
     for point in spec.points:
         env_part = repr(
@@ -153,6 +156,33 @@ def check_points(spec: SweepSpec, where: str) -> None:
             continue  # the same environment, bins and engine: checked already
         prepare(point.config, f"{where}: point {spec.point_id(point.index)}")
         checked[env_part] = None
+
+
+def check_tensorboard(configs: Sequence[Config]) -> None:
+    """Refuse ``train.tensorboard`` without the writer, before a study starts.
+
+    Raises:
+        UserError: naming the extra to install.
+    """
+    if any(config.train.tensorboard for config in configs):
+        from cartpole_q.store.tensorboard import require_writer
+
+        require_writer("train.tensorboard")
+
+
+def write_run_events(directory: Path, config: Config, finished: FinishedRun) -> None:
+    """Write a study run's TensorBoard events (``train.tensorboard``) into ``directory``.
+
+    One event directory per (point or trial, seed), with the run's config as its
+    hyperparameters, so that TensorBoard's HParams view compares the points. A study
+    keeps returns and lengths only: no epsilon, step size or periodic evaluations.
+    """
+    from cartpole_q.store.tensorboard import Session, write_session
+
+    write_session(
+        directory,
+        Session(config.to_dict(), finished.result, finished.returns, finished.lengths),
+    )
 
 
 def start_sweep(spec: SweepSpec, out: Path | None) -> Path:
@@ -248,6 +278,7 @@ def run_sweep(
         RunError: ``results.csv`` has rows that are not of this sweep.
     """
     progress = progress or NullSweepProgress()
+    check_tensorboard([point.config for point in spec.points])
     book = _Book(spec, directory)
     missing = [
         (point.index, seed)
@@ -400,6 +431,10 @@ class _Book:
                 if spec.curves:
                     self._curves[point] = sweepdir.read_curves(self._directory, point_id)
             self._tables[point][spec.seed_key(seed)] = run.q_table
+            config = spec.points[point].config
+            if config.train.tensorboard:
+                board = self._directory / TENSORBOARD_DIR / spec.point_id(point)
+                write_run_events(board / spec.seed_key(seed), config.for_seed(seed), run)
             if spec.curves:
                 self._curves[point][spec.seed_key(seed)] = (run.returns, run.lengths)
             values = spec.points[point].values

@@ -33,15 +33,22 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, mapping_differences, shown_value
 from cartpole_q.errors import RunError, WriteError
-from cartpole_q.experiments.sweep import MAX_RUNS_PER_TASK, FinishedRun, run_task
+from cartpole_q.experiments.sweep import (
+    MAX_RUNS_PER_TASK,
+    FinishedRun,
+    check_tensorboard,
+    run_task,
+    write_run_events,
+)
 from cartpole_q.experiments.tune_spec import Dimension, TuneSpec, load_tune
 from cartpole_q.experiments.workers import InProcess, chunk_size, execute
 from cartpole_q.progress import NullReporter
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.statistics import iqm
-from cartpole_q.store import tunedir
+from cartpole_q.store import sweepdir, tunedir
 from cartpole_q.store.atomic import remove_stale_temporaries, write_failure
 from cartpole_q.store.sweepdir import axis_cell, cell
+from cartpole_q.store.tensorboard import TENSORBOARD_DIR
 
 IQM_BONUS = 1e-3
 """with objective success_rate: the most a trial's IQM eval return adds (below one seed's share)"""
@@ -271,6 +278,7 @@ def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Pat
 
     Call :func:`check_storage` first: it refuses what this would do wrong.
     """
+    check_tensorboard([spec.config_for({})])
     directory = tunedir.create_tune_dir(spec.name, out)
     tunedir.write_tune(directory, spec.to_dict(), storage_url)
     study(spec, directory, storage_url, create=True)
@@ -415,6 +423,7 @@ def run_tune(
         WriteError: the storage cannot be written (a full disk): the study keeps every
             finished trial, and ``tune --resume`` goes on with it.
     """
+    check_tensorboard([spec.config_for({})])
     where = storage_url or directory / tunedir.JOURNAL_FILE
     with storage_errors(where):
         return _run_trials(
@@ -446,8 +455,9 @@ def _run_trials(
         started = time.perf_counter()
         try:
             rows = evaluate_trial(
-                spec, trial, values, the_study, workers, backend, address, should_stop
-            )
+                spec, trial, values, the_study, workers, backend, address, should_stop,
+                board=directory / TENSORBOARD_DIR,
+            )  # fmt: skip
         except BaseException:
             with contextlib.suppress(OSError):  # a full disk: resume fails the trial instead
                 the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
@@ -485,12 +495,14 @@ def _run_trials(
 def evaluate_trial(
     spec: TuneSpec, trial: Any, values: dict[str, Any], the_study: Any, workers: int,
     backend: str, address: str | None, should_stop: Callable[[], bool] | None,
+    board: Path | None = None,
 ) -> list[SeedResult] | None:  # fmt: skip
     """Run the trial's config on every seed; None if pruned.
 
     The first seed runs in this process (loading the compiled loop, which forked workers
     then share); with the pruner, seeds run in rounds and the trial stops once even all
-    its remaining seeds succeeding could not beat the best trial so far.
+    its remaining seeds succeeding could not beat the best trial so far. With
+    ``train.tensorboard``, each seed's events go to ``board/trial-NNNN/seed-S``.
     """
     config = spec.config_for(values, f"trial {trial.number}")
     mapping = config.to_dict()
@@ -499,6 +511,10 @@ def evaluate_trial(
 
     def collect(index: int, finished: FinishedRun) -> None:
         rows.append(finished.result)
+        if board is not None and config.train.tensorboard:
+            seed = finished.result.seed
+            where = board / f"trial-{trial.number:04d}" / sweepdir.seed_key(seed, spec.seeds)
+            write_run_events(where, config.for_seed(seed), finished)
 
     here = InProcess(should_stop, NullReporter())
     for finished in run_task(here, [(trial.number, mapping, seeds[:1])]):

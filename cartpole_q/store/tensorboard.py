@@ -19,6 +19,7 @@ them. The writer is the optional ``tensorboardX`` package
 | ``eval/mean_reward`` | a periodic greedy evaluation's mean (``evaluations.csv``) | every ``train.eval_every`` episodes |
 | ``charts/SPS`` | env steps per second of training (``summary.json``'s ``steps_per_second``) | once, at the last step |
 | ``summary/eval_mean`` | the final greedy evaluation's mean (``summary.json``'s ``eval.mean``) | once, at the last step |
+| ``summary/success`` | 1 when that mean reaches the threshold, else 0 | once, at the last step |
 | ``summary/solved_episode`` | the solve episode, when the run solved | once, at the last step |
 
 The step of every scalar is the env steps taken by the end of that episode (CleanRL's and
@@ -28,7 +29,11 @@ float32: the values are ``metrics.csv``'s, rounded to float32.
 The resolved config is logged as hyperparameters (dotted keys; lists as JSON), with one
 event directory per run, so ``tensorboard --logdir`` on a multi-seed run's directory
 (``seed-*/tensorboard``) or on several run directories lets the HParams view compare them;
-TensorBoard gathers the hyperparameters and metrics of all the runs it finds.
+TensorBoard gathers the hyperparameters and metrics of all the runs it finds. A sweep
+whose points have ``train.tensorboard`` writes ``SWEEP/tensorboard/<point>/seed-<S>/``, a
+tune study ``TUNE/tensorboard/trial-<N>/seed-<S>/``: one session per run, its point's or
+trial's config as hyperparameters. Studies keep returns and lengths only, so their runs
+have no ``charts/epsilon``, ``charts/learning_rate`` or ``eval/mean_reward``.
 
 Each training session (a new run, a resumed or extended one) writes the whole history
 again into one new event file and removes the earlier ones, so the directory always holds
@@ -41,6 +46,7 @@ from __future__ import annotations
 import json
 import tempfile
 from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -51,6 +57,7 @@ from cartpole_q.rl.solve import SOLVE_WINDOW
 from cartpole_q.store.atomic import atomic_write_bytes
 
 if TYPE_CHECKING:
+    from cartpole_q.results import SeedResult
     from cartpole_q.training import TrainResult
 
 TENSORBOARD_DIR = "tensorboard"
@@ -121,6 +128,25 @@ def moving_means(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
     )
 
 
+@dataclass(frozen=True)
+class Session:
+    """What one run's event file holds, from whichever place the run was trained."""
+
+    config: Mapping[str, Any]
+    """the run's resolved config (``Config.to_dict()``), logged as hyperparameters"""
+    result: SeedResult
+    """what it achieved: the final scalars"""
+    returns: np.ndarray
+    lengths: np.ndarray
+    epsilons: np.ndarray | None = None
+    """each episode's exploration rate (a sweep or a tune trial does not keep them)"""
+    alphas: np.ndarray | None = None
+    evaluations: Sequence[Mapping[str, Any]] = ()
+    """the periodic greedy evaluations (``evaluations.csv``'s records)"""
+    steps_per_second: float | None = None
+    """``summary.json``'s figure (default: the result's env steps per training second)"""
+
+
 def write_tensorboard(run_dir: Path, result: TrainResult, steps_per_second: float) -> Path:
     """Write ``run_dir/tensorboard/`` from a training result; return the event file.
 
@@ -129,19 +155,36 @@ def write_tensorboard(run_dir: Path, result: TrainResult, steps_per_second: floa
         result: the run's training result (the whole history, also after a resume).
         steps_per_second: ``summary.json``'s figure, logged as ``charts/SPS``.
 
-    Earlier event files there (from the sessions before a resume) are removed once the
-    new one, which holds the whole history, is in place.
+    Raises:
+        UserError: ``tensorboardX`` is not installed.
+        WriteError: the event file cannot be written.
+    """
+    from cartpole_q.results import SeedResult
+
+    session = Session(
+        result.config.to_dict(), SeedResult.of_train(result), result.metrics.returns,
+        result.metrics.lengths, result.metrics.epsilons, result.metrics.alphas,
+        result.evaluations, steps_per_second,
+    )  # fmt: skip
+    return write_session(run_dir / TENSORBOARD_DIR, session)
+
+
+def write_session(directory: Path, session: Session) -> Path:
+    """Write one run's event file into ``directory``; return its path.
+
+    Earlier event files there (from the sessions before a resume, or a run a killed
+    study had started) are removed once the new one, which holds the whole history, is
+    in place.
 
     Raises:
         UserError: ``tensorboardX`` is not installed.
         WriteError: the event file cannot be written.
     """
     require_writer("train.tensorboard")
-    directory = run_dir / TENSORBOARD_DIR
-    directory.mkdir(exist_ok=True)
+    directory.mkdir(parents=True, exist_ok=True)
     earlier = sorted(directory.glob(f"{EVENT_FILE_PREFIX}*"))
     with tempfile.TemporaryDirectory(prefix="cartpole-q-tensorboard-") as scratch:
-        _write_events(Path(scratch), result, steps_per_second)
+        _write_events(Path(scratch), session)
         (written,) = Path(scratch).glob(f"{EVENT_FILE_PREFIX}*")
         target = directory / written.name
         atomic_write_bytes(target, written.read_bytes())
@@ -151,37 +194,56 @@ def write_tensorboard(run_dir: Path, result: TrainResult, steps_per_second: floa
     return target
 
 
-def _write_events(scratch: Path, result: TrainResult, steps_per_second: float) -> None:
+def final_scalars(session: Session) -> dict[str, float]:
+    """The scalars logged once, at the last step: speed, the final evaluation, the solve.
+
+    >>> from cartpole_q.results import SeedResult
+    >>> result = SeedResult(0, 150, 30000, 120, 20000, 18000, 500.0, True, 475.0, 0.5)
+    >>> final_scalars(Session({}, result, np.zeros(0), np.zeros(0)))
+    {'charts/SPS': 60000.0, 'summary/eval_mean': 500.0, 'summary/success': 1.0, 'summary/solved_episode': 120.0}
+    """
+    result = session.result
+    speed = session.steps_per_second
+    if speed is None:
+        speed = result.env_steps / result.train_seconds if result.train_seconds > 0 else 0.0
+    finals = {"charts/SPS": float(speed)}
+    if result.eval_mean is not None:
+        finals["summary/eval_mean"] = float(result.eval_mean)
+    if result.success is not None:
+        finals["summary/success"] = float(result.success)
+    if result.solved_episode is not None:
+        finals["summary/solved_episode"] = float(result.solved_episode)
+    return finals
+
+
+def _write_events(scratch: Path, session: Session) -> None:
     from tensorboardX import SummaryWriter
     from tensorboardX.summary import hparams
 
-    metrics = result.metrics
-    steps = np.cumsum(metrics.lengths, dtype=np.int64)
+    steps = np.cumsum(session.lengths, dtype=np.int64)
     last_step = int(steps[-1]) if len(steps) else 0
-    per_episode: Sequence[tuple[str, np.ndarray]] = (
-        ("charts/episodic_return", metrics.returns),
-        ("charts/episodic_length", metrics.lengths),
-        ("charts/epsilon", metrics.epsilons),
-        ("charts/learning_rate", metrics.alphas),
-        ("rollout/ep_rew_mean", moving_means(metrics.returns)),
-        ("rollout/ep_len_mean", moving_means(metrics.lengths)),
-    )
+    per_episode = [
+        ("charts/episodic_return", session.returns),
+        ("charts/episodic_length", session.lengths),
+        ("charts/epsilon", session.epsilons),
+        ("charts/learning_rate", session.alphas),
+        ("rollout/ep_rew_mean", moving_means(session.returns)),
+        ("rollout/ep_len_mean", moving_means(session.lengths)),
+    ]
+    columns = [(tag, values) for tag, values in per_episode if values is not None]
     # max_queue: everything is written at once; one flush at close is enough.
     with SummaryWriter(str(scratch), max_queue=1000, flush_secs=3600) as writer:
-        _, session_start, session_end = hparams(hparams_of(result.config.to_dict()), {})
+        _, session_start, session_end = hparams(hparams_of(session.config), {})
         # Only the session's start and end, no experiment of its own: TensorBoard then
         # builds the HParams table from every run under its --logdir, this one included.
         writer.file_writer.add_summary(session_start)
         for index, step in enumerate(steps.tolist()):
-            for tag, values in per_episode:
+            for tag, values in columns:
                 writer.add_scalar(tag, float(values[index]), step)
-        for record in result.evaluations:
+        for record in session.evaluations:
             writer.add_scalar("eval/mean_reward", float(record["mean"]), int(record["env_steps"]))
-        writer.add_scalar("charts/SPS", float(steps_per_second), last_step)
-        if result.eval is not None:
-            writer.add_scalar("summary/eval_mean", float(result.eval.mean), last_step)
-        if result.solved_episode is not None:
-            writer.add_scalar("summary/solved_episode", float(result.solved_episode), last_step)
-        if not result.interrupted:
+        for tag, value in final_scalars(session).items():
+            writer.add_scalar(tag, value, last_step)
+        if not session.result.interrupted:
             # An interrupted run is unfinished: no end, so TensorBoard does not call it done.
             writer.file_writer.add_summary(session_end)
