@@ -11,6 +11,7 @@ from the repository's root, e.g. ``docs/reward_curves.png``), and is, when the p
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import re
 import shutil
@@ -18,8 +19,10 @@ import subprocess
 import sys
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+from types import ModuleType
 
 import pytest
+import typer.main
 import yaml
 
 from tests.conftest import REPO
@@ -223,3 +226,33 @@ def test_the_link_check_finds_missing_files_and_anchors() -> None:
         "```\n[g](in/code.md)\n```\n"
     )
     assert broken_links(text, REPO) == ["docs/nope.md", "#nope", "docs/missing.gif"]
+
+
+def _hook(name: str) -> ModuleType:
+    """A module of ``docs/_hooks`` (they run inside mkdocs, so they are not a package)."""
+    spec = importlib.util.spec_from_file_location(name, DOCS / "_hooks" / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_cli_reference_documents_every_command_and_option() -> None:
+    from cartpole_q.cli.app import app
+
+    hook = _hook("cli_reference")
+    page = hook.on_page_markdown(f"# CLI\n\n{hook.MARKER}\n", page=None)
+    assert hook.MARKER not in page and page.startswith("# CLI\n\n## `cartpole-q`\n")
+    for command in typer.main.get_command(app).commands:
+        assert f"### `cartpole-q {command}`" in page
+    assert "* `--set KEY=VALUE`:" in page and "* `--max-steps N`:" in page
+    assert hook.on_page_markdown("no marker", page=None) == "no marker"
+
+
+def test_sphinx_roles_become_code_on_the_api_pages() -> None:
+    pytest.importorskip("griffe")  # the docs extra
+    plain = _hook("sphinx_roles").plain
+    assert plain(":func:`load_config` -- :class:`~cartpole_q.config.Config`, :mod:`x.y`") == (
+        "`load_config` -- `Config`, `x.y`"
+    )
+    assert plain("``literal`` and :unknown:`role`") == "``literal`` and :unknown:`role`"
