@@ -141,11 +141,25 @@ def test_every_tutorial_has_commands_and_skips_only_what_it_must() -> None:
 
 
 @pytest.mark.parametrize("page", TUTORIALS, ids=lambda page: page.stem)
-def test_every_figure_is_written_by_a_command_on_its_page(page: Path) -> None:
-    commands = "\n".join(block.body for block in blocks(page) if block.runs)
-    for figure in figures(page):
+def test_every_figure_is_remade_by_the_command_printed_under_it(page: Path) -> None:
+    for figure, command in figures_and_commands(page):
         assert (REPO / figure).is_file(), f"{page.name} shows {figure}, which does not exist"
-        assert figure in commands, f"{page.name} shows {figure} but no command on it writes it"
+        assert figure in command, f"{page.name}: the command under {figure} does not write it"
+
+
+def figures_and_commands(page: Path) -> list[tuple[str, str]]:
+    """Each figure of a page with the first command block printed under it ("" if none)."""
+    text = page.read_text(encoding="utf-8")
+    runnable = [
+        (match.start(), match["body"])
+        for match, block in zip(FENCE.finditer(text), blocks(page), strict=True)
+        if block.runs
+    ]
+    pairs = []
+    for match, figure in zip(IMAGE.finditer(text), figures(page), strict=True):
+        under = [body for start, body in runnable if start > match.start()]
+        pairs.append((figure, under[0] if under else ""))
+    return pairs
 
 
 def _run_page(page: Path, workdir: Path) -> None:
