@@ -124,7 +124,7 @@ def evaluate(
     try:
         returns = play_greedy(
             env, q_table.reshape(-1, env_info.n_actions), params.grid, episodes, seed, on_frame,
-            step_cap,
+            step_cap, params.tilings,
         )  # fmt: skip
     finally:
         env.close()

@@ -9,6 +9,10 @@ nothing from ``cartpole_q``: the tests check that the package's runs are byte-id
 The Q-table is a list of rows (one per state, ``n_actions`` Python floats each): Python
 floats are IEEE float64 and every formula below is written exactly as the texts state it,
 parenthesised, left to right.
+
+Tile coding (docs/algorithms.md, "Tile coding"): the table is the weights, one row per tile,
+and a state is the tuple of its ``T`` tiles' rows; ``Q(x, b)`` sums the tiles' weights from
+0.0 in tiling order, and a change of ``Q(x, b)`` by ``amount`` adds ``amount / T`` to each.
 """
 
 from __future__ import annotations
@@ -126,7 +130,7 @@ def schedule(spec: float | Mapping[str, Any] | Schedule) -> Schedule:
 
 def make_indexer(
     space: spaces.Space[Any], discretization: Mapping[str, Sequence[float]] | None
-) -> tuple[tuple[int, ...], Callable[[Any], int]]:
+) -> tuple[tuple[int, ...], Callable[[Any], Any]]:
     """The state shape of an observation space and the function giving an observation's row.
 
     Args:
@@ -158,6 +162,9 @@ def make_indexer(
                 row = row * bins[d] + index
             return row
 
+        tilings = int(discretization.get("tilings", 1))  # type: ignore[call-overload]
+        if tilings > 1:
+            return tile_indexer(bins, lows, highs, tilings)
         return tuple(bins), box_row
 
     assert discretization is None, "Discrete and Tuple observations take no grid"
@@ -175,6 +182,39 @@ def make_indexer(
         return row
 
     return tuple(sizes), discrete_row
+
+
+def tile_indexer(
+    bins: list[int], lows: list[float], highs: list[float], tilings: int
+) -> tuple[tuple[int, ...], Callable[[Any], Any]]:
+    """docs/algorithms.md, "Tile coding": the weights' shape and an observation's tile rows.
+
+    Tiling ``t`` shifts the grid by ``(t * (1 + 2k) mod T) / T`` of a bin in the ``k``-th
+    dimension with more than one bin; each such dimension has ``bins + 1`` tiles; a tile's
+    row is the C-order index of ``(t, coord_0, coord_1, ...)``.
+    """
+    sizes = [b + 1 if b > 1 else 1 for b in bins]
+
+    def tile_rows(observation: Any) -> tuple[int, ...]:
+        xs = np.asarray(observation, dtype=np.float32).tolist()
+        rows = []
+        for t in range(tilings):
+            row, k = t, 0
+            for d, x in enumerate(xs):
+                if bins[d] == 1:
+                    continue
+                v = (x - lows[d]) / (highs[d] - lows[d]) * bins[d]
+                if not v >= 0.0:
+                    v = 0.0
+                elif v > bins[d]:
+                    v = float(bins[d])
+                coord = (math.floor(v * tilings) + (t * (1 + 2 * k)) % tilings) // tilings
+                row = row * (bins[d] + 1) + coord
+                k += 1
+            rows.append(row)
+        return tuple(rows)
+
+    return (tilings, *sizes), tile_rows
 
 
 # CartPole physics (design.md, "CartPole physics").
@@ -229,21 +269,45 @@ class Agent:
 
     # -- reading the table
 
-    def policy_row(self, x: int) -> list[float]:
+    def value(self, x: Any, b: int, table: list[list[float]] | None = None) -> float:
+        """``Q(x, b)``: the entry, or on tiles (``x`` a tuple of rows) the tiles' sum."""
+        table = self.q if table is None else table
+        if isinstance(x, tuple):
+            total = 0.0
+            for tile in x:
+                total = total + table[tile][b]
+            return total
+        return table[x][b]
+
+    def add(self, x: Any, b: int, amount: float, table: list[list[float]] | None = None) -> None:
+        """``Q(x, b) = Q(x, b) + amount``; on tiles each tile by ``amount / T``."""
+        table = self.q if table is None else table
+        if isinstance(x, tuple):
+            step = amount / len(x)
+            for tile in x:
+                table[tile][b] = table[tile][b] + step
+        else:
+            table[x][b] = table[x][b] + amount
+
+    def row(self, x: Any) -> list[float]:
+        """``[Q(x, 0), Q(x, 1), ...]``."""
+        return [self.value(x, b) for b in range(self.n)]
+
+    def policy_row(self, x: Any) -> list[float]:
         """The values epsilon-greedy chooses from (Double Q overrides it with A + B)."""
-        return self.q[x]
+        return self.row(x)
 
-    def greedy(self, x: int) -> int:
+    def greedy(self, x: Any) -> int:
         """The lowest action with the largest ``Q(x, b)``."""
-        return argmax(self.q[x])
+        return argmax(self.row(x))
 
-    def max(self, x: int) -> float:
+    def max(self, x: Any) -> float:
         """``Q(x, greedy(x))``."""
-        return self.q[x][self.greedy(x)]
+        return self.value(x, self.greedy(x))
 
-    def expected(self, x: int) -> float:
+    def expected(self, x: Any) -> float:
         """``E(x) = (1 - epsilon) * Q(x, g) + (epsilon / n) * S``."""
-        row = self.q[x]
+        row = self.row(x)
         g = argmax(row)
         total = row[0]
         for b in range(1, self.n):
@@ -280,8 +344,8 @@ class Agent:
         return lowest
 
     def update(self, x: int, b: int, y: float) -> None:
-        """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))``."""
-        self.q[x][b] = self.q[x][b] + self.alpha * (y - self.q[x][b])
+        """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))`` (on tiles: ``add``'s split)."""
+        self.add(x, b, self.alpha * (y - self.value(x, b)))
 
     # -- what the algorithms override
 
@@ -343,7 +407,7 @@ class Sarsa(Agent):
             self.update(s, a, r)
             return None
         a2 = self.draw(s2)
-        self.update(s, a, r + self.gamma * self.q[s2][a2])
+        self.update(s, a, r + self.gamma * self.value(s2, a2))
         return None if truncated else a2
 
 
@@ -367,16 +431,17 @@ class DoubleQLearning(Agent):
         super().__init__(n_states, n, q_init, *args)
         self.q_b = [[q_init] * n for _ in range(n_states)]
 
-    def policy_row(self, x: int) -> list[float]:
-        return [self.q[x][b] + self.q_b[x][b] for b in range(self.n)]
+    def policy_row(self, x: Any) -> list[float]:
+        return [self.value(x, b) + self.value(x, b, self.q_b) for b in range(self.n)]
 
     def step(
         self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
     ) -> int | None:
         u = self.rng.random()
         first, second = (self.q, self.q_b) if u < 0.5 else (self.q_b, self.q)
-        y = r if terminated else r + self.gamma * second[s2][argmax(first[s2])]
-        first[s][a] = first[s][a] + self.alpha * (y - first[s][a])
+        best = argmax([self.value(s2, b, first) for b in range(self.n)])
+        y = r if terminated else r + self.gamma * self.value(s2, best, second)
+        self.add(s, a, self.alpha * (y - self.value(s, a, first)), first)
         if terminated or truncated:
             return None
         return self.draw(s2)
@@ -407,7 +472,7 @@ class NStepSarsa(Agent):
             g = g + self.gamma ** float(i) * rewards[i]
         if bootstrap:
             assert a2 is not None
-            g = g + self.gamma ** float(k) * self.q[s2][a2]
+            g = g + self.gamma ** float(k) * self.value(s2, a2)
         x, b, _ = self.pending.popleft()
         self.update(x, b, g)
 
@@ -442,7 +507,7 @@ class NStepTreeBackup(Agent):
             others = 0.0
             for c in range(self.n):
                 if c != b:
-                    others = others + self.pi(c, x) * self.q[x][c]
+                    others = others + self.pi(c, x) * self.value(x, c)
             g = steps[m][2] + self.gamma * (others + self.pi(b, x) * g)
         x, b, _ = self.pending.popleft()
         self.update(x, b, g)
@@ -470,23 +535,29 @@ class TraceAgent(Agent):
         super().__init__(*args)
         self.traces: dict[int, float] = {}
         self.lam = float(self.params["lambda"])
+        self.tilings = int(self.params.get("tilings", 1))
 
-    def give_trace(self, s: int, a: int) -> None:
-        """Give ``(s, a)`` a trace (appended at 0.0 if it has none), by ``agent.trace``."""
-        flat = s * self.n + a
-        if flat not in self.traces:
-            self.traces[flat] = 0.0
-        z = self.traces[flat]
-        kind = self.params["trace"]
-        if kind == "accumulating":
-            z = z + 1.0
-        elif kind == "replacing":
-            z = 1.0
-        elif kind == "dutch":
-            z = (1.0 - self.alpha) * z + 1.0
-        else:
-            raise ValueError(f"unknown trace {kind!r}")
-        self.traces[flat] = z
+    def give_trace(self, s: Any, a: int) -> None:
+        """Give ``(s, a)`` a trace (appended at 0.0 if it has none), by ``agent.trace``.
+
+        On tiles each of ``s``'s tiles gets its trace, dutch with the tile's ``alpha / T``.
+        """
+        alpha = self.alpha / len(s) if isinstance(s, tuple) else self.alpha
+        for row in s if isinstance(s, tuple) else (s,):
+            flat = row * self.n + a
+            if flat not in self.traces:
+                self.traces[flat] = 0.0
+            z = self.traces[flat]
+            kind = self.params["trace"]
+            if kind == "accumulating":
+                z = z + 1.0
+            elif kind == "replacing":
+                z = 1.0
+            elif kind == "dutch":
+                z = (1.0 - alpha) * z + 1.0
+            else:
+                raise ValueError(f"unknown trace {kind!r}")
+            self.traces[flat] = z
 
     def decay(self) -> None:
         """``z = (gamma * lambda) * z`` for every trace; traces now exactly 0.0 are dropped."""
@@ -498,10 +569,19 @@ class TraceAgent(Agent):
                 self.traces[flat] = z
 
     def apply(self, delta: float) -> None:
-        """``Q[x] = Q[x] + alpha * delta * z`` for every trace, in list order."""
+        """``Q[x] = Q[x] + alpha * delta * z`` for every trace, in list order.
+
+        On tiles a traced tile ``w = w + ((alpha * delta) / T) * z``.
+        """
+        self.apply_scaled(self.alpha * delta)
+
+    def apply_scaled(self, scale: float) -> None:
+        """``Q[x] = Q[x] + scale * z`` (on tiles ``(scale / T) * z``) for every trace."""
+        if self.tilings > 1:
+            scale = scale / self.tilings
         for flat, z in self.traces.items():
             x, b = divmod(flat, self.n)
-            self.q[x][b] = self.q[x][b] + self.alpha * delta * z
+            self.q[x][b] = self.q[x][b] + scale * z
 
 
 class SarsaLambda(TraceAgent):
@@ -515,8 +595,8 @@ class SarsaLambda(TraceAgent):
             y = r
         else:
             a2 = self.draw(s2)
-            y = r + self.gamma * self.q[s2][a2]
-        delta = y - self.q[s][a]
+            y = r + self.gamma * self.value(s2, a2)
+        delta = y - self.value(s, a)
         self.give_trace(s, a)
         self.apply(delta)
         if terminated or truncated:
@@ -533,14 +613,14 @@ class WatkinsQLambda(TraceAgent):
         self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
     ) -> int | None:
         y = r if terminated else r + self.gamma * self.max(s2)
-        delta = y - self.q[s][a]
+        delta = y - self.value(s, a)
         self.give_trace(s, a)
         self.apply(delta)
         if terminated or truncated:
             self.traces.clear()
             return None
         a2 = self.draw(s2)
-        if self.q[s2][a2] == self.max(s2):
+        if self.value(s2, a2) == self.max(s2):
             self.decay()
         else:
             self.traces.clear()
@@ -558,19 +638,26 @@ class TrueOnlineSarsaLambda(TraceAgent):
         self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
     ) -> int | None:
         a2 = None if terminated else self.draw(s2)
-        q_sa = self.q[s][a]
-        q_next = 0.0 if a2 is None else self.q[s2][a2]
+        q_sa = self.value(s, a)
+        q_next = 0.0 if a2 is None else self.value(s2, a2)
         delta = r + self.gamma * q_next - q_sa
-        flat = s * self.n + a
-        z_sa = self.traces.get(flat, 0.0)
+        # On tiles x(s, a) has a 1 at each of s's tiles, and a tile's step size is alpha / T.
+        rows = s if isinstance(s, tuple) else (s,)
+        tile_alpha = self.alpha / len(rows) if isinstance(s, tuple) else self.alpha
+        z_sa = 0.0 if isinstance(s, tuple) else self.traces.get(s * self.n + a, 0.0)
+        if isinstance(s, tuple):
+            for row in rows:
+                z_sa = z_sa + self.traces.get(row * self.n + a, 0.0)
         self.decay()
-        if flat not in self.traces:
-            self.traces[flat] = 0.0
-        self.traces[flat] = self.traces[flat] + (1.0 - self.alpha * self.gamma * self.lam * z_sa)
-        for trace_flat, z in self.traces.items():
-            x, b = divmod(trace_flat, self.n)
-            self.q[x][b] = self.q[x][b] + self.alpha * (delta + q_sa - self.q_old) * z
-        self.q[s][a] = self.q[s][a] - self.alpha * (q_sa - self.q_old)
+        for row in rows:
+            flat = row * self.n + a
+            if flat not in self.traces:
+                self.traces[flat] = 0.0
+            self.traces[flat] = self.traces[flat] + (
+                1.0 - tile_alpha * self.gamma * self.lam * z_sa
+            )
+        self.apply_scaled(self.alpha * (delta + q_sa - self.q_old))
+        self.add(s, a, -(self.alpha * (q_sa - self.q_old)))
         self.q_old = q_next
         if terminated or truncated:
             self.traces.clear()
@@ -834,9 +921,11 @@ def reference_train(
     physics_rng = np.random.Generator(np.random.PCG64(physics_seq))
     env_seed = int(env_seq.generate_state(1, dtype=np.uint32)[0])
 
+    tilings = int((discretization or {}).get("tilings", 1))  # type: ignore[call-overload]
     agent = ALGORITHMS[algorithm](
-        n_states, n, float(q_init), float(gamma), rng, {**PARAMETER_DEFAULTS, **(params or {})}
-    )
+        n_states, n, float(q_init), float(gamma), rng,
+        {**PARAMETER_DEFAULTS, **(params or {}), "tilings": tilings},
+    )  # fmt: skip
     if isinstance(agent, MonteCarlo):
         assert env.spec is not None
         limit = env.spec.max_episode_steps
@@ -865,7 +954,8 @@ def reference_train(
             observation, reward, terminated, truncated, _ = env.step(a)
             s2 = row(observation)
             r = float(reward)
-            visits[s][a] += 1
+            for tile in s if isinstance(s, tuple) else (s,):
+                visits[tile][a] += 1
             episode_return += r
             length += 1
             a2 = agent.step(s, a, r, s2, bool(terminated), bool(truncated) and not terminated)

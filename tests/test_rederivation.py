@@ -255,14 +255,36 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 600,
         "seed": 10,
     },
+    # Tile coding: 4 tilings of a 4 x 3 grid (docs/algorithms.md, "Tile coding").
+    "mountaincar_tiles": {
+        "env": {"id": "MountainCar-v0"},
+        "discretization": {
+            "bins": [4, 3],
+            "low": [-1.2, -0.07],
+            "high": [0.6, 0.07],
+            "tilings": 4,
+        },
+        "agent": {"gamma": 1.0, "alpha": 0.5, "epsilon": 0.1, "q_init": 0.0},
+        "episodes": 6,
+        "seed": 12,
+    },
+    # One-bin dimensions ignored, offsets by the rank of the binned dimension; 3 tilings.
+    "cartpole_tiles": {
+        "env": {"id": "CartPole-v1"},
+        "discretization": {**DEFAULT["discretization"], "bins": [1, 1, 3, 5], "tilings": 3},
+        "agent": DEFAULT_AGENT,
+        "episodes": 80,
+        "seed": 13,
+    },
 }
 # Worlds with a compiled twin train on both engines.
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
-NUMBA_WORLDS |= {"mountaincar", "acrobot"}
+NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
 NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack"}
 # On the twins other than CartPole's, the numba engine runs one variant of each family.
 OTHER_TWINS = {"mountaincar", "acrobot", "frozenlake", "taxi", "cliffwalking", "blackjack"}
+OTHER_TWINS |= {"mountaincar_tiles", "cartpole_tiles"}
 TABULAR_TWINS = {"frozenlake", "taxi", "cliffwalking", "blackjack"}
 TWIN_FAMILY_VARIANTS = {
     "q_learning",
@@ -409,6 +431,28 @@ def test_cartpole_physics_and_randomized_physics(world: str, variant: str, engin
 def test_other_worlds(world: str, variant: str, engine: str) -> None:
     """Other Box grids (MountainCar, Acrobot with a 200-step limit); CliffWalking: no limit."""
     _assert_same(world, variant, engine)
+
+
+# The algorithms that run on tiles (Dyna and Monte Carlo keep states across episodes).
+TILE_VARIANTS = [
+    variant
+    for variant, (algorithm, _) in {**VARIANTS, **EDGE_VARIANTS}.items()
+    if not algorithm.startswith(("dyna", "monte_carlo", "off_policy")) and variant not in LONG_N
+]
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    [
+        *_params(["mountaincar_tiles"], TILE_VARIANTS, slow="beyond_one_step"),
+        *_params(["cartpole_tiles"], ["q_learning", "sarsa_lambda-dutch"]),
+    ],
+)
+def test_tile_coding(world: str, variant: str, engine: str) -> None:
+    """Tiles: every algorithm that runs on them, traces over tiles, dutch and true online."""
+    expected = _assert_same(world, variant, engine)
+    tilings = CASES[world]["discretization"]["tilings"]
+    assert expected.visits.sum() == tilings * sum(expected.lengths)  # each step, T tiles
 
 
 @pytest.mark.parametrize(

@@ -232,6 +232,16 @@ class DiscretizationConfig:
     high: tuple[float, ...] = field(
         metadata=spec("floats", "the grid's upper edges; values above fall in the last bin")
     )
+    tilings: int = field(
+        metadata=spec(
+            "int",
+            "tile coding: this many grids, each shifted by a fraction of a bin, whose values "
+            'are summed (1: one plain grid, the binning rule; docs/algorithms.md, "Tile '
+            'coding")',
+            low=1,
+            high=64,
+        )
+    )
 
 
 @dataclass(frozen=True)

@@ -72,12 +72,15 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     # The grid is checked before the other keys: a config with several mistakes has always
     # been told about the grid's first.
     discretization = _discretization(reader)
+    agent = AgentConfig(**reader.fields(AgentConfig, "agent."), params=_algorithm_params(reader))
+    if discretization is not None and discretization.tilings > 1:
+        _check_on_tiles(reader, agent.algorithm)
     return Config(
         name=name,
         **reader.fields(Config, "", skip=("name",)),
         env=_env(reader),
         discretization=discretization,
-        agent=AgentConfig(**reader.fields(AgentConfig, "agent."), params=_algorithm_params(reader)),
+        agent=agent,
         train=TrainConfig(**reader.fields(TrainConfig, "train.")),
         eval=EvalConfig(**reader.fields(EvalConfig, "eval.")),
     )
@@ -105,6 +108,17 @@ def _discretization(reader: _Reader) -> DiscretizationConfig | None:
                 f"entry {d} ({lo}) must be below discretization.high entry {d} ({hi}).",
             )
     return grid
+
+
+def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
+    """Tile coding takes the algorithms whose memory holds no state across episodes."""
+    reason = get_algorithm(algorithm).not_on_tiles
+    if reason:
+        raise reader.error(
+            "discretization.tilings",
+            f"tile coding (tilings > 1) does not run agent.algorithm {algorithm}: {reason}. "
+            "Use tilings: 1, or a one-step, n-step or trace algorithm.",
+        )
 
 
 def _env(reader: _Reader) -> EnvConfig:

@@ -131,12 +131,32 @@ class AgentParams:
     agent: AgentRecord
     params: tuple[float, ...]
     """the algorithm's own parameters, as its hooks take them"""
+    tilings: int = 1
+    """tile coding's tilings (1: plain rows; see :mod:`cartpole_q.rl.tiles`)"""
+    max_steps: int = 0
+    """the longest episode (its time limit, or the greedy cap): on tiles, the handles"""
+
+    @property
+    def tiled(self) -> bool:
+        """Whether observations are tile-coded (the hooks get ``(weights, features)``)."""
+        return self.tilings > 1
+
+    def hook_table(self, q: np.ndarray) -> Any:
+        """The table as the hooks take it: ``q``, or on tiles ``(q, features)``.
+
+        The features are a fresh ``(max_steps + 1, T)`` array of the handles' tile rows
+        (scratch: an episode writes them before it reads them).
+        """
+        if not self.tiled:
+            return q
+        return (q, np.zeros((self.max_steps + 1, self.tilings), dtype=np.int64))
 
     @classmethod
     def from_config(cls, config: Config, env_info: EnvInfo) -> AgentParams:
         """Build the parameters of a validated config on its environment."""
         threshold = env_info.reward_threshold
         algorithm = get_algorithm(config.agent.algorithm)
+        tilings = config.discretization.tilings if config.discretization is not None else 1
         return cls(
             algorithm=algorithm,
             grid=Grid.of(config, env_info),
@@ -147,6 +167,8 @@ class AgentParams:
                 threshold=math.inf if threshold is None else float(threshold),
             ),
             params=algorithm.hook_params(config.agent.params, config.agent.tie_break),
+            tilings=tilings,
+            max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
         )
 
 

@@ -11,6 +11,11 @@ one template function, its placeholder globals (``ALGORITHM_STEP``, ``TWIN_STEP`
 one algorithm's and one twin's compiled functions, cached on disk under a name that says
 which. numba's cache key holds a function's bytecode and closure, not its globals, so the
 name (with the algorithm's and twin's source digests in it) keeps the variants apart.
+
+On tile-coded tables (``tiled=True``) every compilable helper that has a tiles variant
+(:func:`~cartpole_q.rl.tabular.tiles_variant`: ``value``, ``shift``, the trace functions) is
+replaced by it, recursively, so the same hooks run on tiles; a variant that calls its own
+original gets the original (it applies it to the weights).
 """
 
 from __future__ import annotations
@@ -22,11 +27,12 @@ from typing import Any
 from numba import njit
 from numba.core.dispatcher import Dispatcher
 
+import cartpole_q.rl.tiles  # noqa: F401  (registers the tiles variants before any compile)
 from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-_COMPILED: dict[Callable[..., Any], Dispatcher] = {}
+_COMPILED: dict[tuple[Callable[..., Any], bool], Dispatcher] = {}
 
 
 def is_compilable(value: Any) -> bool:
@@ -34,18 +40,19 @@ def is_compilable(value: Any) -> bool:
     return isinstance(value, types.FunctionType) and bool(getattr(value, "__compilable__", False))
 
 
-def jit(function: Callable[..., Any]) -> Dispatcher:
+def jit(function: Callable[..., Any], tiled: bool = False) -> Dispatcher:
     """``function`` compiled (inlined where compiled code calls it), its helpers compiled too.
 
-    Compiled once per process; numba compiles it for each argument types on first use.
+    Compiled once per process (and per ``tiled``: for tile-coded tables, see the module
+    docstring); numba compiles it for each argument types on first use.
     """
     if isinstance(function, Dispatcher):
         return function
-    found = _COMPILED.get(function)
+    found = _COMPILED.get((function, tiled))
     if found is not None:
         return found
     assert isinstance(function, types.FunctionType), function
-    namespace = _compiled_globals(function)
+    namespace = _compiled_globals(function, tiled)
     rebuilt = types.FunctionType(
         function.__code__, namespace, function.__name__, function.__defaults__,
         function.__closure__,
@@ -54,17 +61,25 @@ def jit(function: Callable[..., Any]) -> Dispatcher:
     rebuilt.__module__ = function.__module__
     rebuilt.__doc__ = function.__doc__
     dispatcher = njit(nogil=True, inline="always")(rebuilt)
-    _COMPILED[function] = dispatcher
+    _COMPILED[(function, tiled)] = dispatcher
     return dispatcher
 
 
-def _compiled_globals(function: types.FunctionType) -> dict[str, Any]:
-    """The function's globals, the compilable functions it names replaced by compiled ones."""
+def _compiled_globals(function: types.FunctionType, tiled: bool = False) -> dict[str, Any]:
+    """The function's globals, the compilable functions it names replaced by compiled ones.
+
+    With ``tiled``, by their tiles variants where they have one (but a variant's own
+    original stays the original, compiled for plain tables).
+    """
     namespace = dict(function.__globals__)
     for name in _global_names(function.__code__):
         value = namespace.get(name)
         if isinstance(value, types.FunctionType) and is_compilable(value):
-            namespace[name] = jit(value)
+            variant = getattr(value, "__tiled__", None) if tiled else None
+            if variant is function:
+                namespace[name] = jit(value, tiled=False)
+            else:
+                namespace[name] = jit(variant or value, tiled)
     return namespace
 
 
@@ -78,7 +93,12 @@ def _global_names(code: types.CodeType) -> set[str]:
 
 
 def specialise(
-    template: Callable[..., Any], name: str, bindings: Mapping[str, Any], *, inline: bool = False
+    template: Callable[..., Any],
+    name: str,
+    bindings: Mapping[str, Any],
+    *,
+    inline: bool = False,
+    tiled: bool = False,
 ) -> Dispatcher:
     """A compiled copy of ``template`` whose placeholder globals are ``bindings``.
 
@@ -91,10 +111,11 @@ def specialise(
             as :func:`jit` does: an algorithm's hooks).
         inline: inline the copy where compiled code calls it (then it is not cached by
             itself: its callers' cache entries hold it).
+        tiled: compile for tile-coded tables (see the module docstring); ``name`` must say so.
     """
     assert isinstance(template, types.FunctionType)
-    namespace = _compiled_globals(template)
-    namespace.update({key: jit(value) if isinstance(value, types.FunctionType) else value
+    namespace = _compiled_globals(template, tiled)
+    namespace.update({key: jit(value, tiled) if isinstance(value, types.FunctionType) else value
                       for key, value in bindings.items()})  # fmt: skip
     function = types.FunctionType(
         template.__code__, namespace, name, template.__defaults__, template.__closure__

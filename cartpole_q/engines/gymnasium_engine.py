@@ -18,11 +18,11 @@ from cartpole_q.engines.compile import specialise
 from cartpole_q.engines.context import StepContext, step_context
 from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
 from cartpole_q.engines.play import play_greedy
-from cartpole_q.engines.rows import ROW_RULES
+from cartpole_q.engines.rows import STATE_RULES
 from cartpole_q.envs.gym import make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.tabular import ENDED, no_episode_end
+from cartpole_q.rl.tabular import ENDED, no_episode_end, visit
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -31,12 +31,12 @@ configure_numba_cache()  # before any cache=True function is defined
 ALGORITHM_START: Any = None
 ALGORITHM_STEP: Any = None
 ALGORITHM_END: Any = None
-OBSERVATION_ROW: Any = None
+OBSERVATION_STATE: Any = None
 
 
 def first_step(context: Any, observation: Any, epsilon: float) -> tuple[int, int]:
     """An episode's first row and action, for the reset observation."""
-    state = OBSERVATION_ROW(observation, context.grid)
+    state = OBSERVATION_STATE(context.q, observation, context.grid, -1)
     action = ALGORITHM_START(context.q, context.memory, context.params, state, epsilon, context.rng)
     return state, action
 
@@ -46,8 +46,8 @@ def next_step(
     truncated: bool, alpha: float, epsilon: float,
 ) -> tuple[int, int]:  # fmt: skip
     """Learn from one step; the next row and the next action (or ``ENDED``)."""
-    row = OBSERVATION_ROW(observation, context.grid)
-    context.visits[state, action] += 1
+    row = OBSERVATION_STATE(context.q, observation, context.grid, state)
+    visit(context.visits, context.q, state, action)
     chosen = ALGORITHM_STEP(
         context.q, context.memory, context.params, state, action, reward, row, terminated,
         truncated, alpha, context.gamma, epsilon, context.rng,
@@ -68,8 +68,8 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
 
     Args:
         algorithm: the algorithm whose hooks they call.
-        kind: the observation kind (``box``, ``discrete`` or ``tuple``; see
-            :data:`~cartpole_q.engines.rows.ROW_RULES`).
+        kind: the observation kind (``box``, ``discrete`` or ``tuple``; ``tiles``: a Box
+            observation on tiles; see :data:`~cartpole_q.engines.rows.STATE_RULES`).
 
     They take the run's step context (see :mod:`~cartpole_q.engines.context`) and call the
     algorithm's hooks as the numba engine's loop does; cached on disk under the algorithm's
@@ -79,13 +79,14 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
         "ALGORITHM_START": algorithm.start,
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
-        "OBSERVATION_ROW": ROW_RULES[kind],
+        "OBSERVATION_STATE": STATE_RULES[kind],
     }
     suffix = f"{algorithm.key}__{kind}"
+    tiled = kind == "tiles"
     return (
-        specialise(first_step, f"first_step__{suffix}", bindings),
-        specialise(next_step, f"next_step__{suffix}", bindings),
-        specialise(end_episode, f"end_episode__{suffix}", bindings),
+        specialise(first_step, f"first_step__{suffix}", bindings, tiled=tiled),
+        specialise(next_step, f"next_step__{suffix}", bindings, tiled=tiled),
+        specialise(end_episode, f"end_episode__{suffix}", bindings, tiled=tiled),
     )
 
 
@@ -126,7 +127,7 @@ class GymnasiumEngine:
             generator.bit_generator.state = env_rng_state
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
-        kind = observation_kind(self._env.observation_space)
+        kind = "tiles" if params.tiled else observation_kind(self._env.observation_space)
         self._first, self._next, self._end = step_functions(params.algorithm, kind)
         self._has_end = params.algorithm.end is not no_episode_end
         # Tuple observations as plain integers: one compiled specialisation for any env.
@@ -146,7 +147,7 @@ class GymnasiumEngine:
         ):
             p = self._params
             self._context = step_context(
-                state.agent_rng, q, visits, memory, p.params, p.grid, p.agent.gamma
+                state.agent_rng, p.hook_table(q), visits, memory, p.params, p.grid, p.agent.gamma
             )
             self._context_of = of
         return self._context
@@ -205,7 +206,7 @@ class GymnasiumEngine:
             observation = starts if isinstance(space, spaces.Tuple) else starts[0]
         q, visits, memory = state.tables
         scratch = step_context(
-            np.random.default_rng(0), q.copy(), visits.copy(),
+            np.random.default_rng(0), p.hook_table(q.copy()), visits.copy(),
             tuple(array.copy() for array in memory), p.params, grid, p.agent.gamma,
         )  # fmt: skip
         self._first(scratch, observation, 0.0)
@@ -217,7 +218,10 @@ class GymnasiumEngine:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
         env = make_env(self._config.env)
         try:
-            return play_greedy(env, q, self._params.grid, episodes, seed, step_cap=self._step_cap)
+            p = self._params
+            return play_greedy(
+                env, q, p.grid, episodes, seed, step_cap=self._step_cap, tilings=p.tilings
+            )
         finally:
             env.close()
 

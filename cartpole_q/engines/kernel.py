@@ -5,7 +5,7 @@ runs whole episodes on a twin; the gymnasium engine steps a real environment fro
 calls compiled functions once per step (:mod:`cartpole_q.engines.gymnasium_engine`). Either
 way an episode is: epsilon and alpha of the episode; reset; the algorithm's ``start`` on the
 reset state; then per step the environment's step, the observation's row,
-``visits[s, a] += 1``, and the algorithm's ``step``; at the end, the algorithm's ``end``.
+the visit counted, and the algorithm's ``step``; at the end, the algorithm's ``end``.
 The row rule is the gymnasium engine's (:mod:`cartpole_q.engines.rows`), for the twin's
 kind of observation.
 
@@ -25,12 +25,12 @@ import numpy as np
 
 from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid
 from cartpole_q.engines.compile import specialise
-from cartpole_q.engines.rows import ARRAY_ROW_RULES
+from cartpole_q.engines.rows import ARRAY_STATE_RULES
 from cartpole_q.envs.registry import Twin
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.schedules import schedule_value
 from cartpole_q.rl.solve import SOLVE_WINDOW
-from cartpole_q.rl.tabular import ENDED, best_action, compilable
+from cartpole_q.rl.tabular import ENDED, best_action, compilable, visit
 
 # Placeholders, bound per (algorithm, twin) by specialise(); never called as they are.
 ALGORITHM_START: Any = None
@@ -41,7 +41,7 @@ TWIN_STEP: Any = None
 TWIN_RANDOMIZE: Any = None
 TWIN_STATE_DTYPE: Any = None
 TWIN_OBSERVATION_DTYPE: Any = None
-OBSERVATION_ROW: Any = None
+OBSERVATION_STATE: Any = None
 EXPLORING_EPISODE: Any = None
 GREEDY_EPISODE: Any = None
 GREEDY: bool = False
@@ -86,7 +86,7 @@ def record_episode(
 
 
 def twin_episode(
-    q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, low: np.ndarray,
+    q: Any, visits: np.ndarray, memory: Any, params: Any, low: np.ndarray,
     high: np.ndarray, bins: np.ndarray, starts: np.ndarray, gamma: float, alpha: float,
     epsilon: float, rng: np.random.Generator, env_rng: np.random.Generator, env_params: Any,
     max_steps: int, env_state: np.ndarray, observation: np.ndarray,
@@ -101,15 +101,15 @@ def twin_episode(
     if GREEDY:
         epsilon = 0.0
     TWIN_RESET(env_state, observation, env_rng, env_params)
-    state = OBSERVATION_ROW(observation, low, high, bins, starts)
+    state = OBSERVATION_STATE(q, observation, low, high, bins, starts, -1)
     action = ALGORITHM_START(q, memory, params, state, epsilon, rng)
     episode_return, length = 0.0, 0
     while action != ENDED:
         reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, env_params)
         length += 1
         episode_return += reward
-        next_state = OBSERVATION_ROW(observation, low, high, bins, starts)
-        visits[state, action] += 1
+        next_state = OBSERVATION_STATE(q, observation, low, high, bins, starts, state)
+        visit(visits, q, state, action)
         action = ALGORITHM_STEP(
             q, memory, params, state, action, reward, next_state, terminated,
             length >= max_steps, alpha, gamma, epsilon, rng,
@@ -120,7 +120,7 @@ def twin_episode(
 
 
 def train_episodes(
-    q: np.ndarray, visits: np.ndarray, memory: Any, params: Any, grid: Grid, agent: AgentRecord,
+    q: Any, visits: np.ndarray, memory: Any, params: Any, grid: Grid, agent: AgentRecord,
     metrics: EpisodeMetrics, agent_rng: np.random.Generator, env_rng: np.random.Generator,
     env: Any, start: int, stop: int, check_solved: bool, physics_rng: np.random.Generator,
     randomize: tuple[np.ndarray, np.ndarray, np.ndarray],
@@ -128,7 +128,8 @@ def train_episodes(
     """Train episodes ``start .. stop - 1`` on the twin.
 
     Args:
-        q: the learned table as ``(n_states, n_actions)``, updated in place.
+        q: the learned table as ``(n_states, n_actions)``, updated in place (on tiles the
+            pair ``(weights, features)``: see :mod:`cartpole_q.rl.tiles`).
         visits: how often each (state, action) was taken, updated in place.
         memory: the algorithm's memory (a tuple of arrays), updated in place.
         params: the algorithm's parameters (a tuple of floats).
@@ -181,7 +182,7 @@ def train_episodes(
 
 
 def greedy_returns(
-    q: np.ndarray, grid: Grid, env_rng: np.random.Generator, env: Any, episodes: int
+    q: Any, grid: Grid, env_rng: np.random.Generator, env: Any, episodes: int
 ) -> np.ndarray:
     """The greedy policy's return in each of ``episodes`` twin episodes.
 
@@ -196,7 +197,7 @@ def greedy_returns(
     for episode in range(episodes):
         TWIN_RESET(env_state, observation, env_rng, params)
         for length in range(1, max_steps + 1):
-            state = OBSERVATION_ROW(observation, low, high, bins, starts)
+            state = OBSERVATION_STATE(q, observation, low, high, bins, starts, -1)
             action = best_action(q, state)
             reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, params)
             returns[episode] += reward
@@ -219,33 +220,45 @@ class TrainingKernel:
     """the episode loop compiled for epsilon 0"""
 
 
-def training_kernel(algorithm: Algorithm, twin: Twin, randomized: bool = False) -> TrainingKernel:
+def training_kernel(
+    algorithm: Algorithm, twin: Twin, randomized: bool = False, tiled: bool = False
+) -> TrainingKernel:
     """The compiled training loop of one algorithm on one twin.
 
     Compiled for the pair, with the algorithm's hooks and the twin's functions inlined and no
     branch on either left in the loop; cached on disk under the pair's keys (which carry
     digests of their sources), so a run compiles (or loads) only the machine code it runs.
     ``randomized`` compiles the draws of ``env.randomize`` in (a run without them does not
-    compile them at all).
+    compile them at all); ``tiled`` compiles for tile-coded tables (``q`` is then the pair
+    ``(weights, features)``, see :mod:`cartpole_q.rl.tiles`).
     """
-    return _training_kernel(algorithm.key, twin.key, randomized, algorithm, twin)
+    return _training_kernel(algorithm.key, twin.key, randomized, tiled, algorithm, twin)
 
 
 @functools.cache
 def _training_kernel(
-    algorithm_key: str, twin_key: str, randomized: bool, algorithm: Algorithm, twin: Twin
+    algorithm_key: str,
+    twin_key: str,
+    randomized: bool,
+    tiled: bool,
+    algorithm: Algorithm,
+    twin: Twin,
 ) -> TrainingKernel:
-    pair = f"{algorithm_key}__{twin_key}"
+    pair = f"{algorithm_key}__{twin_key}" + ("__tiles" if tiled else "")
     hooks = {
         "ALGORITHM_START": algorithm.start,
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
-        **twin_bindings(twin),
+        **twin_bindings(twin, tiled),
     }
     # The two episode loops are compiled (and cached) on their own, not inlined into the
     # outer loop: each is a smaller compilation, and they can be compiled side by side.
-    exploring = specialise(twin_episode, f"twin_episode__{pair}", {**hooks, "GREEDY": False})
-    greedy = specialise(twin_episode, f"greedy_episode__{pair}", {**hooks, "GREEDY": True})
+    exploring = specialise(
+        twin_episode, f"twin_episode__{pair}", {**hooks, "GREEDY": False}, tiled=tiled
+    )
+    greedy = specialise(
+        twin_episode, f"greedy_episode__{pair}", {**hooks, "GREEDY": True}, tiled=tiled
+    )
     name = f"train_episodes__{pair}" + ("__randomized" if randomized else "")
     outer = specialise(
         train_episodes,
@@ -258,22 +271,24 @@ def _training_kernel(
             "TWIN_STATE_DTYPE": twin.state_dtype,
             "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
         },
+        tiled=tiled,
     )
     return TrainingKernel(name, outer, exploring, greedy)
 
 
 @functools.cache
-def greedy_kernel(twin: Twin) -> Any:
+def greedy_kernel(twin: Twin, tiled: bool = False) -> Any:
     """The compiled greedy play of one twin (see :func:`training_kernel`)."""
-    return specialise(greedy_returns, f"greedy_returns__{twin.key}", twin_bindings(twin))
+    name = f"greedy_returns__{twin.key}" + ("__tiles" if tiled else "")
+    return specialise(greedy_returns, name, twin_bindings(twin, tiled), tiled=tiled)
 
 
-def twin_bindings(twin: Twin) -> dict[str, Any]:
-    """What a loop template's ``TWIN_...`` placeholders and its row rule are for ``twin``."""
+def twin_bindings(twin: Twin, tiled: bool = False) -> dict[str, Any]:
+    """What a loop template's ``TWIN_...`` placeholders and its state rule are for ``twin``."""
     return {
         "TWIN_RESET": twin.reset,
         "TWIN_STEP": twin.step,
         "TWIN_STATE_DTYPE": twin.state_dtype,
         "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
-        "OBSERVATION_ROW": ARRAY_ROW_RULES[twin.observation_kind],
+        "OBSERVATION_STATE": ARRAY_STATE_RULES["tiles" if tiled else twin.observation_kind],
     }

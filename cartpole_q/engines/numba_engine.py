@@ -39,9 +39,11 @@ class NumbaEngine:
         env_rng_state: dict[str, Any] | None = None,
         randomize: Mapping[str, tuple[float, float]] | None = None,
     ) -> None:
-        self._kernel = training_kernel(params.algorithm, settings.twin, bool(randomize))
+        self._kernel = training_kernel(
+            params.algorithm, settings.twin, bool(randomize), params.tiled
+        )
         self._train_episodes = self._kernel.train_episodes
-        self._greedy_returns = greedy_kernel(settings.twin)
+        self._greedy_returns = greedy_kernel(settings.twin, params.tiled)
         self._twin = settings.twin
         limit = settings.max_episode_steps
         self._env = (
@@ -54,6 +56,7 @@ class NumbaEngine:
         # the gymnasium engine's evaluations do (a greedy policy may walk in circles).
         self._greedy_env = (GREEDY_STEP_CAP if limit is None else limit, *self._env[1:])
         self._params = params
+        self._hook_tables: tuple[Any, Any] = (None, None)  # (q, the hooks' view of it)
         ranges = randomize or {}
         physics = profile_for(settings.twin.env_ids[0]).physics
         drawn = physics.randomizable if physics is not None else ()
@@ -72,13 +75,19 @@ class NumbaEngine:
         p = self._params
         q, visits, memory = state.tables
         finished, env_steps, solved = self._train_episodes(
-            q, visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
+            self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
             self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
             self._randomize,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps
         return None if solved < 0 else solved
+
+    def _hook_table(self, q: np.ndarray) -> Any:
+        """``q`` as the hooks take it (made again only for another array)."""
+        if self._hook_tables[0] is not q:
+            self._hook_tables = (q, self._params.hook_table(q))
+        return self._hook_tables[1]
 
     def warm_up(self, state: TrainingState) -> None:
         """Compile the kernels (or load them from the cache); nothing runs, nothing is drawn.
@@ -124,7 +133,7 @@ class NumbaEngine:
         _, state_size, observation_size, params = self._env
         twin = self._twin
         episode(
-            q.copy(), visits.copy(), tuple(array.copy() for array in memory), p.params,
+            p.hook_table(q.copy()), visits.copy(), tuple(array.copy() for array in memory), p.params,
             p.grid.low, p.grid.high, p.grid.bins, p.grid.starts, p.agent.gamma, 0.5, epsilon,
             np.random.default_rng(0), np.random.default_rng(1), params, 1,
             np.zeros(state_size, dtype=twin.state_dtype),
@@ -135,7 +144,7 @@ class NumbaEngine:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
         env_rng = seeding.np_random(seed)[0]
         returns: np.ndarray = self._greedy_returns(
-            q, self._params.grid, env_rng, self._greedy_env, episodes
+            self._params.hook_table(q), self._params.grid, env_rng, self._greedy_env, episodes
         )
         return returns
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from cartpole_q.engines.base import Grid
 from cartpole_q.rl.binning import discrete_index, state_index
+from cartpole_q.rl.tiles import active_tiles, greedy_tile_action
 
 FrameCallback = Callable[[Any, int, int], None]
 """called with ``(env, episode, step)`` after every reset and step, e.g. to render"""
@@ -26,6 +27,7 @@ def play_greedy(
     seed: int,
     on_frame: FrameCallback | None = None,
     step_cap: int | None = None,
+    tilings: int = 1,
 ) -> np.ndarray:
     """Play the greedy policy of a 2-D ``(n_states, n_actions)`` Q-table.
 
@@ -38,6 +40,8 @@ def play_greedy(
         on_frame: called after every reset and step, e.g. to record video frames.
         step_cap: end an episode after this many steps (for environments without a time
             limit, see :data:`GREEDY_STEP_CAP`); ``None``: only the environment ends it.
+        tilings: tile coding's tilings: ``q`` is then the weights ``(T * tiles, n_actions)``
+            and the action the argmax of the tiles' sum (see :mod:`cartpole_q.rl.tiles`).
 
     Returns:
         The return of each episode.
@@ -45,6 +49,7 @@ def play_greedy(
     # Plain Python lists make the uncompiled binning rule about twice as fast per step.
     low, high, bins = grid.low.tolist(), grid.high.tolist(), grid.bins.tolist()
     starts = grid.starts.tolist()
+    tile_rows = np.zeros(tilings, dtype=np.int64)
     returns = np.zeros(episodes, dtype=np.float64)
     for episode in range(episodes):
         observation, _ = env.reset(seed=seed if episode == 0 else None)
@@ -52,11 +57,15 @@ def play_greedy(
             on_frame(env, episode, 0)
         step = 0
         while True:
-            if starts:
-                row = discrete_index(observation, starts, bins)
+            if tilings > 1:
+                active_tiles(observation, low, high, bins, tilings, tile_rows)
+                action = greedy_tile_action(q, tile_rows, q.shape[1])
             else:
-                row = state_index(observation, low, high, bins)
-            action = int(np.argmax(q[row]))
+                if starts:
+                    row = discrete_index(observation, starts, bins)
+                else:
+                    row = state_index(observation, low, high, bins)
+                action = int(np.argmax(q[row]))
             observation, reward, terminated, truncated, _ = env.step(action)
             step += 1
             returns[episode] += reward

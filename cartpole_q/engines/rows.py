@@ -16,6 +16,7 @@ from typing import Any
 
 from cartpole_q.rl.binning import state_index
 from cartpole_q.rl.tabular import compilable
+from cartpole_q.rl.tiles import active_tiles
 
 
 @compilable
@@ -76,3 +77,78 @@ def indexed_array_row(observation: Any, low: Any, high: Any, bins: Any, starts: 
 ARRAY_ROW_RULES = {"box": binned_array_row, "discrete": indexed_array_row,
                    "tuple": indexed_array_row}  # fmt: skip
 """observation kind -> its row rule for an observation a twin wrote into an array"""
+
+
+# -- the state a hook gets: a row, or on tiles a handle of the observation's tiles ---------
+
+
+@compilable
+def tile_handle(q: Any, previous: int) -> int:
+    """The handle after ``previous`` (``-1`` at a reset): ``(previous + 1) mod len(features)``."""
+    handle: int = (previous + 1) % q[1].shape[0]
+    return handle
+
+
+@compilable
+def binned_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
+    """A Box observation's row (``q`` and ``previous`` are for the tiles rule)."""
+    return binned_row(observation, grid)
+
+
+@compilable
+def discrete_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
+    """A Discrete observation's row."""
+    return discrete_row(observation, grid)
+
+
+@compilable
+def tuple_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
+    """A Tuple observation's row."""
+    return tuple_row(observation, grid)
+
+
+@compilable
+def tiled_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
+    """A Box observation on tiles: its tiles written at the next handle, which it returns."""
+    handle = tile_handle(q, previous)
+    features = q[1]
+    active_tiles(observation, grid.low, grid.high, grid.bins, features.shape[1], features[handle])
+    return handle
+
+
+STATE_RULES = {"box": binned_state, "discrete": discrete_state, "tuple": tuple_state,
+               "tiles": tiled_state}  # fmt: skip
+"""observation kind (``tiles``: a Box observation on tiles) -> the state rule of the gymnasium
+engine's step functions"""
+
+
+@compilable
+def binned_array_state(
+    q: Any, observation: Any, low: Any, high: Any, bins: Any, starts: Any, previous: int
+) -> int:
+    """A twin's Box observation: its row."""
+    return binned_array_row(observation, low, high, bins, starts)
+
+
+@compilable
+def indexed_array_state(
+    q: Any, observation: Any, low: Any, high: Any, bins: Any, starts: Any, previous: int
+) -> int:
+    """A twin's Discrete or Tuple observation: its row."""
+    return indexed_array_row(observation, low, high, bins, starts)
+
+
+@compilable
+def tiled_array_state(
+    q: Any, observation: Any, low: Any, high: Any, bins: Any, starts: Any, previous: int
+) -> int:
+    """A twin's Box observation on tiles: its tiles at the next handle, which it returns."""
+    handle = tile_handle(q, previous)
+    features = q[1]
+    active_tiles(observation, low, high, bins, features.shape[1], features[handle])
+    return handle
+
+
+ARRAY_STATE_RULES = {"box": binned_array_state, "discrete": indexed_array_state,
+                     "tuple": indexed_array_state, "tiles": tiled_array_state}  # fmt: skip
+"""observation kind -> the state rule of the numba engine's loop"""

@@ -17,6 +17,7 @@ from typing import Any
 
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
 from cartpole_q.profiles import profile_for
+from cartpole_q.rl.tiles import tile_shape
 
 SOLVE_WINDOW = 100
 """episodes in the moving average of training returns compared with the reward threshold"""
@@ -202,6 +203,9 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
                 "and high one entry per dimension."
             )
         field = "discretization.bins"
+        if config.discretization.tilings > 1:
+            # The weights of T tilings, each bins + 1 tiles wide (see cartpole_q.rl.tiles).
+            state_shape = tile_shape(state_shape, config.discretization.tilings)
     else:
         raise ConfigError(
             f"{blame(source, 'env.id')}: env.id: {env_id!r} has observation space {observation_space}; "

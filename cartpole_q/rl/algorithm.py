@@ -134,6 +134,10 @@ class Algorithm:
     """a name for each memory array (checkpoints and messages)"""
     book: str = ""
     """where Sutton & Barto (2nd ed.) state it"""
+    not_on_tiles: str = ""
+    """why it does not run on tile coding (empty: it does). On tiles a hook's state is a
+    handle of one episode's observations (:mod:`cartpole_q.rl.tiles`), so memory that keys
+    states across episodes (a model, per-state counts) has no meaning there"""
     key: str = field(default="", compare=False)
     """the name and a digest of the module's source: compiled code is cached under it, so
     an edited algorithm is compiled again (set when registered)"""

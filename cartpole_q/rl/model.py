@@ -18,7 +18,15 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.tabular import Memory, Rng, Table, best_value, compilable, update
+from cartpole_q.rl.tabular import (
+    Memory,
+    Rng,
+    Table,
+    action_count,
+    best_value,
+    compilable,
+    update,
+)
 
 PLANNING_STEPS = Param(
     "planning_steps", 10, "planning updates per real step (0: none)",
@@ -52,7 +60,7 @@ def plan_dyna_q(q: Table, model: Memory, steps: int, alpha: float, gamma: float,
     """``steps`` Q-learning updates on transitions drawn from the model (Dyna-Q)."""
     next_states, rewards, terminals = model[0], model[1], model[2]
     seen, taken, taken_count, counters = model[3], model[4], model[5], model[6]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     for _ in range(steps):
         state = seen[rng.integers(0, counters[0])]
         action = taken[state * n_actions + rng.integers(0, taken_count[state])]

@@ -59,23 +59,80 @@ def compilable(function: Function) -> Function:
     return function
 
 
+def tiles_variant(original: Callable[..., Any]) -> Callable[[Function], Function]:
+    """Mark the function below as ``original``'s version for tile-coded tables.
+
+    On tiles (``discretization.tilings > 1``) the engines compile every hook with each
+    compilable helper replaced by its tiles variant where it has one: ``value``, ``shift``
+    and the trace functions are the few that touch table entries, and everything written
+    on them (greedy actions, updates, expectations) works on tiles unchanged.
+    """
+
+    def register(function: Function) -> Function:
+        original.__tiled__ = function  # type: ignore[attr-defined]
+        return compilable(function)
+
+    return register
+
+
+@compilable
+def action_count(q: Table) -> int:
+    """How many actions the table has."""
+    n: int = q.shape[1]
+    return n
+
+
+@compilable
+def value(q: Table, state: int, action: int) -> float:
+    """``Q(state, action)``: the table's entry (a tile-coded table's sum over its tiles)."""
+    entry: float = q[state, action]
+    return entry
+
+
+@compilable
+def shift(q: Table, state: int, action: int, amount: float) -> None:
+    """``Q(state, action) = Q(state, action) + amount`` (tiles: each tile by ``amount / T``)."""
+    q[state, action] = q[state, action] + amount
+
+
+@compilable
+def feature_alpha(q: Table, alpha: float) -> float:
+    """The step size of one feature: ``alpha`` (tiles: ``alpha / T``)."""
+    return alpha
+
+
+@compilable
+def visit(visits: np.ndarray, q: Table, state: int, action: int) -> None:
+    """Count a visit of ``(state, action)`` (tiles: of each of its tiles)."""
+    visits[state, action] += 1
+
+
+@compilable
+def with_weights(q: Table, weights: Table) -> Table:
+    """Another table of ``q``'s shape addressed as ``q`` is (Double Q-learning's ``B``)."""
+    return weights
+
+
 @compilable
 def best_action(q: Table, state: int) -> int:
     """``argmax_a Q(state, a)``, the lowest action on ties."""
     best = 0
-    for action in range(1, q.shape[1]):
-        if q[state, action] > q[state, best]:
-            best = action
+    best_value_so_far = value(q, state, 0)
+    for action in range(1, action_count(q)):
+        entry = value(q, state, action)
+        if entry > best_value_so_far:
+            best, best_value_so_far = action, entry
     return best
 
 
 @compilable
 def best_value(q: Table, state: int) -> float:
     """``max_a Q(state, a)``."""
-    best = q[state, 0]
-    for action in range(1, q.shape[1]):
-        if q[state, action] > best:
-            best = q[state, action]
+    best = value(q, state, 0)
+    for action in range(1, action_count(q)):
+        entry = value(q, state, action)
+        if entry > best:
+            best = entry
     return float(best)
 
 
@@ -85,7 +142,7 @@ def epsilon_greedy(q: Table, state: int, epsilon: float, rng: Rng) -> int:
     if epsilon <= 0.0:
         return best_action(q, state)
     if epsilon >= 1.0 or rng.random() < epsilon:
-        return int(rng.integers(0, q.shape[1]))
+        return int(rng.integers(0, action_count(q)))
     return best_action(q, state)
 
 
@@ -98,14 +155,14 @@ def tied_best_action(q: Table, state: int, rng: Rng) -> int:
     """
     best = best_value(q, state)
     tied = 0
-    for action in range(q.shape[1]):
-        if q[state, action] == best:
+    for action in range(action_count(q)):
+        if value(q, state, action) == best:
             tied += 1
     if tied <= 1:
         return best_action(q, state)
     pick = int(rng.integers(0, tied))
-    for action in range(q.shape[1]):
-        if q[state, action] == best:
+    for action in range(action_count(q)):
+        if value(q, state, action) == best:
             if pick == 0:
                 return action
             pick -= 1
@@ -126,7 +183,7 @@ def behaviour_action(q: Table, params: Params, state: int, epsilon: float, rng: 
     the exploration draw); with ``lowest`` it is :func:`epsilon_greedy` exactly.
     """
     if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
-        return int(rng.integers(0, q.shape[1]))
+        return int(rng.integers(0, action_count(q)))
     if random_ties(params):
         return tied_best_action(q, state, rng)
     return best_action(q, state)
@@ -134,8 +191,8 @@ def behaviour_action(q: Table, params: Params, state: int, epsilon: float, rng: 
 
 @compilable
 def update(q: Table, state: int, action: int, target: float, alpha: float) -> None:
-    """``Q(s, a) += alpha * (target - Q(s, a))``."""
-    q[state, action] += alpha * (target - q[state, action])
+    """``Q(s, a) = Q(s, a) + alpha * (target - Q(s, a))`` (tiles: each tile by a T-th)."""
+    shift(q, state, action, alpha * (target - value(q, state, action)))
 
 
 @compilable
@@ -145,12 +202,12 @@ def expected_value(q: Table, state: int, epsilon: float) -> float:
     ``g`` is the greedy action of ``s``, ``S = Q(s, 0) + Q(s, 1) + ...`` summed in action
     order (Expected SARSA's and tree backup's expectation).
     """
-    n_actions = q.shape[1]
-    total = q[state, 0]
+    n_actions = action_count(q)
+    total = value(q, state, 0)
     for action in range(1, n_actions):
-        total += q[state, action]
+        total += value(q, state, action)
     greedy = best_action(q, state)
-    return float((1.0 - epsilon) * q[state, greedy] + (epsilon / n_actions) * total)
+    return float((1.0 - epsilon) * value(q, state, greedy) + (epsilon / n_actions) * total)
 
 
 @compilable

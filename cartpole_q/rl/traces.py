@@ -5,13 +5,15 @@ Five arrays of an algorithm's memory: ``values`` (each trace), ``states`` and ``
 by flat index ``state * n_actions + action``, ``-1`` without a trace) and ``count``. A step
 costs O(pairs with a trace), not O(table). A trace that decays to exactly 0.0 is dropped;
 the list keeps its order (which never changes a value: each pair is updated on its own).
-The contract: docs/algorithms.md, "Eligibility traces".
+On tiles (:mod:`cartpole_q.rl.tiles`) the traced pairs are (tile, action): a visit of
+``(s, a)`` gives each of ``s``'s tiles its trace, and a traced tile moves by ``alpha / T``
+times what a traced pair moves by. The contract: docs/algorithms.md, "Eligibility traces".
 
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> values, states, actions, slots, count = trace_memory(2, 2)
->>> give_trace(values, states, actions, slots, count, 1, 0, 0, 0.5, 2)
->>> give_trace(values, states, actions, slots, count, 1, 0, 0, 0.5, 2)  # accumulating
+>>> give_trace(q, values, states, actions, slots, count, 1, 0, 0, 0.5, 2)
+>>> give_trace(q, values, states, actions, slots, count, 1, 0, 0, 0.5, 2)  # accumulating
 >>> apply_and_decay(q, values, states, actions, slots, count, 0.5, 0.25)
 >>> float(q[1, 0]), float(values[0])
 (1.0, 0.5)
@@ -22,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.tabular import Table, compilable
+from cartpole_q.rl.tabular import Table, compilable, feature_alpha, tiles_variant
 
 TRACE_KINDS = ("accumulating", "replacing", "dutch")
 """``agent.trace`` values, in the order of their codes"""
@@ -56,18 +58,79 @@ def trace_slot(
 
 
 @compilable
-def give_trace(
-    values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
-    count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
-) -> None:  # fmt: skip
-    """Give ``(state, action)`` its trace: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
-    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
+def set_trace(values: np.ndarray, where: int, kind: int, alpha: float) -> None:
+    """The trace at ``where`` after a visit: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
     if kind == ACCUMULATING:
         values[where] = values[where] + 1.0
     elif kind == REPLACING:
         values[where] = 1.0
     else:
         values[where] = (1.0 - alpha) * values[where] + 1.0
+
+
+@compilable
+def give_trace(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
+) -> None:  # fmt: skip
+    """Give ``(state, action)`` its trace: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
+    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
+    set_trace(values, where, kind, alpha)
+
+
+@tiles_variant(give_trace)
+def give_tile_traces(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
+) -> None:  # fmt: skip
+    """Give each of the state's tiles its trace (dutch: with the tile's ``alpha / T``)."""
+    features = q[1]
+    tile_alpha = feature_alpha(q, alpha)
+    for t in range(features.shape[1]):
+        row = features[state, t]
+        where = trace_slot(values, states, actions, slots, count, row, action, n_actions)
+        set_trace(values, where, kind, tile_alpha)
+
+
+@compilable
+def grow_trace(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, amount: float, n_actions: int,
+) -> None:  # fmt: skip
+    """``z(state, action) = z + amount`` (a pair without a trace starts at 0.0)."""
+    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
+    values[where] = values[where] + amount
+
+
+@tiles_variant(grow_trace)
+def grow_tile_traces(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, state: int, action: int, amount: float, n_actions: int,
+) -> None:  # fmt: skip
+    """Each of the state's tiles ``z = z + amount``, in tiling order."""
+    features = q[1]
+    for t in range(features.shape[1]):
+        row = features[state, t]
+        where = trace_slot(values, states, actions, slots, count, row, action, n_actions)
+        values[where] = values[where] + amount
+
+
+@compilable
+def trace_dot(q: Table, slots: np.ndarray, values: np.ndarray, state: int, action: int) -> float:
+    """``z . x(state, action)``: the pair's trace (tiles: its tiles' traces summed)."""
+    return trace_value(slots, values, state * q.shape[1] + action)
+
+
+@tiles_variant(trace_dot)
+def tile_trace_dot(
+    q: Table, slots: np.ndarray, values: np.ndarray, state: int, action: int
+) -> float:  # fmt: skip
+    """The traces of the state's tiles for ``action``, summed in tiling order from 0.0."""
+    weights, features = q[0], q[1]
+    total = 0.0
+    for t in range(features.shape[1]):
+        total += trace_value(slots, values, features[state, t] * weights.shape[1] + action)
+    return total
 
 
 @compilable
@@ -103,6 +166,15 @@ def apply_and_decay(
         values[kept] = z
         kept += 1
     count[0] = kept
+
+
+@tiles_variant(apply_and_decay)
+def apply_tile_traces_and_decay(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
+    count: np.ndarray, scale: float, decay: float,
+) -> None:  # fmt: skip
+    """:func:`apply_and_decay` on the weights, each traced tile by ``(scale / T) * z``."""
+    apply_and_decay(q[0], values, states, actions, slots, count, scale / q[1].shape[1], decay)
 
 
 @compilable
@@ -146,6 +218,15 @@ def clear_traces(
     for read in range(count[0]):
         slots[states[read] * n_actions + actions[read]] = -1
     count[0] = 0
+
+
+@tiles_variant(apply_traces)
+def apply_tile_traces(
+    q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, count: np.ndarray,
+    scale: float,
+) -> None:  # fmt: skip
+    """:func:`apply_traces` on the weights, each traced tile by ``(scale / T) * z``."""
+    apply_traces(q[0], values, states, actions, count, scale / q[1].shape[1])
 
 
 def trace_memory(n_states: int, n_actions: int) -> tuple[np.ndarray, ...]:

@@ -26,20 +26,23 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     best_action,
     compilable,
     random_ties,
     update,
-)  # fmt: skip
+    value,
+    with_weights,
+)
 
 
 @compilable
 def best_action_of_sum(q_a: Table, q_b: Table, state: int) -> int:
     """``argmax_a (A(state, a) + B(state, a))``, the lowest action on ties."""
     best = 0
-    best_sum = q_a[state, 0] + q_b[state, 0]
-    for action in range(1, q_a.shape[1]):
-        total = q_a[state, action] + q_b[state, action]
+    best_sum = value(q_a, state, 0) + value(q_b, state, 0)
+    for action in range(1, action_count(q_a)):
+        total = value(q_a, state, action) + value(q_b, state, action)
         if total > best_sum:
             best, best_sum = action, total
     return best
@@ -49,16 +52,16 @@ def best_action_of_sum(q_a: Table, q_b: Table, state: int) -> int:
 def tied_best_action_of_sum(q_a: Table, q_b: Table, state: int, rng: Rng) -> int:
     """One of the actions with the largest ``A + B``, as ``tied_best_action`` picks on ``Q``."""
     best = best_action_of_sum(q_a, q_b, state)
-    best_sum = q_a[state, best] + q_b[state, best]
+    best_sum = value(q_a, state, best) + value(q_b, state, best)
     tied = 0
-    for action in range(q_a.shape[1]):
-        if q_a[state, action] + q_b[state, action] == best_sum:
+    for action in range(action_count(q_a)):
+        if value(q_a, state, action) + value(q_b, state, action) == best_sum:
             tied += 1
     if tied <= 1:
         return best
     pick = int(rng.integers(0, tied))
-    for action in range(q_a.shape[1]):
-        if q_a[state, action] + q_b[state, action] == best_sum:
+    for action in range(action_count(q_a)):
+        if value(q_a, state, action) + value(q_b, state, action) == best_sum:
             if pick == 0:
                 return action
             pick -= 1
@@ -71,7 +74,7 @@ def epsilon_greedy_on_sum(
 ) -> int:
     """Epsilon-greedy on ``A + B``, with the draws of ``behaviour_action``."""
     if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
-        return int(rng.integers(0, q_a.shape[1]))
+        return int(rng.integers(0, action_count(q_a)))
     if random_ties(params):
         return tied_best_action_of_sum(q_a, q_b, state, rng)
     return best_action_of_sum(q_a, q_b, state)
@@ -79,25 +82,25 @@ def epsilon_greedy_on_sum(
 
 def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng) -> int:
     """The first action: epsilon-greedy on ``A + B``."""
-    return epsilon_greedy_on_sum(q, memory[0], params, state, epsilon, rng)
+    return epsilon_greedy_on_sum(q, with_weights(q, memory[0]), params, state, epsilon, rng)
 
 
 def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
          next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
          epsilon: float, rng: Rng) -> int:  # fmt: skip
     """A coin picks the table to update; the other one values the updated one's choice."""
-    q_b = memory[0]
+    q_b = with_weights(q, memory[0])
     # Two explicit branches rather than swapped names: an array alias costs reference
     # counting on every step.
     if rng.random() < 0.5:
         target = reward
         if not terminated:
-            target = reward + gamma * q_b[next_state, best_action(q, next_state)]
+            target = reward + gamma * value(q_b, next_state, best_action(q, next_state))
         update(q, state, action, target, alpha)
     else:
         target = reward
         if not terminated:
-            target = reward + gamma * q[next_state, best_action(q_b, next_state)]
+            target = reward + gamma * value(q, next_state, best_action(q_b, next_state))
         update(q_b, state, action, target, alpha)
     if terminated or truncated:
         return ENDED

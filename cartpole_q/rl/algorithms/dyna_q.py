@@ -27,6 +27,7 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     behaviour_action,
     best_value,
     update,
@@ -41,7 +42,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     if not terminated:
         target = reward + gamma * best_value(q, next_state)
     update(q, state, action, target, alpha)
-    remember(memory, state, action, next_state, reward, terminated, q.shape[1])
+    remember(memory, state, action, next_state, reward, terminated, action_count(q))
     plan_dyna_q(q, memory, int(params[0]), alpha, gamma, rng)
     if terminated or truncated:
         return ENDED
@@ -57,6 +58,9 @@ ALGORITHM = Algorithm(
     name="dyna_q",
     description="Dyna-Q: Q-learning plus planning on a learned model (agent.planning_steps)",
     book="8.2",
+    not_on_tiles=(
+        "its model is a table over states, and a tiled observation is not one of a finite set of states"
+    ),
     step=step,
     params=(PLANNING_STEPS,),
     memory=dyna_memory,

@@ -30,6 +30,7 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     behaviour_action,
     best_value,
     compilable,
@@ -45,7 +46,7 @@ def plan_with_bonus(
     """``steps`` planning updates with the exploration bonus ``kappa * sqrt(tau)``."""
     next_states, rewards, terminals = model[0], model[1], model[2]
     seen, counters = model[3], model[6]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     time = counters[1]
     for _ in range(steps):
         state = seen[rng.integers(0, counters[0])]
@@ -66,7 +67,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
          next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
          epsilon: float, rng: Rng) -> int:  # fmt: skip
     """Count the step, learn from it, remember it, plan with bonuses, then draw."""
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     counters, last_tried = memory[6], memory[7]
     counters[1] += 1
     last_tried[state * n_actions + action] = counters[1]
@@ -93,6 +94,9 @@ ALGORITHM = Algorithm(
     name="dyna_q_plus",
     description="Dyna-Q+: Dyna-Q with a bonus for pairs not tried for long (agent.kappa)",
     book="8.3",
+    not_on_tiles=(
+        "its model is a table over states, and a tiled observation is not one of a finite set of states"
+    ),
     step=step,
     params=(PLANNING_STEPS, KAPPA),
     memory=dyna_plus_memory,

@@ -30,9 +30,12 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     behaviour_action,
     expected_value,
+    shift,
     update,
+    value,
 )
 
 UPDATES = ("sample_average", "constant_alpha")
@@ -45,7 +48,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """Record the step; at the episode's end, learn from its first visits backwards."""
     states, actions, rewards, counts, length = memory[0], memory[1], memory[2], memory[3], memory[4]
     first_visit = memory[5]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     t = length[0]
     states[t], actions[t], rewards[t] = state, action, reward
     flat = state * n_actions + action
@@ -64,9 +67,8 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         if first_visit[flat] == t:
             if averaging:
                 counts[flat] = counts[flat] + 1.0
-                q[states[t], actions[t]] = (
-                    q[states[t], actions[t]] + (target - q[states[t], actions[t]]) / counts[flat]
-                )
+                error = target - value(q, states[t], actions[t])
+                shift(q, states[t], actions[t], error / counts[flat])
             else:
                 update(q, states[t], actions[t], target, alpha)
     for t in range(length[0]):
@@ -98,6 +100,9 @@ ALGORITHM = Algorithm(
     name="monte_carlo",
     description="Monte Carlo control: on-policy, first-visit, epsilon-soft (agent.update)",
     book="5.4",
+    not_on_tiles=(
+        "its first-visit marks and sample averages count states, and a tiled observation is not one of a finite set of states"
+    ),
     step=step,
     params=(UPDATE,),
     memory=mc_memory,

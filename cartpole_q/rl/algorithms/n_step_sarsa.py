@@ -30,6 +30,7 @@ from cartpole_q.rl.tabular import (
     behaviour_action,
     compilable,
     update,
+    value,
 )
 
 
@@ -47,7 +48,7 @@ def settle_oldest(
     for i in range(1, pending):
         target = target + gamma ** float(i) * rewards[slot(counter, n, i)]
     if bootstrap:
-        target = target + gamma ** float(pending) * q[next_state, next_action]
+        target = target + gamma ** float(pending) * value(q, next_state, next_action)
     update(q, states[oldest], actions[oldest], target, alpha)
     drop_oldest(counter, n)
 

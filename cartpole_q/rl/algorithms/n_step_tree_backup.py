@@ -28,12 +28,14 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     behaviour_action,
     best_action,
     compilable,
     expected_value,
     policy_probability,
     update,
+    value,
 )
 
 
@@ -45,7 +47,7 @@ def settle_oldest(
 ) -> None:  # fmt: skip
     """Update the oldest pending step toward its tree-backup return, and remove it."""
     n = states.shape[0]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     pending = counter[1]
     target = rewards[slot(counter, n, pending - 1)]
     if not terminated:
@@ -57,8 +59,8 @@ def settle_oldest(
         others = 0.0
         for other in range(n_actions):
             if other != action:
-                others = (
-                    others + policy_probability(other, greedy, epsilon, n_actions) * q[state, other]
+                others = others + policy_probability(other, greedy, epsilon, n_actions) * value(
+                    q, state, other
                 )
         taken = policy_probability(action, greedy, epsilon, n_actions)
         target = rewards[slot(counter, n, m)] + gamma * (others + taken * target)

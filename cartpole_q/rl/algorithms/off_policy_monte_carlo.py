@@ -31,10 +31,13 @@ from cartpole_q.rl.tabular import (
     Params,
     Rng,
     Table,
+    action_count,
     behaviour_action,
     best_action,
     best_value,
     policy_probability,
+    shift,
+    value,
 )
 
 UPDATES = ("sample_average", "constant_alpha")
@@ -53,7 +56,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         memory[4],
     )
     behaviour = memory[5]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     t = length[0]
     states[t], actions[t], rewards[t] = state, action, reward
     behaviour[t] = policy_probability(action, best_action(q, state), epsilon, n_actions)
@@ -73,7 +76,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
             weights[flat] = weights[flat] + weight
         else:
             weights[flat] = (1.0 - alpha) * weights[flat] + weight
-        q[s, a] = q[s, a] + (weight / weights[flat]) * (target - q[s, a])
+        shift(q, s, a, (weight / weights[flat]) * (target - value(q, s, a)))
         if a != best_action(q, s):
             break
         weight = weight / behaviour[t]
@@ -104,6 +107,9 @@ ALGORITHM = Algorithm(
     name="off_policy_monte_carlo",
     description="Off-policy Monte Carlo control: weighted importance sampling, greedy target",
     book="5.7",
+    not_on_tiles=(
+        "its importance-sampling weights are summed per state, and a tiled observation is not one of a finite set of states"
+    ),
     step=step,
     params=(UPDATE,),
     memory=off_policy_memory,

@@ -15,7 +15,16 @@ is, first (also at truncation, where ``a'`` is not played; not when terminated);
 from __future__ import annotations
 
 from cartpole_q.rl.algorithm import Algorithm
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action, update
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    behaviour_action,
+    update,
+    value,
+)
 
 
 def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
@@ -26,7 +35,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     next_action = ENDED
     if not terminated:
         next_action = behaviour_action(q, params, next_state, epsilon, rng)
-        target = reward + gamma * q[next_state, next_action]
+        target = reward + gamma * value(q, next_state, next_action)
     update(q, state, action, target, alpha)
     if terminated or truncated:
         return ENDED

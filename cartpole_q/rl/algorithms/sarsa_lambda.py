@@ -22,7 +22,16 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    action_count,
+    behaviour_action,
+    value,
+)
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
@@ -40,14 +49,14 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """Draw ``a'``, give ``(s, a)`` its trace, move every traced pair, decay the traces."""
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     decay, kind = gamma * params[0], int(params[1])
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     next_action = ENDED
     target = reward
     if not terminated:
         next_action = behaviour_action(q, params, next_state, epsilon, rng)
-        target = reward + gamma * q[next_state, next_action]
-    delta = target - q[state, action]
-    give_trace(values, states, actions, slots, count, state, action, kind, alpha, n_actions)
+        target = reward + gamma * value(q, next_state, next_action)
+    delta = target - value(q, state, action)
+    give_trace(q, values, states, actions, slots, count, state, action, kind, alpha, n_actions)
     if terminated or truncated:
         apply_traces(q, values, states, actions, count, alpha * delta)
         clear_traces(states, actions, slots, count, n_actions)

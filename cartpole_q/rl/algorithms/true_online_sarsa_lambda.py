@@ -21,15 +21,26 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    action_count,
+    behaviour_action,
+    feature_alpha,
+    shift,
+    value,
+)
 from cartpole_q.rl.traces import (
     LAMBDA,
     apply_traces,
     clear_traces,
     decay_traces,
+    grow_trace,
+    trace_dot,
     trace_memory,
-    trace_slot,
-    trace_value,
 )
 
 
@@ -40,21 +51,21 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     q_old_cell = memory[5]
     lam = params[0]
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     next_action = ENDED
     q_next = 0.0
     if not terminated:
         next_action = behaviour_action(q, params, next_state, epsilon, rng)
-        q_next = q[next_state, next_action]
-    q_sa = q[state, action]
+        q_next = value(q, next_state, next_action)
+    q_sa = value(q, state, action)
     q_old = q_old_cell[0]
     delta = reward + gamma * q_next - q_sa
-    z_sa = trace_value(slots, values, state * n_actions + action)
+    z_sa = trace_dot(q, slots, values, state, action)
     decay_traces(values, states, actions, slots, count, gamma * lam, n_actions)
-    where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
-    values[where] = values[where] + (1.0 - alpha * gamma * lam * z_sa)
+    grow = 1.0 - feature_alpha(q, alpha) * gamma * lam * z_sa
+    grow_trace(q, values, states, actions, slots, count, state, action, grow, n_actions)
     apply_traces(q, values, states, actions, count, alpha * (delta + q_sa - q_old))
-    q[state, action] = q[state, action] - alpha * (q_sa - q_old)
+    shift(q, state, action, -(alpha * (q_sa - q_old)))
     q_old_cell[0] = q_next
     if terminated or truncated:
         clear_traces(states, actions, slots, count, n_actions)

@@ -22,7 +22,17 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, behaviour_action, best_value
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rng,
+    Table,
+    action_count,
+    behaviour_action,
+    best_value,
+    value,
+)
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
@@ -40,12 +50,12 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """Move every traced pair toward the greedy target; draw; decay or cut the traces."""
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     decay, kind = gamma * params[0], int(params[1])
-    n_actions = q.shape[1]
+    n_actions = action_count(q)
     target = reward
     if not terminated:
         target = reward + gamma * best_value(q, next_state)
-    delta = target - q[state, action]
-    give_trace(values, states, actions, slots, count, state, action, kind, alpha, n_actions)
+    delta = target - value(q, state, action)
+    give_trace(q, values, states, actions, slots, count, state, action, kind, alpha, n_actions)
     if terminated or truncated:
         apply_traces(q, values, states, actions, count, alpha * delta)
         clear_traces(states, actions, slots, count, n_actions)
@@ -53,7 +63,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     # Decayed in the same pass; cleared below instead when the next action explores.
     apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
     next_action = behaviour_action(q, params, next_state, epsilon, rng)
-    if q[next_state, next_action] != best_value(q, next_state):
+    if value(q, next_state, next_action) != best_value(q, next_state):
         clear_traces(states, actions, slots, count, n_actions)
     return next_action
 
