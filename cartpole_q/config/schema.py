@@ -25,6 +25,7 @@ import yaml
 from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
 from cartpole_q.rl.tabular import TIE_BREAKS
+from cartpole_q.rl.tiles import tile_shape
 
 ENGINES = ("auto", "numba", "gymnasium")
 """``engine`` values"""
@@ -242,6 +243,15 @@ class DiscretizationConfig:
             high=64,
         )
     )
+
+    @property
+    def table_shape(self) -> tuple[int, ...]:
+        """The Q-table's shape without the action axis: the bins, or on tiles ``(T, *sizes)``.
+
+        >>> DiscretizationConfig((1, 6), (0.0, 0.0), (1.0, 1.0), tilings=4).table_shape
+        (4, 1, 7)
+        """
+        return tile_shape(self.bins, self.tilings) if self.tilings > 1 else self.bins
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,6 @@ from typing import Any
 
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
 from cartpole_q.profiles import profile_for
-from cartpole_q.rl.tiles import tile_shape
 
 SOLVE_WINDOW = 100
 """episodes in the moving average of training returns compared with the reward threshold"""
@@ -203,9 +202,8 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
                 "and high one entry per dimension."
             )
         field = "discretization.bins"
-        if config.discretization.tilings > 1:
-            # The weights of T tilings, each bins + 1 tiles wide (see cartpole_q.rl.tiles).
-            state_shape = tile_shape(state_shape, config.discretization.tilings)
+        # On tiles: the weights of T tilings, each bins + 1 tiles wide (cartpole_q.rl.tiles).
+        state_shape = config.discretization.table_shape
     else:
         raise ConfigError(
             f"{blame(source, 'env.id')}: env.id: {env_id!r} has observation space {observation_space}; "

@@ -292,7 +292,9 @@ def load_run(path: str | Path) -> Run:
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
     q_table = load_array(path / Q_TABLE_FILE, np.float64)
     grid = config.discretization
-    check_q_table(q_table, None if grid is None else grid.bins, None, str(path / Q_TABLE_FILE))
+    check_q_table(
+        q_table, None if grid is None else grid.table_shape, None, str(path / Q_TABLE_FILE)
+    )
     visits = None
     if (path / VISITS_FILE).is_file():
         visits = load_array(path / VISITS_FILE, np.int64)
