@@ -922,8 +922,10 @@ def reference_train(
     env_seed = int(env_seq.generate_state(1, dtype=np.uint32)[0])
 
     tilings = int((discretization or {}).get("tilings", 1))  # type: ignore[call-overload]
+    # docs/algorithms.md, "Tile coding": every weight starts at q_init / T.
+    weight_init = float(q_init) / tilings if tilings > 1 else float(q_init)
     agent = ALGORITHMS[algorithm](
-        n_states, n, float(q_init), float(gamma), rng,
+        n_states, n, weight_init, float(gamma), rng,
         {**PARAMETER_DEFAULTS, **(params or {}), "tilings": tilings},
     )  # fmt: skip
     if isinstance(agent, MonteCarlo):

@@ -210,16 +210,19 @@ class TrainingState:
         """Allocate the state of a run that has not started."""
         n_states = math.prod(env_info.state_shape)
         algorithm = get_algorithm(config.agent.algorithm)
+        # On tiles every weight starts at q_init / T, so that every Q(s, a) starts near q_init.
+        tilings = config.discretization.tilings if config.discretization is not None else 1
+        q_init = config.agent.q_init / tilings if tilings > 1 else config.agent.q_init
         context = MemoryContext(
             n_states=n_states,
             n_actions=env_info.n_actions,
-            q_init=config.agent.q_init,
+            q_init=q_init,
             params=dict(config.agent.params),
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
         )
         return cls(
             tables=Tables(
-                q=np.full((n_states, env_info.n_actions), config.agent.q_init, dtype=np.float64),
+                q=np.full((n_states, env_info.n_actions), q_init, dtype=np.float64),
                 visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
                 memory=tuple(algorithm.memory(context)),
             ),
