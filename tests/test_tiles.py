@@ -7,16 +7,19 @@ The byte-exact contract (every algorithm on tiles, both engines) is re-derived i
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from PIL import Image
 
 from cartpole_q import load_config, train
 from cartpole_q.errors import ConfigError
 from cartpole_q.evaluation import evaluate
-from cartpole_q.rl.tiles import active_tiles, tile_shape
+from cartpole_q.rl.tiles import active_tiles, tile_shape, values_on_grid
+from tests.conftest import invoke
 
 BINS = st.lists(st.integers(1, 7), min_size=1, max_size=4)
 
@@ -100,3 +103,21 @@ def test_the_shipped_tile_configs_learn(name: str, seed: int, at_least: float) -
     result = train(load_config(name).for_seed(seed))
     assert result.eval is not None
     assert result.eval.mean >= at_least
+
+
+def test_plot_policy_of_a_tiled_run_draws_the_tiles_sums(tmp_path: Path) -> None:
+    """The policy map of tiles: the tiles' sums on the tilings' fine grid (values_on_grid)."""
+    run = tmp_path / "run"
+    trained = invoke(
+        "train", "-c", "mountaincar_tiles", "--set", "train.episodes=30", "--out", run, "-q"
+    )
+    assert trained.exit_code == 0, trained.output
+    out = tmp_path / "policy.png"
+    drawn = invoke("plot", run, "--policy", "--out", out)
+    assert drawn.exit_code == 0, drawn.output
+    assert Image.open(out).size[0] > 1000
+    weights = np.load(run / "q_table.npy")
+    grid = values_on_grid(weights, [12, 12], [-1.2, -0.07], [0.6, 0.07], (0, 1), (3, 2))
+    rows = np.zeros(16, dtype=np.int64)
+    active_tiles([-1.2 + 1.5 * 0.6, 0.07 * 0.5], [-1.2, -0.07], [0.6, 0.07], [12, 12], 16, rows)
+    assert np.allclose(grid[1, 1], weights.reshape(-1, 3)[rows].sum(axis=0))

@@ -35,6 +35,7 @@ from cartpole_q.figures import (
 )
 from cartpole_q.learning_curves import METRIC_LABELS, X_LABELS, aggregate_band, seed_curves
 from cartpole_q.profiles import profile_for
+from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
 from cartpole_q.store.runsets import load_run_set
@@ -287,9 +288,23 @@ def plot_policy(
     bins = grid.bins
     dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    names = dimension_names(env_id, len(bins))
+    low, high = grid.low, grid.high
+    if grid.tilings > 1:
+        # A tiled table has no state per cell: draw the tiles' sums on the fine grid the
+        # tilings make (T cells per bin, at most 120), the other dimensions at their centre.
+        cells = (min(120, bins[dims[0]] * grid.tilings), min(120, bins[dims[1]] * grid.tilings))
+        grids = [values_on_grid(r.q_table, bins, low, high, dims, cells) for r in runs]
+        q_table = grids[0]
+        if len(grids) > 1:  # the seeds' votes, on the grid (a tile's weights are no state)
+            n_actions = q_table.shape[-1]
+            q_table = sum(np.eye(n_actions)[np.argmax(g, axis=-1)] for g in grids) / len(grids)
+        visits = None
+        low, high = (low[dims[0]], low[dims[1]]), (high[dims[0]], high[dims[1]])
+        names, dims = [names[dims[0]], names[dims[1]]], (0, 1)
+        title += f" ({grid.tilings} tilings; other dimensions at their centre)"
     figure = policy_figure(
-        q_table, visits, dims, grid.low, grid.high,
-        dimension_names(env_id, len(bins)), title,
+        q_table, visits, dims, low, high, names, title,
         action_names=action_names(env_id, q_table.shape[-1]), value_name=value_name,
     )  # fmt: skip
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))

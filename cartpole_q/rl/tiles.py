@@ -151,3 +151,48 @@ def tiled_visit(visits: np.ndarray, q: Any, state: int, action: int) -> None:
 def tiled_with_weights(q: Any, weights: Table) -> Any:
     """Other weights addressed through ``q``'s features."""
     return (weights, q[1])
+
+
+def values_on_grid(
+    weights: np.ndarray,
+    bins: Sequence[int],
+    low: Sequence[float],
+    high: Sequence[float],
+    dims: tuple[int, int],
+    cells: tuple[int, int],
+) -> np.ndarray:
+    """``Q`` of a tiled table at the centres of a ``cells`` grid over two dimensions.
+
+    The other dimensions sit at the centre of their range. For pictures (the policy map
+    and the value surface of a tiled table): the tiles' sums as greedy play computes them.
+
+    Args:
+        weights: ``q_table.npy`` of a tiled run, ``(T, *sizes, n_actions)``.
+        bins: ``discretization.bins``.
+        low: ``discretization.low``.
+        high: ``discretization.high``.
+        dims: the two dimensions drawn (rows, columns).
+        cells: how many cells along each.
+
+    Returns:
+        ``(cells[0], cells[1], n_actions)`` values.
+
+    >>> w = np.zeros((2, 3, 3, 2)); w[:, 1:, :, 1] = 1.0   # tiles from coord 1 up: 1 each
+    >>> values_on_grid(w, [2, 2], [0, 0], [1, 1], (0, 1), (2, 1))[:, 0, 1].tolist()
+    [1.0, 2.0]
+
+    (At 0.25 only the shifted tiling has reached its coordinate 1; at 0.75 both have.)
+    """
+    tilings, n_actions = weights.shape[0], weights.shape[-1]
+    flat = weights.reshape(-1, n_actions)
+    centre = [(lo + hi) / 2 for lo, hi in zip(low, high, strict=True)]
+    rows = np.zeros(tilings, dtype=np.int64)
+    out = np.zeros((*cells, n_actions), dtype=np.float64)
+    point = list(centre)
+    for i in range(cells[0]):
+        point[dims[0]] = low[dims[0]] + (i + 0.5) / cells[0] * (high[dims[0]] - low[dims[0]])
+        for j in range(cells[1]):
+            point[dims[1]] = low[dims[1]] + (j + 0.5) / cells[1] * (high[dims[1]] - low[dims[1]])
+            active_tiles(point, low, high, bins, tilings, rows)
+            out[i, j] = flat[rows].sum(axis=0)
+    return out
