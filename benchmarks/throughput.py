@@ -190,7 +190,7 @@ TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
            ("Taxi-v4 (taxi)", "taxi", 5_000))  # fmt: skip
 """the tabular worlds' rows: label, shipped config, its episodes (the whole training)"""
 
-SECTIONS = ("cartpole", "algorithms", "environments", "tabular", "progress")
+SECTIONS = ("cartpole", "algorithms", "environments", "tabular", "tiles", "progress")
 """what --only can pick; by default every section runs, in this order"""
 
 
@@ -309,6 +309,38 @@ def tabular_rows(repeats: int, scale: float) -> None:
         )
 
 
+TILINGS = (1, 2, 4, 8, 16)
+"""the tiles section's tiling counts (1: the plain grid, the baseline)"""
+
+
+def tile_rows(repeats: int, scale: float) -> None:
+    """MountainCar with the shipped mountaincar_tiles (SARSA(lambda)) at each tiling count.
+
+    Each step sums and updates ``T`` weights per action and traces ``T`` tiles, so a step
+    costs more with more tilings; the rates are against one tiling in the same run, and
+    the gymnasium engine's rate at 8 tilings gives the twin's ratio.
+    """
+    print(f"{'mountaincar_tiles, tilings (numba)':40s} {'env steps/s':>14s} {'vs 1 tiling':>12s}")
+    episodes = max(50, int(300 * scale))
+    baseline = None
+    for tilings in TILINGS:
+        mapping = load_config("mountaincar_tiles", {"discretization.tilings": tilings}).to_dict()
+        engine_rate(mapping, "numba", 2, 0)  # compile or load the cache
+        rate = median_rate(lambda c=mapping: engine_rate(c, "numba", episodes, 0), max(5, repeats))
+        baseline = baseline or rate
+        print(f"{f'T = {tilings}':40s} {rate:14,.0f} {rate / baseline:11.0%}")
+    config = load_config("mountaincar_tiles", {"discretization.tilings": 8}).to_dict()
+    engine_rate(config, "gymnasium", 1, 0)
+    gym_rate = median_rate(
+        lambda: engine_rate(config, "gymnasium", max(5, episodes // 20), 0), repeats
+    )
+    numba_rate = median_rate(lambda: engine_rate(config, "numba", episodes, 0), max(5, repeats))
+    print(
+        f"{'T = 8: gymnasium engine / numba':40s} {gym_rate:14,.0f} / {numba_rate:,.0f} "
+        f"= {numba_rate / gym_rate:,.0f}x"
+    )
+
+
 def progress_row(repeats: int, python_episodes: int) -> None:
     """The progress bar's cost, measured as interleaved pairs so machine drift cancels out."""
     engine_rate(None, "gymnasium", 2, 0)
@@ -354,6 +386,8 @@ def main() -> None:
             environment_rows(args.repeats, scale)
         elif section == "tabular":
             tabular_rows(args.repeats, scale)
+        elif section == "tiles":
+            tile_rows(args.repeats, scale)
         else:
             progress_row(args.repeats, python_episodes)
 

@@ -191,6 +191,32 @@ def metric_curve_figure(
     return figure
 
 
+def summary_line_figure(
+    lines: Sequence[tuple[str, Sequence[float], np.ndarray, np.ndarray, np.ndarray]],
+    x_label: str,
+    y_label: str,
+    title: str,
+    log_y: bool = False,
+) -> Figure:
+    """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
+
+    Each line is ``(label, xs, centre, low, high)``.
+    """
+    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    for (label, xs, centre, low, high), colour in zip(lines, _colours(len(lines)), strict=True):
+        axes.fill_between(xs, low, high, color=colour, alpha=0.25, linewidth=0)
+        axes.plot(xs, centre, color=colour, linewidth=1.8, marker="o", markersize=3, label=label)
+    if log_y:
+        axes.set_yscale("log")
+    axes.set_xlabel(x_label)
+    axes.set_ylabel(y_label)
+    axes.set_title(title, fontsize="medium")
+    axes.grid(alpha=0.3)
+    axes.legend(loc="best", fontsize="small")
+    return figure
+
+
 def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
     bands = sum(isinstance(item, SeedBand) for item in curves)
     average = f"{SOLVE_WINDOW}-episode average"

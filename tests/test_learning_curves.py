@@ -178,6 +178,8 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "smooth": 0}, "figure.smooth: must be at least 1"),
         ({"metric": "length", "file": "../f.png"}, "figure.file"),
         ([1], "figure: must be a mapping"),
+        ({"metric": "length", "against": "agent.gamma"}, "figure.against: 'agent.gamma' is not"),
+        ({"metric": "length", "against": "agent.alpha", "first": 0}, "figure.first: must be"),
     ],
 )
 def test_a_bad_figure_section_is_refused_before_anything_runs(
@@ -197,3 +199,38 @@ def test_x_max_ends_the_grid_where_the_book_does() -> None:
     assert episodes.x.tolist() == [1.0, 2.0] and episodes.values.shape == (1, 2)
     longer = seed_curves(returns, lengths, "return", "episode", x_max=5)
     assert np.isnan(longer.values[0][3:]).all()
+
+
+def test_a_figure_against_an_axis_draws_each_points_mean_over_its_first_episodes(
+    in_tmp: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """S&B Fig. 12.10's shape: per point, the seeds' mean over the first episodes."""
+    figure = {"metric": "length", "against": "agent.alpha", "first": 5, "file": "fig.svg"}
+    result = invoke(
+        "sweep", _sweep_file(in_tmp / "s.yaml", figure), "--out", "sw", "--workers", "1", "-q"
+    )
+    assert result.exit_code == 0, result.output
+    svg = Path("sw/fig.svg").read_text()
+    assert "steps per episode, mean over the first 5 episodes" in svg
+    # the plotted y values are the seeds' means of their first 5 lengths
+    from cartpole_q.experiments.sweep import plot_against
+    from cartpole_q.experiments.sweep_spec import load_sweep
+
+    spec = load_sweep(Path("sw/sweep.yaml"))
+    points = [Path("sw/points") / spec.point_id(p.index) for p in spec.points]
+    drawn = {}
+
+    def capture(lines, *args, **kwargs):  # type: ignore[no-untyped-def]
+        drawn.update({label: (list(xs), centre.tolist()) for label, xs, centre, _, _ in lines})
+        from cartpole_q.figures import summary_line_figure
+
+        return summary_line_figure(lines, *args, **kwargs)
+
+    import cartpole_q.experiments.sweep as sweep_module
+
+    monkeypatch.setattr(sweep_module, "summary_line_figure", capture)
+    plot_against(spec, points, in_tmp / "again.png")
+    curves = np.load(points[1] / "curves.npz")
+    expected = np.mean([curves[f"seed-{s:03d}.lengths"][:5].mean() for s in (0, 1, 2)])
+    ((xs, centre),) = drawn.values()
+    assert xs == [0.1, 0.5] and centre[1] == pytest.approx(expected)

@@ -31,9 +31,13 @@ from cartpole_q.errors import RunError
 from cartpole_q.experiments.plots import CurveStyle, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
+from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, summary_line_figure
+from cartpole_q.learning_curves import METRIC_LABELS, aggregate_band, per_episode
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
+from cartpole_q.store.atomic import atomic_write_bytes
+from cartpole_q.store.runsets import load_run_set
 from cartpole_q.store.sweepdir import PointRow, ResultRow, axis_cell
 from cartpole_q.store.tensorboard import TENSORBOARD_DIR
 
@@ -330,10 +334,56 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
         labels, figure.title, figure.y_label, figure.offset, figure.scale, reference, figure.x_max
     )
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
+    if figure.against is not None:
+        return plot_against(spec, paths, directory / figure.file)
     return plot_metric(
         paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
         figure.smooth, figure.log_y, force=True, style=style,
     )  # fmt: skip
+
+
+def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
+    """The ``figure.against`` figure: each point's per-episode mean against an axis.
+
+    A seed's value is the mean of the metric over its first ``figure.first`` episodes (after
+    ``(value + offset) * scale``); a point's is the mean over seeds, with a 95% bootstrap
+    interval; points that share the other axes' values form one line, ordered by the axis.
+    """
+    figure = spec.figure
+    assert figure is not None and figure.against is not None
+    groups: dict[str, list[tuple[float, np.ndarray]]] = {}
+    for point, path in zip(spec.points, paths, strict=True):
+        runs = load_run_set(path).runs
+        per_seed = []
+        for run in runs:
+            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric)
+            values = values[: figure.first] if figure.first is not None else values
+            per_seed.append((float(np.mean(values)) + figure.offset) * figure.scale)
+        others = ", ".join(
+            f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}"
+            for key, value in point.values.items()
+            if key != figure.against
+        )
+        groups.setdefault(others or spec.name, []).append(
+            (float(point.values[figure.against]), np.array(per_seed)[:, None])
+        )
+    lines = []
+    rng = np.random.default_rng(0)
+    for label, members in groups.items():
+        members.sort(key=lambda member: member[0])
+        bands = [aggregate_band(values, "mean", rng) for _, values in members]
+        lines.append((
+            label, [x for x, _ in members], np.array([b[0][0] for b in bands]),
+            np.array([b[1][0] for b in bands]), np.array([b[2][0] for b in bands]),
+        ))  # fmt: skip
+    first = f"first {figure.first} episodes" if figure.first is not None else "all episodes"
+    y_label = figure.y_label or f"{METRIC_LABELS[figure.metric]}, mean over the {first}"
+    title = figure.title or spec.name
+    drawn = summary_line_figure(
+        lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y
+    )
+    atomic_write_bytes(out, figure_bytes(drawn, FIGURE_FORMATS[out.suffix.lower()]))
+    return out
 
 
 def plan_tasks(

@@ -52,7 +52,7 @@ class Point:
 
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "title", "y_label", "offset", "scale",
-    "reference", "reference_label", "x_max", "file",
+    "reference", "reference_label", "x_max", "file", "against", "first",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -81,6 +81,12 @@ class FigureSpec:
     """where the x axis ends: the book's last step or episode (default: the longest seed's)"""
     file: str = "figure.png"
     """written in the sweep directory: ``.png``, ``.svg`` or ``.pdf``"""
+    against: str | None = None
+    """an axis key: draw each point's mean of the metric per episode (over its ``first``
+    episodes) against this axis's values, one line per value of the other axes, with a 95%
+    bootstrap interval over seeds (S&B Fig. 12.10); ``None``: learning curves"""
+    first: int | None = None
+    """with ``against``: the episodes averaged (default: all)"""
 
     def to_dict(self) -> dict[str, Any]:
         """The section as the resolved ``sweep.yaml`` holds it (every key)."""
@@ -198,7 +204,22 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
     figure = _figure(raw.get("figure"), curves, where)
+    if figure is not None and figure.against is not None:
+        _check_against(figure.against, {**grid, **zipped}, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
+
+
+def _check_against(key: str, axes: Mapping[str, list[Any]], where: str) -> None:
+    """``figure.against`` names an axis of numbers."""
+    if key not in axes:
+        raise ConfigError(
+            f"{where}: figure.against: {key!r} is not an axis of this sweep "
+            f"({', '.join(axes) or 'it has none'})."
+        )
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axes[key]):
+        raise ConfigError(
+            f"{where}: figure.against: the axis {key} must hold numbers to be drawn against."
+        )
 
 
 def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
@@ -232,6 +253,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "smooth": (int,), "log_y": (bool,), "title": (str,), "y_label": (str,),
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
+        "against": (str,), "first": (int,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)
@@ -249,6 +271,8 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             f"{where}: figure.file: {file!r} must be a file name in the sweep directory "
             "ending in .png, .svg or .pdf."
         )
+    if values.get("first") is not None and values["first"] < 1:
+        raise ConfigError(f"{where}: figure.first: must be at least 1, got {values['first']}.")
     if values.get("x_max") is not None and values["x_max"] <= 0:
         raise ConfigError(f"{where}: figure.x_max: must be positive, got {values['x_max']}.")
     for key in ("offset", "scale", "reference", "x_max"):
