@@ -517,7 +517,8 @@ def _wait_for(path: Path, process: subprocess.Popen[bytes], tmp_path: Path) -> N
 
 @pytest.mark.slow
 def test_a_second_writer_is_refused_naming_the_holders_pid(tmp_path: Path) -> None:
-    path = write_yaml(tmp_path / "slow.yaml", {**SLOW, "seeds": "0-11"})
+    # Long enough to outlast the second writer's patience (store/lock.py waits 2 s).
+    path = write_yaml(tmp_path / "slow.yaml", {**SLOW, "seeds": "0-59"})
     directory = tmp_path / "locked"
     process = _start_sweep(tmp_path, path, "--out", directory, "--workers", 1, "-q")
     try:
@@ -534,7 +535,7 @@ def test_a_second_writer_is_refused_naming_the_holders_pid(tmp_path: Path) -> No
     # kill -9 released the lock: the sweep resumes
     result = invoke("sweep", "--resume", directory, "--workers", 2, "-q")
     assert result.exit_code == 0, result.output
-    assert len(_results(directory)) == 12
+    assert len(_results(directory)) == 60
 
 
 @pytest.mark.slow
