@@ -90,6 +90,15 @@ def tile_handle(q: Any, previous: int) -> int:
 
 
 @compilable
+def tile_state(q: Any, observation: Any, low: Any, high: Any, bins: Any, previous: int) -> int:
+    """Write the observation's tiles at the handle after ``previous``; return that handle."""
+    handle = tile_handle(q, previous)
+    features = q[1]
+    active_tiles(observation, low, high, bins, features.shape[1], features[handle])
+    return handle
+
+
+@compilable
 def binned_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
     """A Box observation's row (``q`` and ``previous`` are for the tiles rule)."""
     return binned_row(observation, grid)
@@ -110,10 +119,7 @@ def tuple_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
 @compilable
 def tiled_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
     """A Box observation on tiles: its tiles written at the next handle, which it returns."""
-    handle = tile_handle(q, previous)
-    features = q[1]
-    active_tiles(observation, grid.low, grid.high, grid.bins, features.shape[1], features[handle])
-    return handle
+    return tile_state(q, observation, grid.low, grid.high, grid.bins, previous)
 
 
 STATE_RULES = {"box": binned_state, "discrete": discrete_state, "tuple": tuple_state,
@@ -143,10 +149,7 @@ def tiled_array_state(
     q: Any, observation: Any, low: Any, high: Any, bins: Any, starts: Any, previous: int
 ) -> int:
     """A twin's Box observation on tiles: its tiles at the next handle, which it returns."""
-    handle = tile_handle(q, previous)
-    features = q[1]
-    active_tiles(observation, low, high, bins, features.shape[1], features[handle])
-    return handle
+    return tile_state(q, observation, low, high, bins, previous)
 
 
 ARRAY_STATE_RULES = {"box": binned_array_state, "discrete": indexed_array_state,

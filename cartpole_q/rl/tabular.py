@@ -10,6 +10,11 @@ taking row views: a view costs two atomic reference-count updates in compiled co
 numba's ``np.max`` of a two-entry row costs more than a whole CartPole step. Every argmax is
 the lowest action among the maxima, as ``np.argmax``.
 
+The algorithms read and change entries only through :func:`value`, :func:`shift` (and
+:func:`update`, written on them), :func:`action_count` and the trace functions: on tile
+coding (:mod:`cartpole_q.rl.tiles`) the engines compile them with tiles variants of those
+few, and every algorithm runs on tiles unchanged.
+
 Epsilon-greedy, stated precisely: at ``epsilon <= 0`` greedy, nothing drawn; at
 ``epsilon >= 1`` ``rng.integers(0, n_actions)``; otherwise ``rng.random() < epsilon``
 decides, then ``rng.integers(0, n_actions)`` when exploring.
