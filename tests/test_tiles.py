@@ -121,3 +121,12 @@ def test_plot_policy_of_a_tiled_run_draws_the_tiles_sums(tmp_path: Path) -> None
     rows = np.zeros(16, dtype=np.int64)
     active_tiles([-1.2 + 1.5 * 0.6, 0.07 * 0.5], [-1.2, -0.07], [0.6, 0.07], [12, 12], 16, rows)
     assert np.allclose(grid[1, 1], weights.reshape(-1, 3)[rows].sum(axis=0))
+
+
+def test_on_tiles_alpha_may_reach_the_number_of_tilings() -> None:
+    """A tile's step is alpha / T: on tiles agent.alpha goes up to T (S&B's alpha x T)."""
+    assert load_config("mountaincar_tiles", {"agent.alpha": 16}).agent.alpha.start == 16.0
+    with pytest.raises(ConfigError, match=r"agent.alpha: must be in \(0, 16\], got 16.5"):
+        load_config("mountaincar_tiles", {"agent.alpha": 16.5})
+    with pytest.raises(ConfigError, match=r"agent.alpha: must be in \(0, 1\], got 1.5"):
+        load_config("mountaincar", {"agent.alpha": 1.5})

@@ -36,6 +36,7 @@ from cartpole_q.config.schema import (
     key_of,
 )
 from cartpole_q.errors import ConfigError
+from cartpole_q.learning_curves import INFO_KEY_PATTERN
 from cartpole_q.profiles import Physics, PhysicsRange, all_profiles, profile_for
 from cartpole_q.rl.algorithm import Param, ParamValue
 from cartpole_q.rl.algorithms import get as get_algorithm
@@ -72,8 +73,12 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     # The grid is checked before the other keys: a config with several mistakes has always
     # been told about the grid's first.
     discretization = _discretization(reader)
-    agent = AgentConfig(**reader.fields(AgentConfig, "agent."), params=_algorithm_params(reader))
-    if discretization is not None and discretization.tilings > 1:
+    tilings = discretization.tilings if discretization is not None else 1
+    agent = AgentConfig(
+        **reader.fields(AgentConfig, "agent.", ranges=_tile_ranges(tilings)),
+        params=_algorithm_params(reader),
+    )
+    if tilings > 1:
         _check_on_tiles(reader, agent.algorithm)
     return Config(
         name=name,
@@ -108,6 +113,14 @@ def _discretization(reader: _Reader) -> DiscretizationConfig | None:
                 f"entry {d} ({lo}) must be below discretization.high entry {d} ({hi}).",
             )
     return grid
+
+
+def _tile_ranges(tilings: int) -> dict[str, Key]:
+    """On tiles ``agent.alpha`` is Q's step, up to ``T``: a tile's step ``alpha / T`` <= 1."""
+    if tilings == 1:
+        return {}
+    alpha = next(item for item in dataclasses.fields(AgentConfig) if item.name == "alpha")
+    return {"alpha": dataclasses.replace(key_of(alpha), high=float(tilings))}
 
 
 def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
@@ -232,16 +245,22 @@ class _Reader:
         return (self.raw[section] if section else self.raw)[key]
 
     def fields(
-        self, record: type, prefix: str, *, only: tuple[str, ...] = (), skip: tuple[str, ...] = ()
+        self,
+        record: type,
+        prefix: str,
+        *,
+        only: tuple[str, ...] = (),
+        skip: tuple[str, ...] = (),
+        ranges: Mapping[str, Key] | None = None,
     ) -> dict[str, Any]:
         """Read a record's fields in declaration order (or ``only`` some), but ``skip``.
 
         The kinds a rule above reads (sections, physics, the algorithm's own keys) are left
-        to the rule.
+        to the rule. ``ranges`` replaces some fields' keys (a range another key widens).
         """
         values: dict[str, Any] = {}
         for item in dataclasses.fields(record):
-            key = key_of(item)
+            key = (ranges or {}).get(item.name) or key_of(item)
             if (only and item.name not in only) or item.name in skip or key.kind in _RULED:
                 continue
             field = f"{prefix}{item.name}"
@@ -282,6 +301,8 @@ class _Reader:
                 return self.number_list(field, value)
             case "kwargs":
                 return self.kwargs(field, value)
+            case "info_key":
+                return self.info_key(field, value)
         raise ValueError(f"{field}: no reader for the kind {spec.kind!r}")
 
     # -- scalars ------------------------------------------------------------------------
@@ -320,6 +341,15 @@ class _Reader:
     def boolean(self, field: str, value: Any) -> bool:
         if not isinstance(value, bool):
             raise self.error(field, f"must be true or false, got {shown(value)}.")
+        return value
+
+    def info_key(self, field: str, value: Any) -> str:
+        if not isinstance(value, str) or not INFO_KEY_PATTERN.match(value):
+            raise self.error(
+                field,
+                f"must be a key of the environment's info such as left_from_a (a letter or "
+                f"_, then letters, digits or _; at most 64), got {shown(value)}.",
+            )
         return value
 
     def string(self, field: str, value: Any) -> str:
