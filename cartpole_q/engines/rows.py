@@ -3,11 +3,12 @@
 An engine knows its environment's observation space before it compiles anything, so it
 binds the rule of that kind into its compiled step functions: no branch on the kind is
 left at run time, and no typing-time dispatch is needed. The gymnasium engine passes the
-observation as Gymnasium returns it (:data:`ROW_RULES`); a compiled twin writes it into an
+observation as Gymnasium returns it (:data:`STATE_RULES`); a compiled twin writes it into an
 array, float32 values (Box) or int64 integers (Discrete, Tuple of Discrete), and the numba
-engine's loop takes the grid's arrays one by one (:data:`ARRAY_ROW_RULES`). Both apply the
+engine's loop takes the grid's arrays one by one (:data:`ARRAY_STATE_RULES`). Both apply the
 same rule: the binning rule of :func:`~cartpole_q.rl.binning.state_index`, or
-:func:`indexed_row`.
+:func:`indexed_row`. On tile coding (:mod:`cartpole_q.rl.tiles`) the state a hook gets is a
+handle whose tiles the rule writes into the table's features (:func:`tile_state`).
 """
 
 from __future__ import annotations
@@ -56,10 +57,6 @@ def tuple_row(observation: Any, grid: Any) -> int:
     return row
 
 
-ROW_RULES = {"box": binned_row, "discrete": discrete_row, "tuple": tuple_row}
-"""observation kind -> its row rule (as :func:`cartpole_q.rl.binning.discrete_index`)"""
-
-
 @compilable
 def binned_array_row(observation: Any, low: Any, high: Any, bins: Any, starts: Any) -> int:
     """A twin's Box observation (float32 values): the binning rule."""
@@ -72,11 +69,6 @@ def indexed_array_row(observation: Any, low: Any, high: Any, bins: Any, starts: 
     """A twin's Discrete or Tuple observation (int64 components): :func:`indexed_row`."""
     row: int = indexed_row(observation, bins, starts)
     return row
-
-
-ARRAY_ROW_RULES = {"box": binned_array_row, "discrete": indexed_array_row,
-                   "tuple": indexed_array_row}  # fmt: skip
-"""observation kind -> its row rule for an observation a twin wrote into an array"""
 
 
 # -- the state a hook gets: a row, or on tiles a handle of the observation's tiles ---------
