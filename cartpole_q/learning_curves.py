@@ -5,13 +5,16 @@ per episode (Figs. 8.2, 10.2), episodes completed against time steps (Fig. 6.4) 
 cumulative reward against time steps (Figs. 8.4, 8.5). Every one of them is a function of
 the two per-episode records every run keeps (returns and lengths), so this module turns
 those records into one curve per seed on a common x grid, then aggregates the seeds (mean
-or interquartile mean) with a 95% percentile-bootstrap band.
+or interquartile mean) with a 95% percentile-bootstrap band. A run trained with
+``train.info_metric: KEY`` keeps a third record, each episode's sum of the environment's
+``info[KEY]``, drawn as the metric ``info:KEY`` (Fig. 6.5's left actions from A).
 
 Pure functions of arrays; drawing is :mod:`cartpole_q.figures`' job.
 """
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -21,6 +24,11 @@ import numpy as np
 METRICS = ("return", "length", "cumulative-return", "episodes")
 """what ``plot --metric`` draws: per episode, its return or its length; running totals of
 returns, or of episodes"""
+INFO_METRIC_PREFIX = "info:"
+"""``info:KEY``: each episode's sum of ``info[KEY]`` (runs with ``train.info_metric: KEY``)"""
+INFO_KEY_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
+"""an info key (``train.info_metric``, ``info:KEY``): a letter or ``_``, then letters,
+digits or ``_``; at most 64 (it names a ``metrics.csv`` column and an array)"""
 X_AXES = ("episode", "env-steps")
 """what ``plot --x`` draws against: training episodes, or training env steps"""
 AGGREGATES = ("mean", "iqm")
@@ -38,6 +46,52 @@ METRIC_LABELS = {
 X_LABELS = {"episode": "training episode", "env-steps": "training env steps"}
 
 
+def info_key_of(metric: str) -> str | None:
+    """The info key of an ``info:KEY`` metric (``None`` for the others).
+
+    >>> info_key_of("info:left_from_a"), info_key_of("length")
+    ('left_from_a', None)
+    """
+    if metric.startswith(INFO_METRIC_PREFIX):
+        return metric.removeprefix(INFO_METRIC_PREFIX)
+    return None
+
+
+def check_metric(metric: str) -> str | None:
+    """What is wrong with ``metric`` (a phrase after its name), or ``None`` when it draws.
+
+    >>> check_metric("info:left_from_a") is None, check_metric("return") is None
+    (True, True)
+    >>> print(check_metric("info:left from a"))
+    not info:KEY with a key of letters, digits and _ (as train.info_metric)
+    """
+    key = info_key_of(metric)
+    if key is not None:
+        if INFO_KEY_PATTERN.match(key):
+            return None
+        return "not info:KEY with a key of letters, digits and _ (as train.info_metric)"
+    if metric in METRICS:
+        return None
+    return f"not one of {', '.join(METRICS)}, or info:KEY"
+
+
+def metric_label(metric: str) -> str:
+    """A metric's axis label.
+
+    >>> metric_label("length"), metric_label("info:left_from_a")
+    ('steps per episode', 'left_from_a per episode (sum of info)')
+    """
+    key = info_key_of(metric)
+    if key is not None:
+        return f"{key} per episode (sum of info)"
+    return METRIC_LABELS[metric]
+
+
+def smoothed(metric: str) -> bool:
+    """Whether ``--smooth`` applies to ``metric`` (per-episode values, not running totals)."""
+    return metric in ("return", "length") or info_key_of(metric) is not None
+
+
 @dataclass(frozen=True)
 class SeedCurves:
     """Several seeds' curves of one metric on a common x grid."""
@@ -49,14 +103,24 @@ class SeedCurves:
     on an env-steps grid, or after it stopped training)"""
 
 
-def per_episode(returns: np.ndarray, lengths: np.ndarray, metric: str) -> np.ndarray:
+def per_episode(
+    returns: np.ndarray, lengths: np.ndarray, metric: str, info: np.ndarray | None = None
+) -> np.ndarray:
     """One run's ``metric`` after each of its episodes.
+
+    ``info`` is the run's per-episode sums of ``info[KEY]``, which ``info:KEY`` draws.
 
     >>> per_episode(np.array([1.0, 2.0]), np.array([3, 4]), "cumulative-return").tolist()
     [1.0, 3.0]
     >>> per_episode(np.array([1.0, 2.0]), np.array([3, 4]), "episodes").tolist()
     [1.0, 2.0]
+    >>> per_episode(np.array([1.0]), np.array([2]), "info:left_from_a", np.array([1.0])).tolist()
+    [1.0]
     """
+    if info_key_of(metric) is not None:
+        if info is None:
+            raise ValueError(f"{metric}: the run kept no per-episode info sums")
+        return np.asarray(info, dtype=np.float64)
     if metric == "return":
         return np.asarray(returns, dtype=np.float64)
     if metric == "length":
@@ -90,6 +154,7 @@ def seed_curves(
     x: str,
     window: int = 1,
     x_max: float | None = None,
+    infos: Sequence[np.ndarray | None] | None = None,
 ) -> SeedCurves:
     """Every seed's ``metric`` on a common grid of episodes or env steps.
 
@@ -99,9 +164,10 @@ def seed_curves(
         metric: One of :data:`METRICS`.
         x: One of :data:`X_AXES`.
         window: Trailing moving average applied to each seed's per-episode values first
-            (``return`` and ``length`` only; running totals are not smoothed).
+            (``return``, ``length`` and ``info:KEY``; running totals are not smoothed).
         x_max: The grid's end (the book's figures stop at a fixed step or episode);
             default: the longest seed's.
+        infos: Per seed, its episodes' sums of ``info[KEY]`` (for ``info:KEY``).
 
     Returns:
         The grid and the ``(seeds, points)`` values. On ``episode``, a seed's value at
@@ -112,9 +178,10 @@ def seed_curves(
     if x not in X_AXES:
         raise ValueError(f"unknown x axis {x!r}; one of {', '.join(X_AXES)}")
     per_seed = []
-    for seed_returns, seed_lengths in zip(returns, lengths, strict=True):
-        values = per_episode(seed_returns, seed_lengths, metric)
-        if metric in ("return", "length"):
+    seed_infos = [None] * len(returns) if infos is None else infos
+    for seed_returns, seed_lengths, seed_info in zip(returns, lengths, seed_infos, strict=True):
+        values = per_episode(seed_returns, seed_lengths, metric, seed_info)
+        if smoothed(metric):
             values = smooth(values, window)
         per_seed.append(values)
     if x == "episode":

@@ -97,6 +97,8 @@ class Checkpoint:
     wall_seconds: float
     config: Config | None = None
     """the config the run was trained with (``None`` in checkpoints older than this field)"""
+    info: np.ndarray | None = None
+    """the finished episodes' sums of ``info[train.info_metric]`` (``None`` without it)"""
 
 
 @dataclass(frozen=True)
@@ -128,6 +130,9 @@ class TrainResult:
     wall_seconds: float
     """seconds of the whole training loop, periodic evaluations included"""
     interrupted: bool = False
+    info: np.ndarray | None = None
+    """each training episode's sum of ``info[config.train.info_metric]`` over its steps
+    (``None`` without ``train.info_metric``)"""
 
     @property
     def episodes(self) -> int:
@@ -274,6 +279,7 @@ def _run(
             train_seconds=train_seconds,
             wall_seconds=wall_before + time.perf_counter() - started,
             config=config,
+            info=None if state.info is None else state.info[:episode],
         )
 
     finished = state.episode >= total or (
@@ -350,6 +356,7 @@ def _run(
         train_seconds=train_seconds,
         wall_seconds=wall_seconds,
         interrupted=interrupted,
+        info=None if state.info is None else state.info[:episode].copy(),
     )
 
 
@@ -371,6 +378,13 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
         array[...] = kept
     for column, values in zip(state.metrics, checkpoint.metrics, strict=True):
         column[:episode] = values
+    if (state.info is None) != (checkpoint.info is None):
+        raise RunError(
+            "the checkpoint and the config disagree on train.info_metric (one keeps "
+            "per-episode info sums, the other none); it was written with another config."
+        )
+    if state.info is not None and checkpoint.info is not None:
+        state.info[:episode] = checkpoint.info
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
     if checkpoint.physics_rng_state is not None:
         state.physics_rng.bit_generator.state = checkpoint.physics_rng_state

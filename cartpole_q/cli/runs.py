@@ -172,8 +172,9 @@ def plot(
         typer.Option(
             metavar="METRIC",
             help="Draw learning curves of this per-episode metric instead of the reward "
-            "figure: return, length (steps per episode), cumulative-return or episodes "
-            "(episodes completed), each seed faint, the seeds' aggregate bold with a 95% "
+            "figure: return, length (steps per episode), cumulative-return, episodes "
+            "(episodes completed) or info:KEY (each episode's sum of the environment's "
+            "info[KEY], for runs trained with train.info_metric: KEY), each seed faint, the seeds' aggregate bold with a 95% "
             "bootstrap band.",
             show_default="the reward figure (return, 100-episode average, solve marks)",
         ),
@@ -204,17 +205,19 @@ def plot(
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with exit_codes():
         from cartpole_q.experiments.plots import plot_metric, plot_policy, plot_rewards
-        from cartpole_q.learning_curves import AGGREGATES, METRICS, X_AXES
+        from cartpole_q.learning_curves import AGGREGATES, X_AXES, check_metric
         from cartpole_q.store.rundir import CURVE_FILE
 
         curve_options = x_axis != "episode" or aggregate != "mean" or smooth != 1 or log_y
         if metric is None and curve_options:
             raise UserError("--x, --aggregate, --smooth and --log-y apply to --metric only.")
+        problem = None if metric is None else check_metric(metric)
+        if problem is not None:
+            raise UserError(f"--metric {metric}: {problem}.")
         for option, value, choices in (
-            ("--metric", metric, METRICS), ("--x", x_axis, X_AXES),
-            ("--aggregate", aggregate, AGGREGATES),
+            ("--x", x_axis, X_AXES), ("--aggregate", aggregate, AGGREGATES),
         ):  # fmt: skip
-            if value is not None and value not in choices:
+            if value not in choices:
                 raise UserError(f"{option} {value}: not one of {', '.join(choices)}.")
         if metric is not None:
             if policy:
@@ -223,7 +226,7 @@ def plot(
                 )
             if dims is not None or seed is not None:
                 raise UserError("--dims and --seed only apply to --policy.")
-            name = Path(f"{metric}_by_{x_axis}.png")
+            name = Path(f"{metric.replace(':', '_')}_by_{x_axis}.png")
             default = run_dirs[0] / name if len(run_dirs) == 1 else name
             replace = force or (out is None and len(run_dirs) == 1)
             path = plot_metric(

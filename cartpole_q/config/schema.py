@@ -40,7 +40,7 @@ EXACT_INTEGER = 2**53
 
 Kind = Literal[
     "name", "str", "int", "float", "bool", "choice", "algorithm", "schedule", "seeds",
-    "bins", "floats", "kwargs", "physics", "randomize", "params", "section",
+    "bins", "floats", "kwargs", "physics", "randomize", "params", "section", "info_key",
 ]  # fmt: skip
 """What a config key's value is (see :attr:`Key.kind`)."""
 
@@ -59,7 +59,8 @@ class Key:
     ``algorithm`` (a registered one), ``schedule``, ``seeds``, ``bins`` (positive integers),
     ``floats`` (finite numbers), ``kwargs`` (``gymnasium.make``'s), ``physics`` and
     ``randomize`` (checked against the environment's profile), ``params`` (the algorithm's
-    own keys, which stand in the section itself) or ``section`` (a mapping of keys)"""
+    own keys, which stand in the section itself), ``section`` (a mapping of keys) or
+    ``info_key`` (a key of the environment's ``info``: letters, digits and ``_``)"""
     doc: str
     """its line in the README's config reference (Markdown); ``{interval}`` and
     ``{choices}`` are replaced by the range and the choices below; empty: no line (a
@@ -368,6 +369,18 @@ class TrainConfig:
             "also write TensorBoard event files into the run directory's `tensorboard/` "
             "(`train --tensorboard`; needs the `[tensorboard]` extra); results are unchanged",
         )
+    )
+    info_metric: str | None = field(
+        default=None,
+        metadata=spec(
+            "info_key",
+            "a key of the environment's step `info` (letters, digits, `_`): its per-step "
+            "values (bool or number) are summed per episode and kept as the column "
+            "`info_KEY` of `metrics.csv` (and of checkpoints and sweeps' `curves.npz`), "
+            "drawn with `plot --metric info:KEY`; only the gymnasium engine sees `info`: "
+            "`engine: auto` takes it, `engine: numba` is refused; `null`: none",
+            nullable=True,
+        ),
     )
 
 

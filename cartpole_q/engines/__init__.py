@@ -17,13 +17,25 @@ from cartpole_q.envs.gym import EnvInfo
 def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance = "config") -> str:
     """Return the engine that will run: ``auto`` becomes numba where a twin exists.
 
+    A config with ``train.info_metric`` runs on the gymnasium engine: the compiled twins
+    report no ``info``, so ``auto`` takes gymnasium and ``numba`` is refused.
+
     Raises:
-        ConfigError: ``engine: numba`` was asked for an environment no twin reproduces
-            (the message names the id or key).
+        ConfigError: ``engine: numba`` was asked for an environment no twin reproduces, or
+            with ``train.info_metric`` (the message names the id or key).
     """
     from cartpole_q.envs.registry import TwinSettings, twin_settings
 
     if config.engine == "gymnasium":
+        return "gymnasium"
+    info_key = config.train.info_metric
+    if info_key is not None:
+        if config.engine == "numba":
+            raise ConfigError(
+                f"{blame(source, 'engine')}: engine: numba cannot record train.info_metric "
+                f"({info_key}): the compiled twins report no info. Use engine: gymnasium (or "
+                "auto, which takes it for such a config), or leave train.info_metric out."
+            )
         return "gymnasium"
     settings = twin_settings(
         config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics

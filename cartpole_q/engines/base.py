@@ -198,6 +198,10 @@ class TrainingState:
     """the policy table at the solve point, kept when training goes on past it"""
     evaluations: list[dict[str, Any]] = field(default_factory=list)
     """periodic greedy evaluations: episode, env_steps, mean, std, min, max"""
+    info: np.ndarray | None = None
+    """float64, one value per configured episode: the sum of ``info[train.info_metric]``
+    over the episode's steps (``None`` without ``train.info_metric``; the gymnasium engine
+    fills it)"""
 
     @classmethod
     def fresh(
@@ -230,6 +234,11 @@ class TrainingState:
             metrics=EpisodeMetrics.empty(config.train.episodes),
             physics_rng=physics_rng if physics_rng is not None else np.random.default_rng(0),
             algorithm=algorithm,
+            info=(
+                None
+                if config.train.info_metric is None
+                else np.zeros(config.train.episodes, dtype=np.float64)
+            ),
         )
 
     def policy_table(self) -> np.ndarray:

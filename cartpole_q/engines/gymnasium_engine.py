@@ -19,7 +19,7 @@ from cartpole_q.engines.context import StepContext, step_context
 from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
 from cartpole_q.engines.play import play_greedy
 from cartpole_q.engines.rows import STATE_RULES
-from cartpole_q.envs.gym import make_env, set_physics
+from cartpole_q.envs.gym import info_value, make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.tabular import ENDED, no_episode_end, visit
@@ -133,6 +133,7 @@ class GymnasiumEngine:
         # Tuple observations as plain integers: one compiled specialisation for any env.
         self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
         self._step_cap = step_cap
+        self._info_key = config.train.info_metric
         self._context: StepContext | None = None
         self._context_of: tuple[Any, ...] = ()
 
@@ -159,6 +160,7 @@ class GymnasiumEngine:
         context = self._step_context(state)
         randomize = self._config.env.randomize
         first, following, as_ints = self._first, self._next, self._as_ints
+        info_key, info_sums, env_id = self._info_key, state.info, self._config.env.id
         for episode in range(state.episode, stop):
             epsilon, alpha = episode_rates(agent, episode)
             if randomize:  # one draw per key, in the config's (canonical) order
@@ -172,18 +174,22 @@ class GymnasiumEngine:
             if as_ints:
                 observation = tuple(map(int, observation))
             s, a = first(context, observation, epsilon)
-            episode_return, length = 0.0, 0
+            episode_return, length, info_sum = 0.0, 0, 0.0
             while a != ENDED:
-                observation, reward, terminated, truncated, _ = env.step(a)
+                observation, reward, terminated, truncated, info = env.step(a)
                 if as_ints:
                     observation = tuple(map(int, observation))
                 length += 1
                 episode_return += reward
+                if info_key is not None:
+                    info_sum += info_value(info, info_key, env_id)
                 s, a = following(context, s, a, float(reward), observation, terminated,
                                  truncated, alpha, epsilon)  # fmt: skip
             if self._has_end:
                 self._end(context, alpha, epsilon)
             record_episode(metrics, episode, episode_return, length, epsilon, alpha)
+            if info_sums is not None:
+                info_sums[episode] = info_sum
             state.episode = episode + 1
             state.env_steps += length
             if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):

@@ -8,6 +8,7 @@ allocate) is found here, before any run directory exists.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 import sys
 import warnings
@@ -15,7 +16,10 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
+from cartpole_q.errors import RunError
 from cartpole_q.profiles import profile_for
 
 SOLVE_WINDOW = 100
@@ -138,6 +142,30 @@ def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
     physics_spec.apply(env, physics)
 
 
+def info_value(info: Mapping[str, Any], key: str, env_id: str) -> float:
+    """A step's ``info[key]`` as a number: a bool counts 1 or 0.
+
+    >>> info_value({"left_from_a": True}, "left_from_a", "w"), info_value({"x": 2}, "x", "w")
+    (1.0, 2.0)
+
+    Raises:
+        RunError: the step's info lacks ``key``, or its value is not a bool or a real number.
+    """
+    if key not in info:
+        reported = ", ".join(sorted(map(str, info))) or "nothing"
+        raise RunError(
+            f"train.info_metric: {key}: a step of {env_id} has no such key in its info (it "
+            f"reported: {reported}); name a key the environment reports at every step."
+        )
+    value = info[key]
+    if isinstance(value, bool | np.bool_ | numbers.Real):
+        return float(value)
+    raise RunError(
+        f"train.info_metric: {key}: {env_id} reports a {type(value).__name__} there "
+        f"({value!r}); only a bool or a number can be summed per episode."
+    )
+
+
 def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
     """Make the config's environment once and check that the config can train on it.
 
@@ -162,6 +190,8 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
             env.reset(seed=0)
         except Exception as error:
             raise kwargs_error(config.env, error, source) from None
+        if config.train.info_metric is not None:
+            _check_info_metric(env, config.train.info_metric, env_id, source)
     finally:
         env.close()
     if not isinstance(action_space, spaces.Discrete) or int(action_space.start) != 0:
@@ -233,6 +263,18 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
         state_shape=tuple(state_shape),
         index_starts=index_starts,
     )
+
+
+def _check_info_metric(env: Any, key: str, env_id: str, source: str | Provenance) -> None:
+    """Refuse a ``train.info_metric`` the environment's first step does not report.
+
+    One step (action 0) after the reset; training checks every step the same way.
+    """
+    _, _, _, _, info = env.step(0)
+    try:
+        info_value(info, key, env_id)
+    except RunError as error:
+        raise ConfigError(f"{blame(source, 'train.info_metric')}: {error}") from None
 
 
 def _index_starts(space: Any) -> tuple[int, ...] | None:

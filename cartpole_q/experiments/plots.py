@@ -33,7 +33,14 @@ from cartpole_q.figures import (
     reward_and_paths_figure,
     reward_curve_figure,
 )
-from cartpole_q.learning_curves import METRIC_LABELS, X_LABELS, aggregate_band, seed_curves
+from cartpole_q.learning_curves import (
+    X_LABELS,
+    aggregate_band,
+    info_key_of,
+    metric_label,
+    seed_curves,
+    smoothed,
+)
 from cartpole_q.profiles import profile_for
 from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
@@ -134,7 +141,8 @@ def plot_metric(
     Args:
         run_dirs: Run directories, multi-seed runs or sweep points, one curve each.
         out: A ``.png``, ``.svg`` or ``.pdf`` file.
-        metric: One of :data:`cartpole_q.learning_curves.METRICS`.
+        metric: One of :data:`cartpole_q.learning_curves.METRICS`, or ``info:KEY`` (runs
+            trained with ``train.info_metric: KEY``).
         x: One of :data:`cartpole_q.learning_curves.X_AXES`.
         aggregate: ``mean`` or ``iqm`` over seeds.
         window: Trailing moving average of per-episode values (``return``, ``length``).
@@ -145,10 +153,12 @@ def plot_metric(
             ``figure``); default: the directories' names, the values as they are.
 
     Raises:
-        RunError: A directory is not a complete run, or a sweep point kept no curves.
+        RunError: A directory is not a complete run, a sweep point kept no curves, or
+            (``info:KEY``) its runs kept no sums of ``info[KEY]``.
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     style = style or CurveStyle()
+    info_key = info_key_of(metric)
     bands = []
     for number, path in enumerate(run_dirs):
         run_set = load_run_set(path)
@@ -161,9 +171,11 @@ def plot_metric(
                 f"{path}: this sweep kept no learning curves (its sweep file says curves: "
                 "false, or it predates them); there is nothing to draw."
             )
+        if info_key is not None:
+            check_info(path, runs, info_key)
         curves = seed_curves(
             [run.metrics.returns for run in runs], [run.metrics.lengths for run in runs],
-            metric, x, window, style.x_max,
+            metric, x, window, style.x_max, [run.info for run in runs],
         )  # fmt: skip
         values = (curves.values + style.offset) * style.scale
         centre, low, high = aggregate_band(values, aggregate, np.random.default_rng(0))
@@ -173,15 +185,32 @@ def plot_metric(
             label = f"point {path.name}" if run_set.kind == "sweep point" else path.name
         bands.append(MetricBand(label, curves.x, values, centre, low, high, aggregate))
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    y_label = style.y_label or METRIC_LABELS[metric]
-    if window > 1 and metric in ("return", "length"):
+    y_label = style.y_label or metric_label(metric)
+    if window > 1 and smoothed(metric):
         y_label += f" ({window}-episode average)"
-    title = style.title or f"{METRIC_LABELS[metric].capitalize()} by {X_LABELS[x]}"
+    title = style.title or f"{metric_label(metric).capitalize()} by {X_LABELS[x]}"
     if len(run_dirs) == 1 and style.title is None:
         title += f": {run_dirs[0].name}"
     figure = metric_curve_figure(bands, X_LABELS[x], y_label, title, log_y, style.reference)
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
+
+
+def check_info(path: Path, runs: Sequence[rundir.Run], info_key: str) -> None:
+    """Refuse runs that kept no per-episode sums of ``info[info_key]`` (``info:KEY``).
+
+    Raises:
+        RunError: naming the path, the key and what its runs recorded.
+    """
+    for run in runs:
+        if run.info is None or run.config.train.info_metric != info_key:
+            recorded = run.config.train.info_metric
+            kept = f"train.info_metric: {recorded}" if recorded else "no train.info_metric"
+            raise RunError(
+                f"{path}: --metric info:{info_key}: its runs were trained with {kept}, so they "
+                f"kept no per-episode sums of info[{info_key!r}]; train with train.info_metric: "
+                f"{info_key} to draw it."
+            )
 
 
 def _greedy_paths(

@@ -28,11 +28,11 @@ from cartpole_q.config import (
     shown_value,
 )
 from cartpole_q.errors import RunError
-from cartpole_q.experiments.plots import CurveStyle, plot_metric
+from cartpole_q.experiments.plots import CurveStyle, check_info, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, summary_line_figure
-from cartpole_q.learning_curves import METRIC_LABELS, aggregate_band, per_episode
+from cartpole_q.learning_curves import aggregate_band, info_key_of, metric_label, per_episode
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
@@ -73,6 +73,8 @@ class FinishedRun:
     """the learning curve: each training episode's return"""
     lengths: np.ndarray
     """each training episode's length"""
+    info: np.ndarray | None = None
+    """each training episode's sum of ``info[train.info_metric]`` (``None`` without it)"""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -124,8 +126,9 @@ def run_task(
                 return
             result = train(config.for_seed(seed), env_info=env_info)
             yield FinishedRun(
-                point, SeedResult.of_train(result), result.q_table, result.returns, result.lengths
-            )
+                point, SeedResult.of_train(result), result.q_table, result.returns,
+                result.lengths, result.info,
+            )  # fmt: skip
 
 
 # -- the parent side ---------------------------------------------------------------------
@@ -354,9 +357,12 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     groups: dict[str, list[tuple[float, np.ndarray]]] = {}
     for point, path in zip(spec.points, paths, strict=True):
         runs = load_run_set(path).runs
+        info_key = info_key_of(figure.metric)
+        if info_key is not None:
+            check_info(path, runs, info_key)
         per_seed = []
         for run in runs:
-            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric)
+            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, run.info)
             values = values[: figure.first] if figure.first is not None else values
             per_seed.append((float(np.mean(values)) + figure.offset) * figure.scale)
         others = ", ".join(
@@ -377,7 +383,7 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
             np.array([b[1][0] for b in bands]), np.array([b[2][0] for b in bands]),
         ))  # fmt: skip
     first = f"first {figure.first} episodes" if figure.first is not None else "all episodes"
-    y_label = figure.y_label or f"{METRIC_LABELS[figure.metric]}, mean over the {first}"
+    y_label = figure.y_label or f"{metric_label(figure.metric)}, mean over the {first}"
     title = figure.title or spec.name
     drawn = summary_line_figure(
         lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y
@@ -442,6 +448,7 @@ class _Book:
             self._per_point[point] += 1
         self._tables: dict[int, dict[str, np.ndarray]] = {}
         self._curves: dict[int, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
+        self._info: dict[int, dict[str, np.ndarray]] = {}
         self._dirty: set[int] = set()
         self._last_flush = -math.inf  # the first results are saved at once
         self.saved = len(self.rows)
@@ -480,6 +487,11 @@ class _Book:
                 self._tables[point] = sweepdir.read_tables(self._directory, point_id)
                 if spec.curves:
                     self._curves[point] = sweepdir.read_curves(self._directory, point_id)
+                    info_key = spec.points[point].config.train.info_metric
+                    if info_key is not None:
+                        self._info[point] = sweepdir.read_info_curves(
+                            self._directory, point_id, info_key
+                        )
             self._tables[point][spec.seed_key(seed)] = run.q_table
             config = spec.points[point].config
             if config.train.tensorboard:
@@ -487,6 +499,8 @@ class _Book:
                 write_run_events(board / spec.seed_key(seed), config.for_seed(seed), run)
             if spec.curves:
                 self._curves[point][spec.seed_key(seed)] = (run.returns, run.lengths)
+                if run.info is not None:
+                    self._info[point][spec.seed_key(seed)] = run.info
             values = spec.points[point].values
             self.rows[(point, seed)] = ResultRow(
                 spec.point_id(point), {key: axis_cell(values[key]) for key in spec.axes}, run.result
@@ -503,7 +517,10 @@ class _Book:
             point_id = self._spec.point_id(point)
             sweepdir.write_tables(self._directory, point_id, self._tables[point])
             if self._spec.curves:
-                sweepdir.write_curves(self._directory, point_id, self._curves[point])
+                info_key = self._spec.points[point].config.train.info_metric
+                sweepdir.write_curves(
+                    self._directory, point_id, self._curves[point], self._info.get(point), info_key
+                )
         rows = self.sorted_rows()
         sweepdir.write_results(self._directory, self._spec.axes, rows)
         self.saved = len(rows)
@@ -512,6 +529,7 @@ class _Book:
             if self._per_point[point] == len(self._spec.seeds):
                 del self._tables[point]  # complete: its files hold every seed
                 self._curves.pop(point, None)
+                self._info.pop(point, None)
         self._dirty.clear()
         self._last_flush = time.monotonic()
 

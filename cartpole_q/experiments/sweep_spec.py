@@ -14,7 +14,7 @@ import difflib
 import itertools
 import json
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -204,6 +204,8 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     base_mapping = base.to_dict()
     points = _expand(name, base_mapping, grid, zipped, where)
     figure = _figure(raw.get("figure"), curves, where)
+    if figure is not None:
+        _check_info_metric(figure.metric, points, where)
     if figure is not None and figure.against is not None:
         _check_against(figure.against, {**grid, **zipped}, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
@@ -222,9 +224,26 @@ def _check_against(key: str, axes: Mapping[str, list[Any]], where: str) -> None:
         )
 
 
+def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None:
+    """Refuse ``figure.metric: info:KEY`` unless every point records KEY."""
+    from cartpole_q.learning_curves import info_key_of
+
+    key = info_key_of(metric)
+    if key is None:
+        return
+    for point in points:
+        if point.config.train.info_metric != key:
+            recorded = point.config.train.info_metric
+            raise ConfigError(
+                f"{where}: figure.metric: info:{key} draws each episode's sum of info[{key!r}], "
+                f"but point {point.index} sets train.info_metric: {recorded or 'null'}; put "
+                f"train: {{info_metric: {key}}} in the base."
+            )
+
+
 def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     """Check a sweep file's ``figure`` section (None when it has none)."""
-    from cartpole_q.learning_curves import AGGREGATES, METRICS, X_AXES
+    from cartpole_q.learning_curves import AGGREGATES, METRICS, X_AXES, check_metric
 
     if raw is None:
         return None
@@ -240,9 +259,16 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             "false; keep the curves or leave the figure out."
         )
     values = dict(raw)
-    choices = {"metric": METRICS, "x": X_AXES, "aggregate": AGGREGATES}
+    choices = {"x": X_AXES, "aggregate": AGGREGATES}
     if "metric" not in values:
-        raise ConfigError(f"{where}: figure.metric: is missing; one of {', '.join(METRICS)}.")
+        raise ConfigError(
+            f"{where}: figure.metric: is missing; one of {', '.join(METRICS)}, or info:KEY."
+        )
+    metric = values["metric"]
+    problem = check_metric(metric) if isinstance(metric, str) else "not a string"
+    if problem is not None:
+        shown = json.dumps(metric, default=str)
+        raise ConfigError(f"{where}: figure.metric: {shown} is {problem}.")
     for key, allowed in choices.items():
         if key in values and values[key] not in allowed:
             raise ConfigError(

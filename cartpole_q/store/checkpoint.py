@@ -2,7 +2,8 @@
 
 Arrays are stored as arrays (``allow_pickle=False``): ``q``, ``visits``, the algorithm's
 memory as ``memory_0``, ``memory_1``, ... (whatever it keeps: Double Q-learning's second
-table, traces, buffers, a model), the metrics, and ``solved_q``; the rest (generator states,
+table, traces, buffers, a model), the metrics, ``solved_q``, and with ``train.info_metric``
+the per-episode ``info`` sums; the rest (generator states,
 the config the run was trained with, counters) as one JSON string. Checkpoints written
 before algorithms kept memory stored Double Q-learning's second table as ``q_b`` (empty for
 the others): it loads as ``memory_0``.
@@ -28,6 +29,8 @@ from cartpole_q.training import Checkpoint
 CHECKPOINT_FILE = "checkpoint.npz"
 MEMORY_PREFIX = "memory_"
 """the keys of the algorithm's memory arrays: ``memory_0``, ``memory_1``, ..."""
+INFO_ARRAY = "info"
+"""the finished episodes' sums of ``info[train.info_metric]``, when the config names one"""
 
 
 def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
@@ -60,6 +63,8 @@ def checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
     }
     if checkpoint.solved_q is not None:
         arrays["solved_q"] = checkpoint.solved_q
+    if checkpoint.info is not None:  # train.info_metric's sums (absent without it)
+        arrays[INFO_ARRAY] = checkpoint.info
     buffer = io.BytesIO()
     np.savez(buffer, allow_pickle=False, **arrays)
     return buffer.getvalue()
@@ -108,6 +113,7 @@ def checkpoint_from_bytes(content: bytes, where: str) -> Checkpoint:
                 train_seconds=float(meta["train_seconds"]),
                 wall_seconds=float(meta["wall_seconds"]),
                 config=_checkpoint_config(meta.get("config")),
+                info=data[INFO_ARRAY] if INFO_ARRAY in data.files else None,
             )
     except (
         OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError

@@ -5,7 +5,7 @@
 | ``config.yaml`` | the resolved config; ``train --config`` on it reproduces the run |
 | ``q_table.npy`` | float64, shape ``(*bins, n_actions)``; greedy action = argmax of last axis |
 | ``visits.npy`` | int64, same shape: how often training took each (state, action) |
-| ``metrics.csv`` | ``episode,return,length,epsilon,alpha``, one row per training episode |
+| ``metrics.csv`` | ``episode,return,length,epsilon,alpha`` (and ``info_KEY`` with ``train.info_metric``), one row per training episode |
 | ``evaluations.csv`` | periodic greedy evaluations: ``episode,env_steps,mean,std,min,max`` |
 | ``reward_curve.png`` | returns, their 100-episode moving average, the threshold |
 | ``summary.json`` | figures of the run; written last, so its presence means complete |
@@ -56,6 +56,8 @@ EVALUATIONS_FILE = "evaluations.csv"
 CURVE_FILE = "reward_curve.png"
 SUMMARY_FILE = "summary.json"
 METRICS_HEADER = ("episode", "return", "length", "epsilon", "alpha")
+INFO_COLUMN_PREFIX = "info_"
+"""``metrics.csv``'s last column with ``train.info_metric: KEY`` is ``info_KEY``"""
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
 NPY_MAGIC = b"\x93NUMPY"
 """the first bytes of every ``.npy`` file"""
@@ -154,12 +156,29 @@ def summarize(result: TrainResult) -> RunSummary:
     return RunSummary.of_train(result, versions(), time.strftime("%Y-%m-%dT%H:%M:%S%z"))
 
 
-def metrics_csv(metrics: EpisodeMetrics) -> str:
-    """Per-episode metrics as CSV; floats written with ``repr`` so they round-trip exactly."""
-    lines = [",".join(METRICS_HEADER)]
+def metrics_csv(
+    metrics: EpisodeMetrics, info: np.ndarray | None = None, info_key: str | None = None
+) -> str:
+    """Per-episode metrics as CSV; floats written with ``repr`` so they round-trip exactly.
+
+    With ``info`` (the sums of ``info[info_key]``), a last column ``info_<info_key>``.
+
+    >>> one = EpisodeMetrics(np.array([1.0]), np.array([2]), np.array([0.1]), np.array([0.5]))
+    >>> print(metrics_csv(one, np.array([1.0]), "left_from_a"), end="")
+    episode,return,length,epsilon,alpha,info_left_from_a
+    1,1.0,2,0.1,0.5,1.0
+    """
+    if info is None:
+        lines = [",".join(METRICS_HEADER)]
+        lines.extend(
+            f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r}"
+            for i, (r, n, e, a) in enumerate(zip(*metrics, strict=True))
+        )
+        return "\n".join(lines) + "\n"
+    lines = [",".join((*METRICS_HEADER, f"{INFO_COLUMN_PREFIX}{info_key}"))]
     lines.extend(
-        f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r}"
-        for i, (r, n, e, a) in enumerate(zip(*metrics, strict=True))
+        f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r},{float(v)!r}"
+        for i, (r, n, e, a, v) in enumerate(zip(*metrics, info, strict=True))
     )
     return "\n".join(lines) + "\n"
 
@@ -208,7 +227,10 @@ def write_run(
     write_config(run_dir, result.config)
     atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
     atomic_save_npy(run_dir / VISITS_FILE, result.visits)
-    atomic_write_text(run_dir / METRICS_FILE, metrics_csv(result.metrics))
+    atomic_write_text(
+        run_dir / METRICS_FILE,
+        metrics_csv(result.metrics, result.info, result.config.train.info_metric),
+    )
     atomic_write_text(run_dir / EVALUATIONS_FILE, evaluations_csv(result.evaluations))
     if plot:
         from cartpole_q.figures import Curve, figure_png, reward_curve_figure
@@ -247,6 +269,10 @@ class Run:
     """the columns of ``metrics.csv`` (episodes are numbered from 1 in order)"""
     result: SeedResult
     """what it achieved (from ``summary.json``, or a sweep's ``results.csv`` row)"""
+    info: np.ndarray | None = None
+    """each episode's sum of ``info[config.train.info_metric]`` (``metrics.csv``'s
+    ``info_KEY`` column; ``None`` without ``train.info_metric``, or a sweep point that kept
+    no curves)"""
 
     @property
     def name(self) -> str:
@@ -302,7 +328,7 @@ def load_run(path: str | Path) -> Run:
             raise RunError(
                 f"{path / VISITS_FILE}: has shape {visits.shape}, but the Q-table's is {q_table.shape}."
             )
-    metrics = read_metrics(path / METRICS_FILE)
+    metrics, info = read_metric_columns(path / METRICS_FILE, config.train.info_metric)
     return Run(
         path=path,
         config=config,
@@ -310,6 +336,7 @@ def load_run(path: str | Path) -> Run:
         visits=visits,
         metrics=metrics,
         result=_with_threshold(summary.result(config.seed), config),
+        info=info,
     )
 
 
@@ -364,11 +391,26 @@ def load_array(path: Path, dtype: type) -> np.ndarray:
 
 
 def read_metrics(path: Path) -> EpisodeMetrics:
-    """Read ``metrics.csv``.
+    """Read ``metrics.csv`` (without an ``info_KEY`` column).
 
     Raises:
         RunError: the file is missing, has another header, or a row is not numeric.
     """
+    return read_metric_columns(path, None)[0]
+
+
+def read_metric_columns(
+    path: Path, info_key: str | None
+) -> tuple[EpisodeMetrics, np.ndarray | None]:
+    """Read ``metrics.csv``: its metrics, and its ``info_<info_key>`` column when given.
+
+    Raises:
+        RunError: the file is missing, has another header (``info_KEY`` exactly when
+            ``info_key`` is given), or a row is not numeric.
+    """
+    header: tuple[str, ...] = METRICS_HEADER
+    if info_key is not None:
+        header = (*METRICS_HEADER, f"{INFO_COLUMN_PREFIX}{info_key}")
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -376,23 +418,29 @@ def read_metrics(path: Path) -> EpisodeMetrics:
     except (OSError, UnicodeDecodeError) as error:
         raise RunError(f"{path}: cannot be read ({error}).") from None
     rows = list(csv.reader(io.StringIO(text)))
-    if not rows or tuple(rows[0]) != METRICS_HEADER:
-        raise RunError(f"{path}: must start with the header {','.join(METRICS_HEADER)}.")
+    if not rows or tuple(rows[0]) != header:
+        because = ""
+        if info_key is not None:
+            because = f" (its config's train.info_metric is {info_key})"
+        elif rows and len(rows[0]) > len(header):
+            because = " (its config sets no train.info_metric)"
+        raise RunError(f"{path}: must start with the header {','.join(header)}{because}.")
     try:
         columns = np.array([[float(value) for value in row] for row in rows[1:]], dtype=np.float64)
     except ValueError:
-        raise RunError(f"{path}: has a row that is not five numbers.") from None
-    if columns.size and (columns.ndim != 2 or columns.shape[1] != len(METRICS_HEADER)):
-        raise RunError(f"{path}: every row must have {len(METRICS_HEADER)} values.")
-    columns = columns.reshape(-1, len(METRICS_HEADER))
+        raise RunError(f"{path}: has a row that is not {len(header)} numbers.") from None
+    if columns.size and (columns.ndim != 2 or columns.shape[1] != len(header)):
+        raise RunError(f"{path}: every row must have {len(header)} values.")
+    columns = columns.reshape(-1, len(header))
     if not np.array_equal(columns[:, 0], np.arange(1, len(columns) + 1)):
         raise RunError(f"{path}: its episodes must be numbered 1, 2, 3, ... in order.")
-    return EpisodeMetrics(
+    metrics = EpisodeMetrics(
         returns=columns[:, 1],
         lengths=columns[:, 2].astype(np.int64),
         epsilons=columns[:, 3],
         alphas=columns[:, 4],
     )
+    return metrics, (columns[:, 5].copy() if info_key is not None else None)
 
 
 def read_summary(run_dir: Path) -> RunSummary | None:

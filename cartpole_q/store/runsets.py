@@ -138,6 +138,8 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
         ) from None
     tables = sweepdir.read_tables(sweep, point_dir.name)
     curves = sweepdir.read_curves(sweep, point_dir.name)
+    info_key = config.train.info_metric
+    infos = {} if info_key is None else sweepdir.read_info_curves(sweep, point_dir.name, info_key)
     threshold = rundir.config_threshold(config)
     seeds = sweepdir.sweep_seeds(sweep)
     runs = []
@@ -159,6 +161,7 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
                 visits=None,
                 metrics=_metrics(seed_config, returns, lengths),
                 result=dataclasses.replace(row.result, reward_threshold=threshold),
+                info=infos.get(key),
             )
         )
     total = len(seeds)

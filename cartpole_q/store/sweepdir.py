@@ -35,7 +35,8 @@ POINTS_DIR = "points"
 TABLES_FILE = "q_tables.npz"
 CURVES_FILE = "curves.npz"
 """a point's learning curves: ``seed-NNN.returns`` (float64) and ``seed-NNN.lengths``
-(int64) per finished seed, one value per training episode, compressed"""
+(int64) per finished seed, one value per training episode, compressed; with
+``train.info_metric: KEY`` also ``seed-NNN.info_KEY`` (float64, the per-episode sums)"""
 FIGURE_FILE = "sweep.png"
 SWEEPS_ROOT = Path("sweeps")
 RESULT_COLUMNS = (
@@ -266,14 +267,24 @@ def curves_path(directory: Path, point_id: str) -> Path:
 
 
 def write_curves(
-    directory: Path, point_id: str, curves: Mapping[str, tuple[np.ndarray, np.ndarray]]
+    directory: Path,
+    point_id: str,
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    info: Mapping[str, np.ndarray] | None = None,
+    info_key: str | None = None,
 ) -> None:
-    """Rewrite a point's ``curves.npz`` whole: each seed's returns and lengths, compressed."""
+    """Rewrite a point's ``curves.npz`` whole: each seed's returns and lengths, compressed.
+
+    With ``info`` (by seed key, the sums of ``info[info_key]``), each seed's
+    ``seed-NNN.info_<info_key>`` too.
+    """
     arrays: dict[str, Any] = {}
     for key in sorted(curves):
         returns, lengths = curves[key]
         arrays[f"{key}.returns"] = np.asarray(returns, dtype=np.float64)
         arrays[f"{key}.lengths"] = np.asarray(lengths, dtype=np.int64)
+        if info is not None and key in info:
+            arrays[f"{key}.info_{info_key}"] = np.asarray(info[key], dtype=np.float64)
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)
     atomic_write_bytes(curves_path(directory, point_id), buffer.getvalue())
@@ -293,6 +304,29 @@ def read_curves(directory: Path, point_id: str) -> dict[str, tuple[np.ndarray, n
             names = archive.files
             keys = sorted({name.rpartition(".")[0] for name in names})
             return {key: (archive[f"{key}.returns"], archive[f"{key}.lengths"]) for key in keys}
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as error:
+        raise RunError(
+            f"{path}: cannot be read ({error}); the sweep directory is damaged."
+        ) from None
+
+
+def read_info_curves(directory: Path, point_id: str, info_key: str) -> dict[str, np.ndarray]:
+    """A point's kept per-episode sums of ``info[info_key]`` by seed key (none if none).
+
+    Raises:
+        RunError: the file is damaged.
+    """
+    path = curves_path(directory, point_id)
+    if not path.is_file():
+        return {}
+    suffix = f".info_{info_key}"
+    try:
+        with np.load(path, allow_pickle=False) as archive:
+            return {
+                name.removesuffix(suffix): archive[name]
+                for name in archive.files
+                if name.endswith(suffix)
+            }
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as error:
         raise RunError(
             f"{path}: cannot be read ({error}); the sweep directory is damaged."
