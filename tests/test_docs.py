@@ -209,11 +209,12 @@ def _github_anchor(heading: str) -> str:
 def broken_links(markdown: str, root: Path) -> list[str]:
     """The relative links and images of a Markdown text that do not resolve from ``root``.
 
-    A path must exist; an anchor alone (``#commands``) must be one of the text's headings.
-    Links to the web are not checked (the tests run offline), nor links inside code blocks.
+    A path must exist; an anchor (``#commands``, ``page.md#commands``) must be a heading of
+    the text or of the Markdown page it names. Links to the web are not checked (the tests run
+    offline), nor links inside code blocks.
     """
     outside_code = re.sub(r"```.*?```", "", markdown, flags=re.DOTALL)
-    anchors = {_github_anchor(h) for h in re.findall(r"^#+ (.+)$", outside_code, re.MULTILINE)}
+    anchors = _anchors(markdown)
     targets = re.findall(r"\]\(([^)\s]+)\)", outside_code)
     targets += re.findall(r'(?:src|href)="([^"]+)"', outside_code)
     broken = []
@@ -221,9 +222,20 @@ def broken_links(markdown: str, root: Path) -> list[str]:
         if re.match(r"[a-z]+:", target):
             continue
         path, _, anchor = target.partition("#")
-        if (not path and anchor not in anchors) or (path and not (root / path).exists()):
+        if path and not (root / path).exists():
+            broken.append(target)
+        elif anchor and path.endswith(".md"):
+            if anchor not in _anchors((root / path).read_text(encoding="utf-8")):
+                broken.append(target)
+        elif anchor and not path and anchor not in anchors:
             broken.append(target)
     return broken
+
+
+def _anchors(markdown: str) -> set[str]:
+    """The anchors of a Markdown text's headings (those outside code blocks)."""
+    outside_code = re.sub(r"```.*?```", "", markdown, flags=re.DOTALL)
+    return {_github_anchor(h) for h in re.findall(r"^#+ (.+)$", outside_code, re.MULTILINE)}
 
 
 def test_every_relative_link_of_the_readme_resolves() -> None:
@@ -237,9 +249,12 @@ def test_the_link_check_finds_missing_files_and_anchors() -> None:
         "# Title\n## `cartpole-q eval`\n## Sutton & Barto's worlds\n"
         "[a](README.md) [b](docs/nope.md) [c](#cartpole-q-eval) [d](#sutton--bartos-worlds) "
         '[e](#nope) [f](https://example.org/x) <img src="docs/missing.gif">\n'
+        "[h](docs/results.md#speed) [i](docs/results.md#nope)\n"
         "```\n[g](in/code.md)\n```\n"
     )
-    assert broken_links(text, REPO) == ["docs/nope.md", "#nope", "docs/missing.gif"]
+    assert broken_links(text, REPO) == [
+        "docs/nope.md", "#nope", "docs/results.md#nope", "docs/missing.gif",
+    ]  # fmt: skip
 
 
 def _hook(name: str) -> ModuleType:

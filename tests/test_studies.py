@@ -398,10 +398,10 @@ def test_the_readme_names_every_shipped_config() -> None:
     from cartpole_q.config import shipped_configs
     from tests.conftest import REPO
 
-    text = (REPO / "README.md").read_text()
+    text = (REPO / "docs" / "reference" / "configuration.md").read_text()
     section = text[text.index("Shipped configs (installed") :].split("\n\n")[0]
     missing = [name for name in shipped_configs() if f"`{name}`" not in section]
-    assert not missing, f"the README's list of shipped configs misses {missing}"
+    assert not missing, f"the configuration reference's list of shipped configs misses {missing}"
 
 
 def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
