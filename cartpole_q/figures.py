@@ -158,11 +158,13 @@ def metric_curve_figure(
     title: str,
     log_y: bool = False,
     reference: tuple[float, str] | None = None,
+    y_limits: tuple[float | None, float | None] = (None, None),
 ) -> Figure:
     """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
 
     One run (a single seed) is drawn as its line alone. ``reference`` is a dashed
-    horizontal line and its legend label (an optimum, the book's figure).
+    horizontal line and its legend label (an optimum, the book's figure); ``y_limits`` the
+    y axis's ends (``None``: automatic).
     """
     figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
@@ -183,6 +185,8 @@ def metric_curve_figure(
                      label=reference[1])  # fmt: skip
     if log_y:
         axes.set_yscale("log")
+    if y_limits != (None, None):
+        axes.set_ylim(*y_limits)
     axes.set_xlabel(x_label)
     axes.set_ylabel(y_label)
     axes.set_title(title, fontsize="medium")

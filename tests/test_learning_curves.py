@@ -179,6 +179,7 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "file": "../f.png"}, "figure.file"),
         ([1], "figure: must be a mapping"),
         ({"metric": "length", "against": "agent.gamma"}, "figure.against: 'agent.gamma' is not"),
+        ({"metric": "length", "y_min": 5, "y_max": 5}, "figure.y_min: must be below figure.y_max"),
         ({"metric": "length", "against": "agent.alpha", "first": 0}, "figure.first: must be"),
     ],
 )
@@ -234,3 +235,16 @@ def test_a_figure_against_an_axis_draws_each_points_mean_over_its_first_episodes
     expected = np.mean([curves[f"seed-{s:03d}.lengths"][:5].mean() for s in (0, 1, 2)])
     ((xs, centre),) = drawn.values()
     assert xs == [0.1, 0.5] and centre[1] == pytest.approx(expected)
+
+
+def test_y_limits_end_the_axis_where_the_book_does() -> None:
+    """``figure.y_min``/``y_max``: Fig. 6.3's axis stops at -100 as the book's does."""
+    from cartpole_q.figures import MetricBand, metric_curve_figure
+
+    values = np.array([[-1700.0, -50.0, -25.0], [-1500.0, -40.0, -30.0]])
+    band = MetricBand("a", np.arange(1.0, 4.0), values, values.mean(0), values.min(0),
+                      values.max(0), "mean")  # fmt: skip
+    figure = metric_curve_figure([band], "episode", "return", "t", y_limits=(-100.0, 0.0))
+    assert figure.axes[0].get_ylim() == (-100.0, 0.0)
+    automatic = metric_curve_figure([band], "episode", "return", "t")
+    assert automatic.axes[0].get_ylim()[0] < -1500

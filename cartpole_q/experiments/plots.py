@@ -122,6 +122,8 @@ class CurveStyle:
     """a dashed horizontal line and its label"""
     x_max: float | None = None
     """where the x axis ends (default: the longest seed's training)"""
+    y_limits: tuple[float | None, float | None] = (None, None)
+    """the y axis's ends (``None``: matplotlib's choice), as the book's figure shows it"""
 
 
 def plot_metric(
@@ -191,7 +193,9 @@ def plot_metric(
     title = style.title or f"{metric_label(metric).capitalize()} by {X_LABELS[x]}"
     if len(run_dirs) == 1 and style.title is None:
         title += f": {run_dirs[0].name}"
-    figure = metric_curve_figure(bands, X_LABELS[x], y_label, title, log_y, style.reference)
+    figure = metric_curve_figure(
+        bands, X_LABELS[x], y_label, title, log_y, style.reference, style.y_limits
+    )
     atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
     return out
 

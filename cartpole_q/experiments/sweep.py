@@ -334,8 +334,9 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
     if figure.reference is not None:
         reference = (figure.reference, figure.reference_label)
     style = CurveStyle(
-        labels, figure.title, figure.y_label, figure.offset, figure.scale, reference, figure.x_max
-    )
+        labels, figure.title, figure.y_label, figure.offset, figure.scale, reference,
+        figure.x_max, (figure.y_min, figure.y_max),
+    )  # fmt: skip
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     if figure.against is not None:
         return plot_against(spec, paths, directory / figure.file)

@@ -52,7 +52,7 @@ class Point:
 
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "title", "y_label", "offset", "scale",
-    "reference", "reference_label", "x_max", "file", "against", "first",
+    "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -79,6 +79,10 @@ class FigureSpec:
     reference_label: str = "reference"
     x_max: float | None = None
     """where the x axis ends: the book's last step or episode (default: the longest seed's)"""
+    y_min: float | None = None
+    """where the y axis starts, as the book's figure (default: automatic)"""
+    y_max: float | None = None
+    """where the y axis ends (default: automatic)"""
     file: str = "figure.png"
     """written in the sweep directory: ``.png``, ``.svg`` or ``.pdf``"""
     against: str | None = None
@@ -279,7 +283,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "smooth": (int,), "log_y": (bool,), "title": (str,), "y_label": (str,),
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
-        "against": (str,), "first": (int,),
+        "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)
@@ -301,7 +305,10 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         raise ConfigError(f"{where}: figure.first: must be at least 1, got {values['first']}.")
     if values.get("x_max") is not None and values["x_max"] <= 0:
         raise ConfigError(f"{where}: figure.x_max: must be positive, got {values['x_max']}.")
-    for key in ("offset", "scale", "reference", "x_max"):
+    low, high = values.get("y_min"), values.get("y_max")
+    if low is not None and high is not None and not low < high:
+        raise ConfigError(f"{where}: figure.y_min: must be below figure.y_max ({low} >= {high}).")
+    for key in ("offset", "scale", "reference", "x_max", "y_min", "y_max"):
         if values.get(key) is not None:
             values[key] = float(values[key])
     return FigureSpec(**values)
