@@ -6,7 +6,7 @@ metadata), :mod:`~cartpole_q.config.yaml_io` (safe YAML, the shipped configs),
 :mod:`~cartpole_q.config.validation` (the readers and the cross-key rules),
 :mod:`~cartpole_q.config.diff` (what differs between configs),
 :mod:`~cartpole_q.config.loading` (:func:`load_config`, putting them together) and
-:mod:`~cartpole_q.config.reference` (the README's key table, generated).
+:mod:`~cartpole_q.config.reference` (the configuration page's key table, generated).
 
 This package imports neither numba nor gymnasium, so that the command line starts fast.
 

@@ -1,12 +1,12 @@
-"""The README's config reference, generated: ``python -m cartpole_q.config.reference``.
+"""The config reference of docs/reference/configuration.md, generated: ``python -m cartpole_q.config.reference``.
 
 One row per key, in file order: its name, its value in the embedded default
 (``default.yaml``) and its :class:`~cartpole_q.config.schema.Key` doc, with the ranges and
 choices the validation uses. The registries fill in what the schema cannot know: the
 algorithms' names and their own keys (from their :class:`~cartpole_q.rl.algorithm.Param`
 declarations), and the physics each environment's profile allows. It documents what is
-registered, so a fresh process prints the package's own; the README's ``## Configuration``
-table is that output, and a test fails when they differ.
+registered, so a fresh process prints the package's own; docs/reference/configuration.md's table
+is that output, and a test fails when they differ.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from cartpole_q.rl.algorithms import algorithms
 from cartpole_q.rl.algorithms import names as algorithm_names
 
 HEADER = "| key | default | meaning |\n| --- | --- | --- |\n"
-"""the table's first two lines (the README test finds the table by them)"""
+"""the table's first two lines (the reference test finds the table by them)"""
 
 
 def reference_table() -> str:

@@ -175,7 +175,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     if not raw:
         raise ConfigError(
             f"{where}: is empty; a sweep file gives `grid` (or `zip`) axes over config keys, "
-            "and usually `base` and `seeds` (see the README's sweep section)."
+            "and usually `base` and `seeds` (see docs/commands.md, `cartpole-q sweep`)."
         )
     check_top_keys(raw, SWEEP_KEYS, where)
     name = checked_name(raw, default_name, where)

@@ -550,7 +550,7 @@ def connect_ray(workers: int, address: str | None) -> bool:
             f"--address {address}: cannot connect to a Ray cluster ({error}). Is `ray start "
             "--head` running there? Ray 2.59 and later use token authentication: on the head "
             "machine `--address auto` works; elsewhere set RAY_AUTH_MODE=token and give the "
-            "cluster's token (see the README)."
+            "cluster's token (see docs/tutorials/ray-cluster.md)."
         ) from None
     finally:
         if main:
