@@ -102,27 +102,28 @@ class NumbaEngine:
         self.evaluate(state.tables.q, 0, 0)
 
     def _compile_side_by_side(self, state: TrainingState) -> None:
-        """Compile the exploring episode loop here while a child compiles the greedy ones.
+        """Compile the exploring episode loop and the greedy play here, the greedy loop in a child.
 
         Each loop is compiled by running it on scratch copies for one step (a compiled
         function is compiled for the argument types of its first call); the child writes
-        numba's cache and exits, and the outer loop then loads its code from there. Where a
-        process cannot fork (or has threads, where forking is unsafe), everything is
-        compiled here, one after another.
+        numba's cache and exits, and the outer loop then loads its code from there. (The
+        greedy play is the smaller compilation: it goes with the exploring loop, which
+        compiles faster than the greedy one.) Where a process cannot fork (or has threads,
+        where forking is unsafe), everything is compiled here, one after another.
         """
         if not hasattr(os, "fork") or threading.active_count() > 1:
             return
         child = os.fork()
-        if child == 0:  # the child: the greedy loops, then exit without clean-up
+        if child == 0:  # the child: the greedy episode loop, then exit without clean-up
             code = 1
             try:
                 self._scratch_episode(state, self._kernel.greedy_episode, 0.0)
-                self.evaluate(state.tables.q.copy(), 0, 0)
                 code = 0
             finally:
                 os._exit(code)
         try:
             self._scratch_episode(state, self._kernel.exploring_episode, 0.5)
+            self.evaluate(state.tables.q.copy(), 0, 0)
         finally:
             os.waitpid(child, 0)
 

@@ -144,9 +144,7 @@ def best_value(q: Table, state: int) -> float:
 @compilable
 def epsilon_greedy(q: Table, state: int, epsilon: float, rng: Rng) -> int:
     """A uniform random action with probability ``epsilon``, else the greedy one."""
-    if epsilon <= 0.0:
-        return best_action(q, state)
-    if epsilon >= 1.0 or rng.random() < epsilon:
+    if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
         return int(rng.integers(0, action_count(q)))
     return best_action(q, state)
 
@@ -158,20 +156,25 @@ def tied_best_action(q: Table, state: int, rng: Rng) -> int:
     Among the ``k`` actions whose value equals the largest, the ``rng.integers(0, k)``-th in
     action order; nothing is drawn when one action is best (or none compares equal: NaN).
     """
-    best = best_value(q, state)
-    tied = 0
-    for action in range(action_count(q)):
-        if value(q, state, action) == best:
+    # One pass finds the largest value, its lowest action and how many actions tie for it:
+    # compiled code inlines every call, so fewer calls compile faster.
+    n_actions = action_count(q)
+    greedy, best, tied = 0, value(q, state, 0), 1
+    for action in range(1, n_actions):
+        entry = value(q, state, action)
+        if entry > best:
+            greedy, best, tied = action, entry, 1
+        elif entry == best:
             tied += 1
     if tied <= 1:
-        return best_action(q, state)
+        return greedy
     pick = int(rng.integers(0, tied))
-    for action in range(action_count(q)):
+    for action in range(greedy, n_actions):
         if value(q, state, action) == best:
             if pick == 0:
                 return action
             pick -= 1
-    return best_action(q, state)
+    return greedy
 
 
 @compilable
