@@ -125,13 +125,22 @@ def _run_sweep(
     from cartpole_q.experiments.workers import default_workers
     from cartpole_q.progress import make_sweep_progress
 
-    if not quiet:
+    def say_compiling(loops: int) -> None:
+        if not quiet:
+            typer.echo(
+                f"compiling {loops} training loop{'s' if loops > 1 else ''} first: once per "
+                "machine and version, a few seconds each...",
+                err=True,
+            )
+
+    if not quiet and backend is BackendChoice.ray:
         say_if_compiling(spec.points[0].config)
     progress = make_sweep_progress(quiet)
     with stoppable(f"finish it with `cartpole-q sweep --resume {directory}`") as stop:
         return sweeping.run_sweep(
             spec, directory, workers=workers or default_workers(spec.runs),
             backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
+            on_compile=say_compiling,
         )  # fmt: skip
 
 

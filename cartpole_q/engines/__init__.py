@@ -78,6 +78,32 @@ def make_engine(
     return GymnasiumEngine(config, params, env_seed, env_rng_state, step_cap)
 
 
+def loop_name(config: Config, env_info: EnvInfo, engine: str) -> str:
+    """The compiled loop a run of ``config`` on ``engine`` calls, as numba's cache names it."""
+    from cartpole_q.engines.base import kernel_name, step_function_name
+    from cartpole_q.rl.algorithms import get as get_algorithm
+
+    algorithm = get_algorithm(config.agent.algorithm)
+    grid = config.discretization
+    tiled = grid is not None and grid.tilings > 1
+    if engine == "numba":
+        from cartpole_q.envs.registry import TwinSettings, twin_settings
+
+        settings = twin_settings(
+            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
+        )
+        assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
+        randomized = bool(config.env.randomize)
+        return kernel_name(algorithm.key, settings.twin.key, randomized, tiled)
+    if tiled:
+        kind = "tiles"
+    elif grid is not None:
+        kind = "box"
+    else:  # a Discrete observation has one start, a Tuple one per component
+        kind = "tuple" if len(env_info.index_starts or ()) > 1 else "discrete"
+    return step_function_name("next_step", algorithm.key, kind)
+
+
 def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None:
     """What to tell a user before a run whose compiled loop is not in numba's cache yet.
 
@@ -86,27 +112,12 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
         when the loop is cached.
     """
     from cartpole_q.numba_cache import is_cached
-    from cartpole_q.rl.algorithms import get as get_algorithm
 
-    algorithm = get_algorithm(config.agent.algorithm)
-    if engine == "numba":
-        from cartpole_q.envs.registry import TwinSettings, twin_settings
-
-        settings = twin_settings(
-            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
-        )
-        assert isinstance(settings, TwinSettings)
-        name = f"train_episodes__{algorithm.key}__{settings.twin.key}"
-        seconds = "a few seconds"
-    else:
-        kind = "box" if config.discretization is not None else "discrete"
-        name = f"next_step__{algorithm.key}__{kind}"
-        seconds = "a few seconds"
-    if is_cached(name):
+    if is_cached(loop_name(config, env_info, engine)):
         return None
     return (
         f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "
-        f"({engine} engine): once per machine and version, {seconds}..."
+        f"({engine} engine): once per machine and version, a few seconds..."
     )
 
 

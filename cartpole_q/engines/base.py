@@ -21,6 +21,25 @@ from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 
 
+def kernel_name(algorithm_key: str, twin_key: str, randomized: bool, tiled: bool) -> str:
+    """The numba engine's outer loop for one pair, as numba's cache names it.
+
+    >>> kernel_name("sarsa", "cartpole_0123", randomized=True, tiled=False)
+    'train_episodes__sarsa__cartpole_0123__randomized'
+    """
+    pair = f"{algorithm_key}__{twin_key}" + ("__tiles" if tiled else "")
+    return f"train_episodes__{pair}" + ("__randomized" if randomized else "")
+
+
+def step_function_name(step: str, algorithm_key: str, kind: str) -> str:
+    """One of the gymnasium engine's compiled step functions, as numba's cache names it.
+
+    >>> step_function_name("next_step", "sarsa_0123", "tiles")
+    'next_step__sarsa_0123__tiles'
+    """
+    return f"{step}__{algorithm_key}__{kind}"
+
+
 class ScheduleRecord(NamedTuple):
     """A schedule as the compiled code takes it (see :mod:`cartpole_q.rl.schedules`)."""
 

@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from cartpole_q.config import Config
-from cartpole_q.engines.base import AgentParams, TrainingState
+from cartpole_q.engines.base import AgentParams, TrainingState, step_function_name
 from cartpole_q.engines.compile import specialise
 from cartpole_q.engines.context import StepContext, step_context
 from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
@@ -81,13 +81,13 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
         "ALGORITHM_END": algorithm.end,
         "OBSERVATION_STATE": STATE_RULES[kind],
     }
-    suffix = f"{algorithm.key}__{kind}"
     tiled = kind == "tiles"
-    return (
-        specialise(first_step, f"first_step__{suffix}", bindings, tiled=tiled),
-        specialise(next_step, f"next_step__{suffix}", bindings, tiled=tiled),
-        specialise(end_episode, f"end_episode__{suffix}", bindings, tiled=tiled),
-    )
+
+    def compiled(template: Any) -> Any:
+        name = step_function_name(template.__name__, algorithm.key, kind)
+        return specialise(template, name, bindings, tiled=tiled)
+
+    return compiled(first_step), compiled(next_step), compiled(end_episode)
 
 
 def observation_kind(space: Any) -> str:

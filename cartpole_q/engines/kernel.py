@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid
+from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid, kernel_name
 from cartpole_q.engines.compile import specialise
 from cartpole_q.engines.rows import ARRAY_STATE_RULES
 from cartpole_q.envs.registry import Twin
@@ -259,7 +259,7 @@ def _training_kernel(
     greedy = specialise(
         twin_episode, f"greedy_episode__{pair}", {**hooks, "GREEDY": True}, tiled=tiled
     )
-    name = f"train_episodes__{pair}" + ("__randomized" if randomized else "")
+    name = kernel_name(algorithm_key, twin_key, randomized, tiled)
     outer = specialise(
         train_episodes,
         name,

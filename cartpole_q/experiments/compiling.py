@@ -5,12 +5,17 @@ This compiles the loops of a config (the embedded default's, or any), or with ``
 loops of every registered algorithm on every environment with a compiled twin and on the
 gymnasium engine for each observation kind, spread over worker processes; later runs load
 them from the cache in a fraction of a second.
+
+Studies use :func:`compile_ahead`: before their runs start, each distinct loop they will run
+and the cache lacks is compiled once, the loops side by side on the workers. Without it every
+worker compiles each loop it meets: on a cold cache two workers starting the same point
+both compile it, and a study of several algorithms compiles each of them once per worker.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -100,3 +105,74 @@ def compile_all(
         workers=workers or default_workers(len(jobs)), should_stop=should_stop,
     )  # fmt: skip
     return done, time.perf_counter() - started
+
+
+def compile_ahead(
+    configs: Sequence[Config],
+    workers: int,
+    should_stop: Callable[[], bool] | None = None,
+    on_start: Callable[[int], None] | None = None,
+) -> int:
+    """Compile the distinct loops ``configs`` will run that numba's cache lacks, once each.
+
+    One loop is compiled in this process (worker processes forked later inherit it); several
+    are compiled side by side on up to ``workers`` processes (the runs' workers then load
+    them from the cache).
+
+    Args:
+        configs: the configs of the runs about to start (validated).
+        workers: the worker processes the runs will use.
+        should_stop: polled between loops (a loop being compiled is finished first).
+        on_start: told how many loops are about to be compiled (not called for none).
+
+    Returns:
+        How many loops were compiled.
+    """
+    from cartpole_q.engines import loop_name, resolve_engine
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.numba_cache import is_cached
+
+    missing: dict[str, tuple[dict[str, Any], str]] = {}
+    seen: set[tuple[Any, ...]] = set()
+    for config in configs:
+        signature = _loop_signature(config)
+        if signature in seen:
+            continue
+        seen.add(signature)
+        info = inspect_env(config)
+        engine = resolve_engine(config, info)
+        name = loop_name(config, info, engine)
+        if name not in missing and not is_cached(name):
+            missing[name] = (config.to_dict(), engine)
+    if not missing:
+        return 0
+    if on_start is not None:
+        on_start(len(missing))
+    execute(
+        _compile_loop, list(missing.values()), lambda index, item: None,
+        workers=min(workers, len(missing)), should_stop=should_stop,
+    )  # fmt: skip
+    return len(missing)
+
+
+def _loop_signature(config: Config) -> tuple[Any, ...]:
+    """What decides which loops a config compiles (physics values and seeds do not)."""
+    grid = config.discretization
+    return (
+        config.engine,
+        config.agent.algorithm,
+        config.env.id,
+        repr(config.env.kwargs),
+        None if grid is None else grid.tilings,
+        bool(config.env.randomize),
+        config.train.info_metric,
+    )
+
+
+def _compile_loop(handle: JobHandle, mapping: dict[str, Any], engine: str) -> str:
+    """Job: compile (or load) the loops of one config on one engine."""
+    from cartpole_q.engines import precompile
+
+    if not handle.should_stop():
+        precompile(load_config(mapping), engine)
+    return engine

@@ -19,6 +19,7 @@ from typing import Any
 
 from cartpole_q.config import format_seeds, load_config
 from cartpole_q.errors import RunError
+from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.run import (
     Prepared,
     check_resumable,
@@ -110,6 +111,8 @@ def run_seeds(
         items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
         size = chunk_size(len(items), workers)
         chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
+        if len(chunks) > 1:  # compiled once here, not once per worker
+            compile_ahead([config], workers, should_stop)
         execute(
             _train_seeds, chunks, on_item,
             workers=workers, should_stop=should_stop, reporter=reporter,

@@ -28,6 +28,7 @@ from cartpole_q.config import (
     shown_value,
 )
 from cartpole_q.errors import RunError
+from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_info, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
@@ -265,6 +266,7 @@ def run_sweep(
     address: str | None = None,
     progress: SweepProgress | None = None,
     should_stop: Callable[[], bool] | None = None,
+    on_compile: Callable[[int], None] | None = None,
 ) -> SweepOutcome:
     """Run whatever ``results.csv`` of ``directory`` does not have yet, then summarise.
 
@@ -277,6 +279,8 @@ def run_sweep(
         progress: receives the count of finished runs.
         should_stop: polled between runs; when true, the finished runs are saved and
             the sweep ends, to be finished with ``--resume``.
+        on_compile: told how many training loops are compiled before the runs start (on
+            the local backend: see :func:`~cartpole_q.experiments.compiling.compile_ahead`).
 
     Returns:
         How far it got; when complete, ``points.csv`` and ``sweep.png`` are written.
@@ -293,6 +297,13 @@ def run_sweep(
         for seed in spec.seeds
         if (point.index, seed) not in book.rows
     ]
+    if backend == "local":  # before the progress bar: its thread would stop forking
+        points = {point for point, _ in missing}
+        configs = [point.config for point in spec.points if point.index in points]
+        try:
+            compile_ahead(configs, workers, should_stop, on_compile)
+        except KeyboardInterrupt:
+            raise SweepInterrupted(directory, book.saved, spec.runs) from None
     progress.start(spec.runs, len(book.rows), len(spec.points), book.points_done())
     tasks = plan_tasks(spec, missing, workers)
 

@@ -1,0 +1,97 @@
+"""Compiling a study's loops once, before its runs: the names numba caches them under.
+
+The loops here (Q-learning and SARSA on CartPole's twin, with and without ``env.randomize``,
+on tiles, and on the gymnasium engine for a Box, a Discrete and a Tuple) are loops the rest
+of the suite compiles anyway, so on a cold cache they cost no extra compilation.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+import cartpole_q.numba_cache
+from cartpole_q.config import Config, load_config
+from cartpole_q.engines import loop_name, resolve_engine
+from cartpole_q.envs.gym import inspect_env
+from cartpole_q.experiments.compiling import compile_ahead
+from cartpole_q.numba_cache import is_cached
+from cartpole_q.training import train
+from tests.conftest import invoke, write_yaml
+
+RANDOMIZE = {"env.randomize": {"length": [0.4, 0.6]}}
+TILES = {"discretization": {"bins": [1, 1, 3, 5], "tilings": 3}}
+
+
+def _config(**overrides: Any) -> Config:
+    return load_config(overrides={"train.episodes": 2, "eval.episodes": 1, **overrides})
+
+
+@pytest.mark.parametrize(
+    ("overrides", "expected"),
+    [
+        ({}, "train_episodes__q_learning_"),
+        (RANDOMIZE, "train_episodes__q_learning_"),
+        ({**TILES, "engine": "numba"}, "train_episodes__q_learning_"),
+        ({"engine": "gymnasium"}, "next_step__q_learning_"),
+        ({"env.id": "FrozenLake-v1", "engine": "gymnasium"}, "next_step__q_learning_"),
+        ({"env.id": "Blackjack-v1", "engine": "gymnasium"}, "next_step__q_learning_"),
+    ],
+    ids=["numba", "randomized", "tiles", "box", "discrete", "tuple"],
+)
+def test_loop_name_is_what_numba_caches_once_trained(
+    overrides: dict[str, Any], expected: str
+) -> None:
+    config = _config(**overrides)
+    info = inspect_env(config)
+    name = loop_name(config, info, resolve_engine(config, info))
+    assert name.startswith(expected)
+    kind = {"randomized": "__randomized", "tiles": "__tiles"}
+    for key, suffix in (("env.randomize", kind["randomized"]), ("discretization", "__tiles")):
+        assert name.endswith(suffix) == (key in overrides)
+    train(config, final_eval=False)
+    assert is_cached(name)
+
+
+def test_compile_ahead_asks_once_per_distinct_loop_and_fills_the_cache(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    configs = [
+        _config(),
+        _config(**{"seed": 7, "agent.alpha": 0.3, "env.physics": {"length": 0.6}}),
+        _config(**{"agent.algorithm": "sarsa"}),
+        _config(**RANDOMIZE),
+    ]
+    asked: list[str] = []
+
+    def never_cached(name: str) -> bool:
+        asked.append(name)
+        return False
+
+    monkeypatch.setattr(cartpole_q.numba_cache, "is_cached", never_cached)
+    assert compile_ahead(configs, workers=2) == 3  # seed, alpha and physics are no new loop
+    assert len(asked) == len(set(asked)) == 3
+    monkeypatch.undo()
+    assert all(is_cached(name) for name in asked)
+    assert compile_ahead(configs, workers=2) == 0
+
+
+def test_a_sweep_says_how_many_loops_it_compiles_first(
+    in_tmp: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(cartpole_q.numba_cache, "is_cached", lambda name: False)
+    sweep = write_yaml(
+        in_tmp / "s.yaml",
+        {
+            "base": {"train": {"episodes": 3, "eval_every": 0}, "eval": {"episodes": 1}},
+            "grid": {"agent.algorithm": ["q_learning", "sarsa"]},
+            "seeds": "0-1",
+        },
+    )
+    result = invoke("sweep", sweep, "--out", in_tmp / "out", "--workers", 2)
+    assert result.exit_code == 0, result.output
+    assert "compiling 2 training loops first" in result.stderr
+    result = invoke("sweep", sweep, "--out", in_tmp / "quiet", "--workers", 2, "--quiet")
+    assert "compiling" not in result.stderr
