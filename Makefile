@@ -23,7 +23,7 @@ train: $(STAMP)
 	$(BIN)/cartpole-q train
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -n 2
+	$(BIN)/python -m pytest -n 2 --dist loadgroup
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -1,6 +1,7 @@
 """This checkout against another one, side by side in one run: training throughput and start-up.
 
     python benchmarks/versus.py --baseline /path/to/other/checkout [--repeats 5] [--quick]
+        [--skip-cold] [--algorithms A,B,... [--only-algorithms]]
 
 The baseline is any checkout of cartpole-q (``git worktree add /tmp/base <commit>``). Each
 figure is measured in a fresh interpreter per side, the two sides interleaved (A B A B ...),
@@ -8,7 +9,8 @@ and the median of ``--repeats`` is quoted with the ratio this / baseline, so tha
 machine's drift cancels out. Each side keeps its own numba cache directory.
 
 Rows:
-  numba, <algorithm>       env steps/s of the default config, each algorithm both have
+  numba, <algorithm>       env steps/s of the default config with each algorithm (design.md's
+                           four, or --algorithms; both checkouts must have them)
   numba, <environment>     env steps/s of Q-learning on MountainCar-v0 and Acrobot-v1 twins
   gymnasium / blog loop    the gymnasium engine's rate over the blog tutorial's loop, measured
                            in the same interpreter (so the ratio is that side's own)
@@ -91,6 +93,12 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5)
     parser.add_argument("--quick", action="store_true", help="fewer episodes (a rough check)")
     parser.add_argument("--skip-cold", action="store_true", help="leave out the cold start")
+    parser.add_argument(
+        "--algorithms",
+        default="q_learning,sarsa,expected_sarsa,double_q_learning",
+        help="comma-separated agent.algorithm values to compare",
+    )
+    parser.add_argument("--only-algorithms", action="store_true", help="only the algorithms' rows")
     args = parser.parse_args()
     scale = 0.2 if args.quick else 1.0
     sides = {"this": CHECKOUT, "baseline": args.baseline.resolve()}
@@ -101,13 +109,17 @@ def main() -> None:
 
     rows: list[tuple[str, str, str, int]] = [
         (f"numba, {name}", "algorithm", name, int(10_000 * scale))
-        for name in ("q_learning", "sarsa", "expected_sarsa", "double_q_learning")
+        for name in args.algorithms.split(",")
     ]
-    rows += [
-        ("numba, MountainCar-v0", "environment", "mountaincar", int(5_000 * scale)),
-        ("numba, Acrobot-v1", "environment", "acrobot", int(2_000 * scale)),
-        ("gymnasium / blog loop", "versus_blog", "", max(20, int(400 * scale))),
-    ]
+    rows += (
+        []
+        if args.only_algorithms
+        else [
+            ("numba, MountainCar-v0", "environment", "mountaincar", int(5_000 * scale)),
+            ("numba, Acrobot-v1", "environment", "acrobot", int(2_000 * scale)),
+            ("gymnasium / blog loop", "versus_blog", "", max(20, int(400 * scale))),
+        ]
+    )
     print(
         f"{'figure (median of ' + str(args.repeats) + ')':34s} {'this':>14s} {'baseline':>14s} {'ratio':>7s}"
     )
@@ -121,6 +133,8 @@ def main() -> None:
         print(f"{label:34s} {fmt.format(this)} {fmt.format(base)} {this / base:7.2f}")
 
     timings = [("train, warm (s)", False)] + ([] if args.skip_cold else [("train, cold (s)", True)])
+    if args.only_algorithms:
+        timings = []
     for label, cold in timings:
         seconds: dict[str, list[float]] = {name: [] for name in sides}
         for repeat in range(args.repeats + (0 if cold else 1)):

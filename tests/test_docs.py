@@ -4,7 +4,8 @@ Every fenced ``bash`` block of ``docs/tutorials/*.md`` runs, in page order, in o
 directory per page, after the page's files (fences with ``title="NAME"``) are written
 there. A block that cannot run here is preceded by ``<!-- not run: REASON -->``. The
 commands run as printed, on smaller settings: a seed range ``A-B`` becomes ``A-(A+1)`` (two
-seeds), and the study files under ``examples/`` are copied with two seeds and a few trials.
+seeds), and the study files under ``examples/`` are copied with two seeds and a few trials
+(the book's, ``examples/book/``, with two values per sweep axis).
 Each figure a tutorial shows must be written by a command printed on its page (its path
 from the repository's root, e.g. ``docs/reward_curves.png``), and is, when the page runs.
 """
@@ -85,8 +86,13 @@ def shrink(command: str) -> str:
     return SEED_RANGE.sub(two_seeds, command)
 
 
-def shrink_study(path: Path) -> None:
-    """A sweep or tune file on small settings: two seeds, a few trials (comments dropped)."""
+def shrink_study(path: Path, axes: bool = False) -> None:
+    """A sweep or tune file on small settings (comments dropped).
+
+    Two seeds, a few trials, and with ``axes`` each sweep axis cut to its first and last
+    values (a zip's axes to their first two): the study keeps its shape and its figure, on
+    fewer points (for studies whose points no page names by number: the book's).
+    """
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict):
         return
@@ -94,6 +100,13 @@ def shrink_study(path: Path) -> None:
         data["seeds"] = shrink(str(data["seeds"]))
     if "trials" in data:
         data["trials"] = min(int(data["trials"]), STUDY_TRIALS)
+    if axes:
+        for key, values in (data.get("grid") or {}).items():
+            if isinstance(values, list) and len(values) > 2:
+                data["grid"][key] = [values[0], values[-1]]
+        for key, values in (data.get("zip") or {}).items():
+            if isinstance(values, list):
+                data["zip"][key] = values[:2]
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
 
 
@@ -113,6 +126,22 @@ def test_shrink_cuts_seed_ranges_and_nothing_else() -> None:
     assert shrink("# 2026-11-22, kappa 1e-4, length=0.1:1.0:10") == (
         "# 2026-11-22, kappa 1e-4, length=0.1:1.0:10"
     )
+
+
+def test_shrink_study_keeps_two_seeds_a_few_trials_and_two_values_per_axis(tmp_path: Path) -> None:
+    study = tmp_path / "s.yaml"
+    study.write_text(
+        "# a comment\nseeds: 0-99\ntrials: 40\ngrid:\n  agent.alpha: [0.1, 0.2, 0.5]\n"
+        "  agent.n: [1, 2]\nzip:\n  agent.lambda: [0, 0.5, 0.9]\n  agent.gamma: [1, 0.9, 0.8]\n",
+        encoding="utf-8",
+    )
+    shrink_study(study, axes=True)
+    assert yaml.safe_load(study.read_text(encoding="utf-8")) == {
+        "seeds": "0-1",
+        "trials": STUDY_TRIALS,
+        "grid": {"agent.alpha": [0.1, 0.5], "agent.n": [1, 2]},
+        "zip": {"agent.lambda": [0, 0.5], "agent.gamma": [1, 0.9]},
+    }
 
 
 def test_blocks_are_found_with_their_titles_and_reasons(tmp_path: Path) -> None:
@@ -167,7 +196,7 @@ def _run_page(page: Path, workdir: Path) -> None:
     os.symlink(REPO / "configs", workdir / "configs")
     shutil.copytree(REPO / "examples", workdir / "examples")
     for study in (workdir / "examples").rglob("*.yaml"):
-        shrink_study(study)
+        shrink_study(study, axes=study.parent.name == "book")
     for figure in figures(page):
         (workdir / figure).parent.mkdir(parents=True, exist_ok=True)
     env = {

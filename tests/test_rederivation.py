@@ -387,6 +387,9 @@ def _params(worlds: list[str], variants: list[str], slow: str = "none") -> list[
         for variant in variants:
             marked = slow == "all" or (slow == "beyond_one_step" and variant not in ONE_STEP)
             marks = [pytest.mark.slow] if marked else []
+            # Both engines' tests of a pair on one worker, which re-derives it once
+            # (``make test`` runs pytest with ``--dist loadgroup``).
+            marks.append(pytest.mark.xdist_group(f"{world}-{variant}"))
             for engine in engines:
                 chosen = OTHER_TWIN_VARIANTS.get(world)
                 if engine == "numba" and chosen is not None and variant not in chosen:

@@ -275,10 +275,17 @@ def test_train_takes_a_path_a_name_or_a_mapping(tmp_path: Path) -> None:
 
 # -- real signals, in a subprocess ---------------------------------------------------------
 
+# Long enough that a signal sent at the first checkpoint lands in training on a fast machine.
+SLOW_EPISODES = 600
 SLOW_TRAINING = {
     "name": "slow",
     "engine": "gymnasium",
-    "train": {"episodes": 1500, "stop_when_solved": False, "checkpoint_every": 5, "eval_every": 0},
+    "train": {
+        "episodes": SLOW_EPISODES,
+        "stop_when_solved": False,
+        "checkpoint_every": 5,
+        "eval_every": 0,
+    },
     "eval": {"episodes": 5},
 }
 
@@ -339,7 +346,7 @@ def test_sigint_or_sigterm_completes_the_run_directory_and_exits_130(
     assert "Traceback" not in stderr and f"{name}: stopping after the current episode" in stderr
     assert stdout.strip().splitlines()[-1] == str(run)
     summary = json.loads((run / "summary.json").read_text())
-    assert summary["interrupted"] is True and 5 <= summary["episodes"] < 1500
+    assert summary["interrupted"] is True and 5 <= summary["episodes"] < SLOW_EPISODES
     assert _check_every_file_loads(run) >= 7
     assert len(rundir.load_run(run).metrics.returns) == summary["episodes"]
 

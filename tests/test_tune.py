@@ -172,7 +172,7 @@ def _journal_trials(directory: Path) -> list[Any]:
 
 @pytest.mark.slow
 def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: Path) -> None:
-    path = write_yaml(tmp_path / "k.yaml", {**TUNE, "trials": 12, "seeds": "0-19"})
+    path = write_yaml(tmp_path / "k.yaml", {**TUNE, "trials": 6, "seeds": "0-9"})
     out = tmp_path / "out"
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
@@ -184,11 +184,11 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     finally:
         os.killpg(process.pid, signal.SIGKILL)
         process.wait()
-    assert len([t for t in _journal_trials(out) if t.state.name == "COMPLETE"]) < 12
+    assert len([t for t in _journal_trials(out) if t.state.name == "COMPLETE"]) < 6
     result = invoke("tune", "--resume", out, "-q")
     assert result.exit_code == 0, result.output
     trials = _journal_trials(out)
-    assert sum(t.state.name == "COMPLETE" for t in trials) == 12
+    assert sum(t.state.name == "COMPLETE" for t in trials) == 6
     assert not [t for t in trials if t.state.name == "RUNNING"]
 
 
