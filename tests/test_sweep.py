@@ -564,6 +564,29 @@ def test_every_finished_run_is_saved_at_once_whatever_the_task_size(tmp_path: Pa
         assert rows[(row["point"], row["seed"])] == row
 
 
+def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real SIGINT right after ``sweep.yaml`` is written, before any run or compilation."""
+    start = sweeping.start_sweep
+
+    def start_then_signal(*args: Any) -> Path:
+        directory = start(*args)
+        os.kill(os.getpid(), signal.SIGINT)
+        return directory
+
+    monkeypatch.setattr(sweeping, "start_sweep", start_then_signal)
+    directory = tmp_path / "early"
+    result = invoke("sweep", write_yaml(tmp_path / "s.yaml", SWEEP), "--out", directory, "-q")
+    assert result.exit_code == 130, result.output
+    results = directory / sweepdir.RESULTS_FILE
+    assert f"no run had finished, so nothing is saved in {results} yet" in result.stderr
+    assert f"cartpole-q sweep --resume {directory}" in result.stderr
+    resumed = invoke("sweep", "--resume", directory, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert len(_results(directory)) == 12
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("early", [True, False], ids=["before-any-run", "after-some-runs"])
 def test_a_second_sigint_says_exactly_what_is_saved(tmp_path: Path, early: bool) -> None:

@@ -9,7 +9,7 @@ Heavy modules (numpy, numba, gymnasium, matplotlib) are imported inside the comm
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from enum import StrEnum
 from typing import TYPE_CHECKING, Annotated, Any, NoReturn
@@ -174,7 +174,7 @@ def exit_codes() -> Iterator[None]:
 
 
 @contextmanager
-def stoppable(hint: str) -> Iterator[StopRequest]:
+def stoppable(hint: str | Callable[[], str]) -> Iterator[StopRequest]:
     """The one stop routine of every command that can stop cleanly.
 
     A first SIGINT or SIGTERM asks the work to stop at its next safe point (the request is
@@ -182,7 +182,8 @@ def stoppable(hint: str) -> Iterator[StopRequest]:
     with ``hint`` (how to go on) and exits with 130.
 
     An exception with a ``text`` attribute (a sweep's, saying exactly what was saved) puts
-    it before the hint. After the block, :func:`exit_if_stopped` ends a stopped command.
+    it before the hint (a callable hint is asked then, for what is known only later).
+    After the block, :func:`exit_if_stopped` ends a stopped command.
     """
     from cartpole_q.experiments.run import StopRequest
 
@@ -191,7 +192,8 @@ def stoppable(hint: str) -> Iterator[StopRequest]:
             yield stop
         except KeyboardInterrupt as error:
             saved = getattr(error, "text", None)
-            exit_interrupted(f"interrupted at once: {f'{saved}; ' if saved else ''}{hint}")
+            how = hint() if callable(hint) else hint
+            exit_interrupted(f"interrupted at once: {f'{saved}; ' if saved else ''}{how}")
 
 
 def exit_if_stopped(stopped: bool, hint: str) -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -72,9 +73,9 @@ def sweep_command(
                     "a SWEEP.yaml nor --out."
                 )
             sweepdir.sweep_file(resume)  # a sweep directory, before a lock file goes into it
-            with directory_lock(resume, "sweep"):
+            with directory_lock(resume, "sweep"), _stoppable_sweep(lambda: resume) as stop:
                 spec = sweeping.load_sweep_dir(resume)
-                outcome = _run_sweep(spec, resume, workers, backend, address, quiet)
+                outcome = _run_sweep(spec, resume, workers, backend, address, quiet, stop)
         else:
             if sweep_file is None:
                 raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
@@ -88,9 +89,13 @@ def sweep_command(
                 spec.runs, max_runs, yes, str(sweep_file),
                 f"{len(spec.points)} points x {len(spec.seeds)} seeds",
             )  # fmt: skip
-            directory = sweeping.start_sweep(spec, out)
-            with directory_lock(directory, "sweep"):
-                outcome = _run_sweep(spec, directory, workers, backend, address, quiet)
+            # A signal from the moment the directory exists is a request to stop that the
+            # sweep answers (saying what it saved), however early it comes.
+            started: list[Path] = []
+            with _stoppable_sweep(lambda: started[0] if started else None) as stop:
+                started.append(sweeping.start_sweep(spec, out))
+                with directory_lock(started[0], "sweep"):
+                    outcome = _run_sweep(spec, started[0], workers, backend, address, quiet, stop)
         if not quiet and outcome.complete:
             from cartpole_q.cli.report import print_sweep_summary
 
@@ -112,6 +117,18 @@ def _check_size(runs: int, max_runs: int, yes: bool, where: str, product: str) -
         )
 
 
+def _stoppable_sweep(directory: Callable[[], Path | None]) -> Any:
+    """The stop routine of a sweep in ``directory()`` (``None``: not created yet)."""
+
+    def hint() -> str:
+        where = directory()
+        if where is None:
+            return "no sweep directory was created"
+        return f"finish it with `cartpole-q sweep --resume {where}`"
+
+    return stoppable(hint)
+
+
 def _run_sweep(
     spec: Any,
     directory: Path,
@@ -119,8 +136,9 @@ def _run_sweep(
     backend: BackendChoice,
     address: str | None,
     quiet: bool,
+    stop: Any,
 ) -> Any:
-    """Run a (locked) sweep directory until done or stopped; exit 130 on a second signal."""
+    """Run a (locked) sweep directory until done or ``stop`` is set."""
     from cartpole_q.experiments import sweep as sweeping
     from cartpole_q.experiments.workers import default_workers
     from cartpole_q.progress import make_sweep_progress
@@ -136,12 +154,11 @@ def _run_sweep(
     if not quiet and backend is BackendChoice.ray:
         say_if_compiling(spec.points[0].config)
     progress = make_sweep_progress(quiet)
-    with stoppable(f"finish it with `cartpole-q sweep --resume {directory}`") as stop:
-        return sweeping.run_sweep(
-            spec, directory, workers=workers or default_workers(spec.runs),
-            backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
-            on_compile=say_compiling,
-        )  # fmt: skip
+    return sweeping.run_sweep(
+        spec, directory, workers=workers or default_workers(spec.runs),
+        backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
+        on_compile=say_compiling,
+    )  # fmt: skip
 
 
 @app.command("tune", cls=Command)
