@@ -588,3 +588,27 @@ def test_a_full_disk_costs_at_most_the_trial_in_flight_and_resume_recovers(
     assert states.count("complete") == 12
     assert states.count("fail") <= 1, "at most the trial in flight is lost"
     assert before >= 3
+
+
+def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A real SIGINT right after the tune directory is created, before any trial."""
+    from cartpole_q.experiments import tune as tuning
+
+    start = tuning.start_tune
+
+    def start_then_signal(*args: Any) -> Path:
+        directory = start(*args)
+        os.kill(os.getpid(), signal.SIGINT)
+        return directory
+
+    monkeypatch.setattr(tuning, "start_tune", start_then_signal)
+    directory = tmp_path / "early"
+    path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 2, "seeds": "0-1"})
+    result = invoke("tune", path, "--out", directory, "-q")
+    assert result.exit_code == 130, result.output
+    assert f"go on with `cartpole-q tune --resume {directory}`" in result.stderr
+    resumed = invoke("tune", "--resume", directory, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert len(_trials(directory)) == 2

@@ -73,7 +73,8 @@ def sweep_command(
                     "a SWEEP.yaml nor --out."
                 )
             sweepdir.sweep_file(resume)  # a sweep directory, before a lock file goes into it
-            with directory_lock(resume, "sweep"), _stoppable_sweep(lambda: resume) as stop:
+            hint = _resume_hint("sweep", "finish", lambda: resume)
+            with directory_lock(resume, "sweep"), stoppable(hint) as stop:
                 spec = sweeping.load_sweep_dir(resume)
                 outcome = _run_sweep(spec, resume, workers, backend, address, quiet, stop)
         else:
@@ -92,7 +93,8 @@ def sweep_command(
             # A signal from the moment the directory exists is a request to stop that the
             # sweep answers (saying what it saved), however early it comes.
             started: list[Path] = []
-            with _stoppable_sweep(lambda: started[0] if started else None) as stop:
+            hint = _resume_hint("sweep", "finish", lambda: started[0] if started else None)
+            with stoppable(hint) as stop:
                 started.append(sweeping.start_sweep(spec, out))
                 with directory_lock(started[0], "sweep"):
                     outcome = _run_sweep(spec, started[0], workers, backend, address, quiet, stop)
@@ -117,16 +119,18 @@ def _check_size(runs: int, max_runs: int, yes: bool, where: str, product: str) -
         )
 
 
-def _stoppable_sweep(directory: Callable[[], Path | None]) -> Any:
-    """The stop routine of a sweep in ``directory()`` (``None``: not created yet)."""
+def _resume_hint(
+    command: str, verb: str, directory: Callable[[], Path | None]
+) -> Callable[[], str]:
+    """How to go on with the study in ``directory()`` (``None``: not created yet)."""
 
     def hint() -> str:
         where = directory()
         if where is None:
-            return "no sweep directory was created"
-        return f"finish it with `cartpole-q sweep --resume {where}`"
+            return f"no {command} directory was created"
+        return f"{verb} it with `cartpole-q {command} --resume {where}`"
 
-    return stoppable(hint)
+    return hint
 
 
 def _run_sweep(
@@ -241,7 +245,8 @@ def tune_command(
                 spec, storage_url = tuning.load_tune_dir(resume)
                 where = str(resume / tunedir.TUNE_FILE)
                 _check_tune_size(spec, trials, max_runs, yes, where)
-                _tune(spec, resume, storage_url, trials, workers, backend, address, quiet)
+                with stoppable(_resume_hint("tune", "go on", lambda: resume)) as stop:
+                    _tune(spec, resume, storage_url, trials, workers, backend, address, quiet, stop)
             return
         if tune_file is None:
             raise UserError("give a TUNE.yaml file, or --resume DIR to go on with a study.")
@@ -250,9 +255,14 @@ def tune_command(
         storage_url = tuning.absolute_url(storage)
         tuning.optuna_module()
         tuning.check_storage(spec, storage_url, join, str(tune_file))
-        directory = tuning.start_tune(spec, out, storage_url)
-        with directory_lock(directory, "tune directory"):
-            _tune(spec, directory, storage_url, trials, workers, backend, address, quiet)
+        # A signal from the moment the directory exists is a request to stop that the
+        # study answers (with how to go on), however early it comes.
+        started: list[Path] = []
+        hint = _resume_hint("tune", "go on", lambda: started[0] if started else None)
+        with stoppable(hint) as stop:
+            started.append(tuning.start_tune(spec, out, storage_url))
+            with directory_lock(started[0], "tune directory"):
+                _tune(spec, started[0], storage_url, trials, workers, backend, address, quiet, stop)
 
 
 def _check_tune_size(spec: Any, trials: int | None, max_runs: int, yes: bool, where: str) -> None:
@@ -270,8 +280,9 @@ def _tune(
     backend: BackendChoice,
     address: str | None,
     quiet: bool,
+    stop: Any,
 ) -> None:
-    """Run a (locked) tune directory's study; print each trial and the best."""
+    """Run a (locked) tune directory's study until done or ``stop`` is set; print each trial."""
     from cartpole_q.experiments import tune as tuning
     from cartpole_q.experiments.workers import default_workers
 
@@ -290,12 +301,11 @@ def _tune(
     hint = f"go on with `cartpole-q tune --resume {directory}`"
     if not quiet:
         say_if_compiling(spec.config_for({}))
-    with stoppable(hint) as stop:
-        outcome = tuning.run_tune(
-            spec, directory, storage_url, trials=trials,
-            workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
-            address=address, should_stop=stop.is_set, on_trial=report,
-        )  # fmt: skip
+    outcome = tuning.run_tune(
+        spec, directory, storage_url, trials=trials,
+        workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
+        address=address, should_stop=stop.is_set, on_trial=report,
+    )  # fmt: skip
     if not quiet and outcome.best is not None:
         best = outcome.best
         typer.echo(
