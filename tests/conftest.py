@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import os
+import signal
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -54,3 +57,14 @@ def small_config_file(tmp_path: Path) -> Path:
 def invoke(*args: object) -> Result:
     """Run the command line in-process (unexpected exceptions propagate to the test)."""
     return CliRunner().invoke(app, [str(a) for a in args], catch_exceptions=False)
+
+
+def then_sigint(function: Callable[..., Any]) -> Callable[..., Any]:
+    """``function``, after which this process gets a real SIGINT (a signal at that moment)."""
+
+    def wrapped(*args: Any, **kwargs: Any) -> Any:
+        result = function(*args, **kwargs)
+        os.kill(os.getpid(), signal.SIGINT)
+        return result
+
+    return wrapped

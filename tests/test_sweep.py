@@ -26,7 +26,7 @@ from cartpole_q.experiments import sweep as sweeping
 from cartpole_q.experiments.sweep_spec import load_sweep
 from cartpole_q.statistics import summarize_point
 from cartpole_q.store import sweepdir
-from tests.conftest import invoke, write_yaml
+from tests.conftest import invoke, then_sigint, write_yaml
 
 # Short runs: 60 episodes of CartPole (few solve), so a sweep of 12 runs takes a second.
 BASE = {
@@ -568,14 +568,7 @@ def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A real SIGINT right after ``sweep.yaml`` is written, before any run or compilation."""
-    start = sweeping.start_sweep
-
-    def start_then_signal(*args: Any) -> Path:
-        directory = start(*args)
-        os.kill(os.getpid(), signal.SIGINT)
-        return directory
-
-    monkeypatch.setattr(sweeping, "start_sweep", start_then_signal)
+    monkeypatch.setattr(sweeping, "start_sweep", then_sigint(sweeping.start_sweep))
     directory = tmp_path / "early"
     result = invoke("sweep", write_yaml(tmp_path / "s.yaml", SWEEP), "--out", directory, "-q")
     assert result.exit_code == 130, result.output

@@ -16,7 +16,7 @@ import pytest
 from cartpole_q.config import ConfigError, load_config
 from cartpole_q.experiments.tune_spec import load_tune
 from cartpole_q.store import tunedir
-from tests.conftest import invoke, write_yaml
+from tests.conftest import invoke, then_sigint, write_yaml
 
 pytest.importorskip("optuna")
 
@@ -596,14 +596,7 @@ def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
     """A real SIGINT right after the tune directory is created, before any trial."""
     from cartpole_q.experiments import tune as tuning
 
-    start = tuning.start_tune
-
-    def start_then_signal(*args: Any) -> Path:
-        directory = start(*args)
-        os.kill(os.getpid(), signal.SIGINT)
-        return directory
-
-    monkeypatch.setattr(tuning, "start_tune", start_then_signal)
+    monkeypatch.setattr(tuning, "start_tune", then_sigint(tuning.start_tune))
     directory = tmp_path / "early"
     path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 2, "seeds": "0-1"})
     result = invoke("tune", path, "--out", directory, "-q")
