@@ -320,6 +320,22 @@ class Agent:
             return (1 - self.epsilon) + self.epsilon / self.n
         return self.epsilon / self.n
 
+    def b(self, c: int, x: int) -> float:
+        """``b(c | x)``: the probability with which ``draw(x)`` takes ``c``, ties as in force.
+
+        ``lowest``: ``pi(c | x)``. ``random``: ``(1 - epsilon) / k + epsilon / n`` for each
+        of the ``k`` tied best actions (``greedy(x)`` alone when none equals it), else
+        ``epsilon / n``.
+        """
+        if self.params.get("tie_break", "lowest") != "random":
+            return self.pi(c, x)
+        row = self.policy_row(x)
+        g = argmax(row)
+        tied = [d for d in range(self.n) if row[d] == row[g]] or [g]
+        if c in tied:
+            return (1 - self.epsilon) / len(tied) + self.epsilon / self.n
+        return self.epsilon / self.n
+
     # -- drawing and updating
 
     def draw(self, x: int) -> int:
@@ -540,21 +556,31 @@ class TraceAgent(Agent):
     def give_trace(self, s: Any, a: int) -> None:
         """Give ``(s, a)`` a trace (appended at 0.0 if it has none), by ``agent.trace``.
 
-        On tiles each of ``s``'s tiles gets its trace, dutch with the tile's ``alpha / T``.
+        On tiles each of ``s``'s tiles gets its trace; dutch is the book's eq. 12.11 over the
+        ``T`` binary features: ``S`` = the tiles' traces summed, then each tile
+        ``z = z + (1.0 - (alpha / T) * S)``.
         """
-        alpha = self.alpha / len(s) if isinstance(s, tuple) else self.alpha
+        kind = self.params["trace"]
+        if isinstance(s, tuple) and kind == "dutch":
+            total = 0.0
+            for row in s:
+                total = total + self.traces.get(row * self.n + a, 0.0)
+            amount = 1.0 - (self.alpha / len(s)) * total
+            for row in s:
+                flat = row * self.n + a
+                self.traces[flat] = self.traces.get(flat, 0.0) + amount
+            return
         for row in s if isinstance(s, tuple) else (s,):
             flat = row * self.n + a
             if flat not in self.traces:
                 self.traces[flat] = 0.0
             z = self.traces[flat]
-            kind = self.params["trace"]
             if kind == "accumulating":
                 z = z + 1.0
             elif kind == "replacing":
                 z = 1.0
             elif kind == "dutch":
-                z = (1.0 - alpha) * z + 1.0
+                z = (1.0 - self.alpha) * z + 1.0
             else:
                 raise ValueError(f"unknown trace {kind!r}")
             self.traces[flat] = z
@@ -761,7 +787,7 @@ class MonteCarlo(Agent):
     ) -> int | None:
         t = len(self.states)
         if self.off_policy:
-            self.behaviour.append(self.pi(a, s))
+            self.behaviour.append(self.b(a, s))
         elif s * self.n + a not in self.first_visit:
             self.first_visit[s * self.n + a] = t
         self.states.append(s)

@@ -354,6 +354,34 @@ def test_cartpole_threshold_scales_with_the_time_limit(overrides: dict, threshol
     assert inspect_env(load_config(overrides=overrides)).reward_threshold == threshold
 
 
+@pytest.mark.parametrize(
+    ("epsilon", "episodes", "refused"),
+    [
+        (1e-310, 10, True),  # a constant so small that epsilon / n can round to 0
+        ({"type": "exponential", "start": 1.0, "decay": 0.5, "end": 0.0}, 2000, True),
+        ({"type": "exponential", "start": 1.0, "decay": 0.5, "end": 0.0}, 900, False),
+        ({"type": "exponential", "start": 1.0, "decay": 0.995, "end": 0.0}, 1000, False),
+        (0.0, 10, False),  # greedy behaviour: b_t is 1 / k, never 0
+        (1e-300, 10, False),
+    ],
+)
+def test_off_policy_monte_carlo_refuses_an_epsilon_that_makes_it_undefined(
+    epsilon: object, episodes: int, refused: bool
+) -> None:
+    overrides = {
+        "agent.algorithm": "off_policy_monte_carlo",
+        "agent.epsilon": epsilon,
+        "train.episodes": episodes,
+    }
+    if not refused:
+        assert load_config(overrides=overrides).train.episodes == episodes
+        return
+    with pytest.raises(ConfigError, match=r"agent\.epsilon: off_policy_monte_carlo divides"):
+        load_config(overrides=overrides)
+    # Only the method that divides by the behaviour probability refuses it.
+    assert load_config(overrides={**overrides, "agent.algorithm": "monte_carlo"})
+
+
 def test_an_env_module_that_cannot_be_imported_is_a_config_error() -> None:
     from cartpole_q.envs.gym import inspect_env, make_env
 

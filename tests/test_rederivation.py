@@ -105,6 +105,12 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "true_online_sarsa_lambda-lambda1": ("true_online_sarsa_lambda", {"lambda": 1.0}),
     "dyna_q-planning0": ("dyna_q", {"planning_steps": 0}),
     "dyna_q_plus-kappa0": ("dyna_q_plus", {"planning_steps": 3, "kappa": 0.0}),
+    # Greedy behaviour with random ties: b_t = 1 / k of the tied action taken (issue 29: the
+    # lowest rule's 0 made W / b_t divide by zero).
+    "off_policy_monte_carlo-random-ties-greedy": (
+        "off_policy_monte_carlo",
+        {"tie_break": "random", "epsilon": 0.0, "q_init": 0.3},
+    ),
     # agent.tie_break: random, where ties are common (q_init 0 on FrozenLake; CartPole's
     # optimistic start)
     **{
@@ -121,6 +127,8 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         )
     },
 }
+AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init"}
+"""keys a variant may give that are the agent's own, not its algorithm's"""
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
 LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")
 ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS}
@@ -348,6 +356,10 @@ def _reference(world: str, variant: str, **overrides: Any) -> ReferenceRun:
         "stop_when_solved": case.get("stop_when_solved", False),
         **case["agent"],
     }
+    # A variant may set the agent's own keys too (epsilon, q_init): they are not params.
+    for key in AGENT_KEYS & params.keys():
+        options[key] = params[key]
+    options["params"] = {key: value for key, value in params.items() if key not in AGENT_KEYS}
     options.update(overrides)
     return reference_train(case["env"]["id"], **options)
 

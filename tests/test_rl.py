@@ -11,12 +11,14 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from cartpole_q.engines.compile import jit
 from cartpole_q.engines.kernel import reaches_threshold
 from cartpole_q.rl import tabular
 from cartpole_q.rl.algorithms import q_learning
-from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG
+from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG, smallest_positive_value
 from cartpole_q.rl.schedules import schedule_value as python_schedule_value
 from cartpole_q.rl.tabular import ENDED
 
@@ -126,3 +128,21 @@ def test_solve_needs_a_full_window_of_returns_at_the_threshold() -> None:
     assert reaches_threshold(returns, 99, 485.0)
     assert not reaches_threshold(returns, 99, 485.01)
     assert not reaches_threshold(returns, 149, 500.0)
+
+
+@given(
+    kind=st.sampled_from([CONSTANT, EXPONENTIAL, LOG]),
+    start=st.sampled_from([0.0, 1e-320, 0.3, 1.0]),
+    end=st.sampled_from([0.0, 1e-320, 0.01]),
+    rate=st.sampled_from([1e-100, 0.01, 0.5, 0.9, 1.0, 25.0]),
+    episodes=st.integers(1, 1200),
+)
+def test_smallest_positive_schedule_value_is_the_brute_force_one(
+    kind: int, start: float, end: float, rate: float, episodes: int
+) -> None:
+    if kind == EXPONENTIAL and rate > 1.0:
+        rate = 0.5  # decay is at most 1
+    values = [python_schedule_value(kind, start, end, rate, e) for e in range(episodes)]
+    positive = [(value, e) for e, value in enumerate(values) if value > 0.0]
+    expected = min(positive, key=lambda pair: (pair[0], -pair[1])) if positive else None
+    assert smallest_positive_value(kind, start, end, rate, episodes) == expected

@@ -41,7 +41,7 @@ from cartpole_q.profiles import Physics, PhysicsRange, all_profiles, profile_for
 from cartpole_q.rl.algorithm import Param, ParamValue
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.algorithms import names as algorithm_names
-from cartpole_q.rl.schedules import SCHEDULE_KINDS
+from cartpole_q.rl.schedules import SCHEDULE_KINDS, smallest_positive_value
 
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
 _NUMBER_PATTERN = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
@@ -80,13 +80,15 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     )
     if tilings > 1:
         _check_on_tiles(reader, agent.algorithm)
+    train = TrainConfig(**reader.fields(TrainConfig, "train."))
+    _check_epsilon_floor(reader, agent, train.episodes)
     return Config(
         name=name,
         **reader.fields(Config, "", skip=("name",)),
         env=_env(reader),
         discretization=discretization,
         agent=agent,
-        train=TrainConfig(**reader.fields(TrainConfig, "train.")),
+        train=train,
         eval=EvalConfig(**reader.fields(EvalConfig, "eval.")),
     )
 
@@ -132,6 +134,26 @@ def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
             f"tile coding (tilings > 1) does not run agent.algorithm {algorithm}: {reason}. "
             "Use tilings: 1, or a one-step, n-step or trace algorithm.",
         )
+
+
+def _check_epsilon_floor(reader: _Reader, agent: AgentConfig, episodes: int) -> None:
+    """An algorithm undefined for tiny positive epsilons refuses a schedule that reaches one."""
+    floor = get_algorithm(agent.algorithm).epsilon_floor
+    schedule = agent.epsilon
+    smallest = smallest_positive_value(
+        schedule.code, schedule.start, schedule.end, schedule.rate, episodes
+    )
+    if floor <= 0.0 or smallest is None or smallest[0] >= floor:
+        return
+    value, episode = smallest
+    raise reader.error(
+        "agent.epsilon",
+        f"{agent.algorithm} divides by the probability epsilon / n with which the behaviour "
+        f"policy explores, and this epsilon is {value!r} at episode {episode + 1}, so small "
+        "that the probability can round to 0 and the method is undefined. Keep every "
+        f"positive epsilon at least {floor:g} (0 itself is allowed): a larger constant, or "
+        "a schedule's end of 0 replaced by a floor such as 0.001.",
+    )
 
 
 def _env(reader: _Reader) -> EnvConfig:

@@ -138,6 +138,11 @@ class Algorithm:
     """why it does not run on tile coding (empty: it does). On tiles a hook's state is a
     handle of one episode's observations (:mod:`cartpole_q.rl.tiles`), so memory that keys
     states across episodes (a model, per-state counts) has no meaning there"""
+    epsilon_floor: float = 0.0
+    """the smallest positive epsilon it is defined for (0.0: any): off-policy Monte Carlo
+    divides by the probability ``epsilon / n`` of an exploratory action, which a smaller
+    positive epsilon could round to 0. Configs whose epsilon takes a positive value below
+    it in any episode are refused"""
     key: str = field(default="", compare=False)
     """the name and a digest of the module's source: compiled code is cached under it, so
     an edited algorithm is compiled again (set when registered)"""

@@ -42,3 +42,37 @@ def schedule_value(kind: int, start: float, end: float, rate: float, episode: in
     if kind == EXPONENTIAL:
         return float(max(end, start * rate ** float(episode)))
     return float(max(end, min(start, 1.0 - math.log10((episode + 1.0) / rate))))
+
+
+def smallest_positive_value(
+    kind: int, start: float, end: float, rate: float, episodes: int
+) -> tuple[float, int] | None:
+    """The smallest positive value a schedule takes in episodes ``0 .. episodes - 1``.
+
+    Every schedule is non-increasing in the episode (``decay <= 1``; the log term falls), so
+    the smallest positive value is the last one before the schedule reaches 0, found by
+    bisection: a few evaluations however many episodes.
+
+    Returns:
+        The value and its episode, or ``None`` when no episode's value is positive.
+
+    >>> smallest_positive_value(EXPONENTIAL, 1.0, 0.0, 0.5, 2000)
+    (5e-324, 1074)
+    >>> smallest_positive_value(LOG, 1.0, 0.01, 25.0, 1000)
+    (0.01, 999)
+    >>> smallest_positive_value(CONSTANT, 0.0, 0.0, 1.0, 10) is None
+    True
+    """
+    last = episodes - 1
+    if schedule_value(kind, start, end, rate, last) > 0.0:
+        return schedule_value(kind, start, end, rate, last), last
+    if not schedule_value(kind, start, end, rate, 0) > 0.0:
+        return None
+    positive, zero = 0, last  # the value is positive at ``positive``, not at ``zero``
+    while zero - positive > 1:
+        middle = (positive + zero) // 2
+        if schedule_value(kind, start, end, rate, middle) > 0.0:
+            positive = middle
+        else:
+            zero = middle
+    return schedule_value(kind, start, end, rate, positive), positive

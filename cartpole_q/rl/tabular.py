@@ -150,26 +150,35 @@ def epsilon_greedy(q: Table, state: int, epsilon: float, rng: Rng) -> int:
 
 
 @compilable
+def greedy_and_ties(q: Table, state: int) -> tuple[int, float, int]:
+    """The lowest best action, the largest value and how many actions have it, in one pass.
+
+    Comparisons with NaN are false: a NaN at action 0 keeps it best, alone. One pass instead of
+    :func:`best_action` and a count: compiled code inlines every call, so fewer calls
+    compile faster.
+    """
+    greedy, best, tied = 0, value(q, state, 0), 1
+    for action in range(1, action_count(q)):
+        entry = value(q, state, action)
+        if entry > best:
+            greedy, best, tied = action, entry, 1
+        elif entry == best:
+            tied += 1
+    return greedy, best, tied
+
+
+@compilable
 def tied_best_action(q: Table, state: int, rng: Rng) -> int:
     """One of the actions with the largest ``Q(state, .)``, uniformly at random.
 
     Among the ``k`` actions whose value equals the largest, the ``rng.integers(0, k)``-th in
     action order; nothing is drawn when one action is best (or none compares equal: NaN).
     """
-    # One pass finds the largest value, its lowest action and how many actions tie for it:
-    # compiled code inlines every call, so fewer calls compile faster.
-    n_actions = action_count(q)
-    greedy, best, tied = 0, value(q, state, 0), 1
-    for action in range(1, n_actions):
-        entry = value(q, state, action)
-        if entry > best:
-            greedy, best, tied = action, entry, 1
-        elif entry == best:
-            tied += 1
+    greedy, best, tied = greedy_and_ties(q, state)
     if tied <= 1:
         return greedy
     pick = int(rng.integers(0, tied))
-    for action in range(greedy, n_actions):
+    for action in range(greedy, action_count(q)):
         if value(q, state, action) == best:
             if pick == 0:
                 return action
@@ -227,6 +236,35 @@ def policy_probability(action: int, greedy: int, epsilon: float, n_actions: int)
     """
     if action == greedy:
         return (1.0 - epsilon) + epsilon / n_actions
+    return epsilon / n_actions
+
+
+@compilable
+def behaviour_probability(
+    q: Table, params: Params, state: int, action: int, epsilon: float
+) -> float:
+    """``b(action | state)``: the probability that :func:`behaviour_action` takes ``action``.
+
+    Under the tie rule in force: with ``lowest`` it is :func:`policy_probability` of the
+    greedy action; with ``random`` the greedy branch's share ``1 - epsilon`` is split among
+    the ``k`` tied best actions, ``(1 - epsilon) / k + epsilon / n`` for each of them (the
+    greedy action alone when ``k = 1``, so it is then byte for byte the ``lowest`` rule's
+    value). Positive for every action the behaviour can take.
+
+    >>> import numpy as np
+    >>> q = np.array([[1.0, 1.0, 0.0]])
+    >>> behaviour_probability(q, (1.0,), 0, 1, 0.0), behaviour_probability(q, (0.0,), 0, 1, 0.0)
+    (0.5, 0.0)
+    >>> behaviour_probability(q, (1.0,), 0, 2, 0.3)
+    0.09999999999999999
+    """
+    n_actions = action_count(q)
+    if not random_ties(params):
+        return policy_probability(action, best_action(q, state), epsilon, n_actions)
+    greedy, best, tied = greedy_and_ties(q, state)
+    among = action == greedy if tied <= 1 else value(q, state, action) == best
+    if among:
+        return (1.0 - epsilon) / tied + epsilon / n_actions
     return epsilon / n_actions
 
 

@@ -83,13 +83,23 @@ def give_tile_traces(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
     count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
 ) -> None:  # fmt: skip
-    """Give each of the state's tiles its trace (dutch: with the tile's ``alpha / T``)."""
+    """Give each of the state's tiles its trace, the dutch one over all of them at once.
+
+    Accumulating and replacing set each tile's trace alone. Dutch is Sutton & Barto's
+    (eq. 12.11) for the binary features of the ``T`` tiles, whose decayed traces sum to
+    ``S``: every tile ``z = z + (1.0 - (alpha / T) * S)`` (one-hot features, ``T = 1``, give
+    ``(1 - alpha) z + 1``).
+    """
+    if kind == DUTCH:
+        dot = tile_trace_dot(q, slots, values, state, action)
+        amount = 1.0 - feature_alpha(q, alpha) * dot
+        grow_tile_traces(q, values, states, actions, slots, count, state, action, amount, n_actions)
+        return
     features = q[1]
-    tile_alpha = feature_alpha(q, alpha)
     for t in range(features.shape[1]):
         row = features[state, t]
         where = trace_slot(values, states, actions, slots, count, row, action, n_actions)
-        set_trace(values, where, kind, tile_alpha)
+        set_trace(values, where, kind, alpha)
 
 
 @compilable

@@ -33,9 +33,9 @@ from cartpole_q.rl.tabular import (
     Table,
     action_count,
     behaviour_action,
+    behaviour_probability,
     best_action,
     best_value,
-    policy_probability,
     shift,
     value,
 )
@@ -59,7 +59,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     n_actions = action_count(q)
     t = length[0]
     states[t], actions[t], rewards[t] = state, action, reward
-    behaviour[t] = policy_probability(action, best_action(q, state), epsilon, n_actions)
+    behaviour[t] = behaviour_probability(q, params, state, action, epsilon)
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return behaviour_action(q, params, next_state, epsilon, rng)
@@ -112,6 +112,9 @@ ALGORITHM = Algorithm(
     ),
     step=step,
     params=(UPDATE,),
+    # W / b_t: an exploratory action's b_t = epsilon / n must not round to 0 in float64
+    # (docs/algorithms.md, "No division by zero").
+    epsilon_floor=1e-300,
     memory=off_policy_memory,
     memory_names=(
         "episode_states", "episode_actions", "episode_rewards", "cumulative_weights",
