@@ -169,6 +169,14 @@ def test_links_shared_and_unrelated_directories_are_never_removed(
     assert (shared / "agent.nbi").is_file() and unrelated.is_dir()
 
 
+@pytest.mark.skipif(os.getuid() != 0, reason="making another user's directory needs root")
+def test_another_users_directory_is_never_removed(root: Path) -> None:
+    theirs = _version_cache(root, "theirs", unused_days=365)
+    os.chown(theirs, 12345, 12345)
+    assert numba_cache.remove_stale_caches(root, root / "numba-current") == []
+    assert (theirs / "agent.nbi").is_file()
+
+
 def test_other_versions_are_looked_at_once_a_day(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
