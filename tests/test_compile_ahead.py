@@ -14,7 +14,7 @@ import pytest
 
 import cartpole_q.numba_cache
 from cartpole_q.config import Config, load_config
-from cartpole_q.engines import loop_name, resolve_engine
+from cartpole_q.engines import loop_names, resolve_engine
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.numba_cache import is_cached
@@ -32,9 +32,9 @@ def _config(**overrides: Any) -> Config:
 @pytest.mark.parametrize(
     ("overrides", "expected"),
     [
-        ({}, "train_episodes__q_learning_"),
-        (RANDOMIZE, "train_episodes__q_learning_"),
-        ({**TILES, "engine": "numba"}, "train_episodes__q_learning_"),
+        ({}, "train_exploring__q_learning_"),
+        (RANDOMIZE, "train_exploring__q_learning_"),
+        ({**TILES, "engine": "numba"}, "train_exploring__q_learning_"),
         ({"engine": "gymnasium"}, "next_step__q_learning_"),
         ({"env.id": "FrozenLake-v1", "engine": "gymnasium"}, "next_step__q_learning_"),
         ({"env.id": "Blackjack-v1", "engine": "gymnasium"}, "next_step__q_learning_"),
@@ -46,7 +46,7 @@ def test_loop_name_is_what_numba_caches_once_trained(
 ) -> None:
     config = _config(**overrides)
     info = inspect_env(config)
-    name = loop_name(config, info, resolve_engine(config, info))
+    (name,) = loop_names(config, info, resolve_engine(config, info))  # two episodes explore
     assert name.startswith(expected)
     kind = {"randomized": "__randomized", "tiles": "__tiles"}
     for key, suffix in (("env.randomize", kind["randomized"]), ("discretization", "__tiles")):
@@ -95,3 +95,17 @@ def test_a_sweep_says_how_many_loops_it_compiles_first(
     assert "compiling 2 training loops first" in result.stderr
     result = invoke("sweep", sweep, "--out", in_tmp / "quiet", "--workers", 2, "--quiet")
     assert "compiling" not in result.stderr
+
+
+def test_the_numba_engine_compiles_the_loops_its_epsilon_plays() -> None:
+    """An exploring loop for epsilon > 0, a greedy one for epsilon 0: a run names those it plays."""
+
+    def names(**overrides: Any) -> list[str]:
+        config = load_config(overrides=overrides)
+        return [name.split("__")[0] for name in loop_names(config, inspect_env(config), "numba")]
+
+    # The default's log schedule reaches 0 at episode 90 of its 1,000.
+    assert names() == ["train_exploring", "train_greedy"]
+    assert names(**{"train.episodes": 89}) == ["train_exploring"]
+    assert names(**{"agent.epsilon": 0.1}) == ["train_exploring"]
+    assert names(**{"agent.epsilon": 0.0}) == ["train_greedy"]

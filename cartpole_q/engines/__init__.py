@@ -78,9 +78,19 @@ def make_engine(
     return GymnasiumEngine(config, params, env_seed, env_rng_state, step_cap)
 
 
-def loop_name(config: Config, env_info: EnvInfo, engine: str) -> str:
-    """The compiled loop a run of ``config`` on ``engine`` calls, as numba's cache names it."""
-    from cartpole_q.engines.base import kernel_name, step_function_name
+def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...]:
+    """The compiled loops a run of ``config`` on ``engine`` calls, as numba's cache names them.
+
+    On the numba engine, the training loops its epsilon plays over ``train.episodes`` (see
+    :func:`~cartpole_q.engines.base.loops_played`); on the gymnasium engine, its step
+    functions (named by the one that learns).
+    """
+    from cartpole_q.engines.base import (
+        ScheduleRecord,
+        kernel_name,
+        loops_played,
+        step_function_name,
+    )
     from cartpole_q.rl.algorithms import get as get_algorithm
 
     algorithm = get_algorithm(config.agent.algorithm)
@@ -94,14 +104,18 @@ def loop_name(config: Config, env_info: EnvInfo, engine: str) -> str:
         )
         assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
         randomized = bool(config.env.randomize)
-        return kernel_name(algorithm.key, settings.twin.key, randomized, tiled)
+        played = loops_played(ScheduleRecord.of(config.agent.epsilon), 0, config.train.episodes)
+        return tuple(
+            kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy)
+            for greedy in played
+        )
     if tiled:
         kind = "tiles"
     elif grid is not None:
         kind = "box"
     else:  # a Discrete observation has one start, a Tuple one per component
         kind = "tuple" if len(env_info.index_starts or ()) > 1 else "discrete"
-    return step_function_name("next_step", algorithm.key, kind)
+    return (step_function_name("next_step", algorithm.key, kind),)
 
 
 def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None:
@@ -113,7 +127,7 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
     """
     from cartpole_q.numba_cache import is_cached
 
-    if is_cached(loop_name(config, env_info, engine)):
+    if all(is_cached(name) for name in loop_names(config, env_info, engine)):
         return None
     return (
         f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "

@@ -19,16 +19,20 @@ from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
+from cartpole_q.rl.schedules import schedule_value
 
 
-def kernel_name(algorithm_key: str, twin_key: str, randomized: bool, tiled: bool) -> str:
-    """The numba engine's outer loop for one pair, as numba's cache names it.
+def kernel_name(
+    algorithm_key: str, twin_key: str, randomized: bool, tiled: bool, greedy: bool
+) -> str:
+    """One of the numba engine's two training loops of a pair, as numba's cache names it.
 
-    >>> kernel_name("sarsa", "cartpole_0123", randomized=True, tiled=False)
-    'train_episodes__sarsa__cartpole_0123__randomized'
+    >>> kernel_name("sarsa", "cartpole_0123", randomized=True, tiled=False, greedy=False)
+    'train_exploring__sarsa__cartpole_0123__randomized'
     """
     pair = f"{algorithm_key}__{twin_key}" + ("__tiles" if tiled else "")
-    return f"train_episodes__{pair}" + ("__randomized" if randomized else "")
+    kind = "greedy" if greedy else "exploring"
+    return f"train_{kind}__{pair}" + ("__randomized" if randomized else "")
 
 
 def step_function_name(step: str, algorithm_key: str, kind: str) -> str:
@@ -52,6 +56,29 @@ class ScheduleRecord(NamedTuple):
     def of(cls, schedule: Schedule) -> ScheduleRecord:
         """The record of a config's schedule."""
         return cls(schedule.code, schedule.start, schedule.end, schedule.rate)
+
+
+def loops_played(epsilon: ScheduleRecord, start: int, stop: int) -> tuple[bool, ...]:
+    """Which training loops episodes ``start .. stop - 1`` play, as ``greedy`` flags, sorted.
+
+    The numba engine has an exploring loop (epsilon > 0) and a greedy one (epsilon 0; see
+    :mod:`~cartpole_q.engines.kernel`). Epsilon schedules never rise: the first episode says
+    whether any explores, the last whether any is greedy. Computed by the plain schedule,
+    it decides only what to compile ahead (the loops decide for themselves).
+
+    >>> loops_played(ScheduleRecord(2, 1.0, 0.0, 9.0), 0, 1000)  # the default's log schedule
+    (False, True)
+    >>> constant = ScheduleRecord(0, 0.1, 0.1, 1.0)
+    >>> loops_played(constant, 0, 1000), loops_played(constant, 5, 5)
+    ((False,), ())
+    """
+    if start >= stop:
+        return ()
+    first, last = (
+        not schedule_value(epsilon.kind, epsilon.start, epsilon.end, epsilon.rate, episode) > 0.0
+        for episode in (start, stop - 1)
+    )
+    return tuple(sorted({first, last}))
 
 
 class AgentRecord(NamedTuple):

@@ -13,6 +13,14 @@ The functions below are templates: their upper-case globals (``ALGORITHM_STEP``,
 ``TWIN_STEP``, ...) are placeholders that :func:`~cartpole_q.engines.compile.specialise`
 binds to one algorithm's hooks and one twin's functions. Each (algorithm, twin) pair is
 compiled on its own, with no branch on either left in the loop, and cached on disk.
+
+A pair has two training loops, each calling its own episode loop: the *exploring* one
+plays the episodes whose epsilon is positive, the *greedy* one, compiled with epsilon the
+constant 0 (without the generator calls greedy steps skip anyway: a third faster), those
+whose epsilon is 0. Each returns at the first episode that is the other's, and the engine goes on with
+the other; epsilon schedules never rise, so a run switches at most once. A run compiles
+only the loops its schedule plays (a constant positive epsilon: the exploring one alone),
+and a cold start compiles the two side by side.
 """
 
 from __future__ import annotations
@@ -42,10 +50,10 @@ TWIN_RANDOMIZE: Any = None
 TWIN_STATE_DTYPE: Any = None
 TWIN_OBSERVATION_DTYPE: Any = None
 OBSERVATION_STATE: Any = None
-EXPLORING_EPISODE: Any = None
-GREEDY_EPISODE: Any = None
+EPISODE: Any = None
 GREEDY: bool = False
-"""bound to True in the copy of :func:`twin_episode` compiled for epsilon 0"""
+"""bound to True in the copies of :func:`twin_episode` and :func:`train_episodes` compiled
+for epsilon 0"""
 RANDOMIZED: bool = False
 """bound to True in the outer loop of a run whose ``env.randomize`` draws physics"""
 
@@ -125,7 +133,11 @@ def train_episodes(
     env: Any, start: int, stop: int, check_solved: bool, physics_rng: np.random.Generator,
     randomize: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> tuple[int, int, int]:  # fmt: skip
-    """Train episodes ``start .. stop - 1`` on the twin.
+    """Train episodes ``start .. stop - 1`` on the twin, up to the first that is the other loop's.
+
+    The exploring copy (``GREEDY`` False) plays the episodes whose epsilon is positive and
+    returns at the first whose epsilon is not; the greedy copy the reverse (see the module
+    docstring). An episode handed back is untouched: nothing of it is drawn.
 
     Args:
         q: the learned table as ``(n_states, n_actions)``, updated in place (on tiles the
@@ -148,7 +160,8 @@ def train_episodes(
 
     Returns:
         ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
-        right after the solve episode when ``check_solved``.
+        right after the solve episode when ``check_solved``, and before an episode that
+        is the other loop's (then ``episodes finished < stop`` and no solve).
     """
     max_steps, state_size, observation_size, base_params = env
     keys, lows, highs = randomize
@@ -159,21 +172,15 @@ def train_episodes(
     env_steps = 0
     for episode in range(start, stop):
         epsilon, alpha = episode_rates(agent, episode)
+        if (epsilon > 0.0) == GREEDY:  # the other loop's episode (NaN: the greedy one's)
+            return episode, env_steps, -1
         env_params = base_params
         if RANDOMIZED:  # compiled in only where env.randomize draws physics
             env_params = TWIN_RANDOMIZE(base_params, physics_rng, keys, lows, highs)
-        # Greedy episodes (epsilon 0) run a copy of the loop compiled with a constant
-        # epsilon, without the generator calls they would skip anyway: a third faster.
-        if epsilon > 0.0:
-            episode_return, length = EXPLORING_EPISODE(
-                q, visits, memory, params, low, high, bins, starts, gamma, alpha, epsilon,
-                agent_rng, env_rng, env_params, max_steps, env_state, observation,
-            )  # fmt: skip
-        else:
-            episode_return, length = GREEDY_EPISODE(
-                q, visits, memory, params, low, high, bins, starts, gamma, alpha, 0.0,
-                agent_rng, env_rng, env_params, max_steps, env_state, observation,
-            )  # fmt: skip
+        episode_return, length = EPISODE(
+            q, visits, memory, params, low, high, bins, starts, gamma, alpha, epsilon,
+            agent_rng, env_rng, env_params, max_steps, env_state, observation,
+        )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
         env_steps += length
         if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
@@ -208,16 +215,24 @@ def greedy_returns(
 
 @dataclass(frozen=True)
 class TrainingKernel:
-    """One (algorithm, twin) pair's compiled loops: the outer loop and its two episode loops."""
+    """One (algorithm, twin) pair's two training loops (see the module docstring).
 
-    name: str
-    """the outer loop's name (its cache entry)"""
-    train_episodes: Any
-    """the outer loop (see :func:`train_episodes`)"""
-    exploring_episode: Any
-    """the episode loop for epsilon > 0"""
-    greedy_episode: Any
-    """the episode loop compiled for epsilon 0"""
+    Each is compiled at its first call (or loaded from numba's cache): a run that never
+    plays a greedy episode never compiles the greedy loop.
+    """
+
+    exploring_name: str
+    """the exploring loop's name (its cache entry)"""
+    exploring: Any
+    """:func:`train_episodes` for the episodes whose epsilon is positive"""
+    greedy_name: str
+    """the greedy loop's name (its cache entry)"""
+    greedy: Any
+    """:func:`train_episodes` compiled for the episodes whose epsilon is 0"""
+
+    def loop(self, greedy: bool) -> tuple[str, Any]:
+        """The name and the loop for greedy (epsilon 0) or exploring episodes."""
+        return (self.greedy_name, self.greedy) if greedy else (self.exploring_name, self.exploring)
 
 
 def training_kernel(
@@ -251,29 +266,27 @@ def _training_kernel(
         "ALGORITHM_END": algorithm.end,
         **twin_bindings(twin, tiled),
     }
-    # The two episode loops are compiled (and cached) on their own, not inlined into the
-    # outer loop: each is a smaller compilation, and they can be compiled side by side.
-    exploring = specialise(
-        twin_episode, f"twin_episode__{pair}", {**hooks, "GREEDY": False}, tiled=tiled
-    )
-    greedy = specialise(
-        twin_episode, f"greedy_episode__{pair}", {**hooks, "GREEDY": True}, tiled=tiled
-    )
-    name = kernel_name(algorithm_key, twin_key, randomized, tiled)
-    outer = specialise(
-        train_episodes,
-        name,
-        {
-            "EXPLORING_EPISODE": exploring,
-            "GREEDY_EPISODE": greedy,
+    loops: list[Any] = []  # name, loop, name, loop
+    for greedy in (False, True):
+        # The episode loop is compiled (and cached) on its own and called, not inlined:
+        # numba's inlining of a whole episode loop costs more than the call saves.
+        episode = specialise(
+            twin_episode,
+            f"{'greedy' if greedy else 'exploring'}_episode__{pair}",
+            {**hooks, "GREEDY": greedy},
+            tiled=tiled,
+        )
+        name = kernel_name(algorithm_key, twin_key, randomized, tiled, greedy)
+        bindings = {
+            "EPISODE": episode,
+            "GREEDY": greedy,
             "TWIN_RANDOMIZE": twin.randomize,
             "RANDOMIZED": randomized,
             "TWIN_STATE_DTYPE": twin.state_dtype,
             "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
-        },
-        tiled=tiled,
-    )
-    return TrainingKernel(name, outer, exploring, greedy)
+        }
+        loops += [name, specialise(train_episodes, name, bindings, tiled=tiled)]
+    return TrainingKernel(*loops)
 
 
 @functools.cache

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from gymnasium.utils import seeding
 
-from cartpole_q.engines.base import AgentParams, TrainingState
+from cartpole_q.engines.base import AgentParams, TrainingState, loops_played
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
@@ -42,9 +42,7 @@ class NumbaEngine:
         self._kernel = training_kernel(
             params.algorithm, settings.twin, bool(randomize), params.tiled
         )
-        self._train_episodes = self._kernel.train_episodes
         self._greedy_returns = greedy_kernel(settings.twin, params.tiled)
-        self._twin = settings.twin
         limit = settings.max_episode_steps
         self._env = (
             NO_TIME_LIMIT if limit is None else limit,
@@ -71,17 +69,44 @@ class NumbaEngine:
             self._env_rng.bit_generator.state = env_rng_state
 
     def run(self, state: TrainingState, stop: int, check_solved: bool) -> int | None:
-        """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`)."""
+        """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`).
+
+        The exploring and the greedy loop take turns (see :mod:`~cartpole_q.engines.kernel`):
+        each plays episodes up to the first that is the other's.
+        """
+        first = loops_played(self._params.agent.epsilon, state.episode, state.episode + 1)
+        greedy = first == (True,)  # the loop of the first episode
+        handed_back = False  # the last loop returned without playing an episode
+        while state.episode < stop:
+            started = state.episode
+            solved = self._run_loop(greedy, state, stop, check_solved)
+            if solved is not None:
+                return solved
+            if state.episode == started:
+                # Both loops handing back the same episode cannot happen (they read one
+                # schedule value); a bug must not spin forever.
+                assert not handed_back, f"no training loop takes episode {started}"
+                handed_back = True
+            else:
+                handed_back = False
+            greedy = not greedy
+        return None
+
+    def _run_loop(
+        self, greedy: bool, state: TrainingState, stop: int, check_solved: bool
+    ) -> int | None:
+        """One loop's turn: episodes up to ``stop`` or the other loop's first one."""
         p = self._params
         q, visits, memory = state.tables
-        finished, env_steps, solved = self._train_episodes(
+        _, loop = self._kernel.loop(greedy)
+        finished, env_steps, solved = loop(
             self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
             self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
             self._randomize,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps
-        return None if solved < 0 else solved
+        return None if solved < 0 else int(solved)
 
     def _hook_table(self, q: np.ndarray) -> Any:
         """``q`` as the hooks take it (made again only for another array)."""
@@ -90,56 +115,53 @@ class NumbaEngine:
         return self._hook_tables[1]
 
     def warm_up(self, state: TrainingState) -> None:
-        """Compile the kernels (or load them from the cache); nothing runs, nothing is drawn.
+        """Compile the loops the run plays (or load them from the cache); nothing runs.
 
-        Compiling takes seconds, once per machine: then the two episode loops and the greedy
-        play are compiled side by side, in this process and a forked one, which leaves its
-        code in numba's cache for this one to load (see :func:`_compile_side_by_side`).
+        The loops are those of the episodes left (``state.episode`` up to the configured
+        episodes), and the greedy play. Compiling takes seconds, once per machine: then they
+        are compiled side by side, in this process and a forked one, which leaves its code
+        in numba's cache for this one to load (see :meth:`_compile_side_by_side`).
         """
-        if not is_cached(self._kernel.name):
-            self._compile_side_by_side(state)
-        self.run(state, state.episode, check_solved=False)
+        needed = loops_played(self._params.agent.epsilon, state.episode, len(state.metrics.returns))
+        if not all(is_cached(self._kernel.loop(greedy)[0]) for greedy in needed):
+            self._compile_side_by_side(state, needed)
+        for greedy in needed:
+            self._load(state, greedy)
         self.evaluate(state.tables.q, 0, 0)
 
-    def _compile_side_by_side(self, state: TrainingState) -> None:
-        """Compile the exploring episode loop and the greedy play here, the greedy loop in a child.
+    def _load(self, state: TrainingState, greedy: bool) -> None:
+        """Compile one loop, or load it from the cache, by a call that plays no episode.
 
-        Each loop is compiled by running it on scratch copies for one step (a compiled
-        function is compiled for the argument types of its first call); the child writes
-        numba's cache and exits, and the outer loop then loads its code from there. (The
-        greedy play is the smaller compilation: it goes with the exploring loop, which
-        compiles faster than the greedy one.) Where a process cannot fork (or has threads,
-        where forking is unsafe), everything is compiled here, one after another.
+        A compiled function is compiled for the argument types of its first call; an empty
+        range of episodes touches nothing and draws nothing.
         """
-        if not hasattr(os, "fork") or threading.active_count() > 1:
+        self._run_loop(greedy, state, state.episode, check_solved=False)
+
+    def _compile_side_by_side(self, state: TrainingState, needed: tuple[bool, ...]) -> None:
+        """Compile the loops ``needed`` and the greedy play, in two processes at once.
+
+        The first loop needed (the exploring one, the larger compilation, when both are)
+        here; the other, if any, and the greedy play in a forked child, which writes numba's
+        cache and exits; this process then loads the child's code from there. Where a
+        process cannot fork (or has threads, where forking is unsafe), everything is
+        compiled here, one after another.
+        """
+        if not hasattr(os, "fork") or threading.active_count() > 1 or not needed:
             return
         child = os.fork()
-        if child == 0:  # the child: the greedy episode loop, then exit without clean-up
+        if child == 0:  # the child: compile into the cache, then exit without clean-up
             code = 1
             try:
-                self._scratch_episode(state, self._kernel.greedy_episode, 0.0)
+                for greedy in needed[1:]:
+                    self._load(state, greedy)
+                self.evaluate(state.tables.q.copy(), 0, 0)
                 code = 0
             finally:
                 os._exit(code)
         try:
-            self._scratch_episode(state, self._kernel.exploring_episode, 0.5)
-            self.evaluate(state.tables.q.copy(), 0, 0)
+            self._load(state, needed[0])
         finally:
             os.waitpid(child, 0)
-
-    def _scratch_episode(self, state: TrainingState, episode: Any, epsilon: float) -> None:
-        """Run an episode loop for one step on copies of everything it would change."""
-        p = self._params
-        q, visits, memory = state.tables
-        _, state_size, observation_size, params = self._env
-        twin = self._twin
-        episode(
-            p.hook_table(q.copy()), visits.copy(), tuple(array.copy() for array in memory), p.params,
-            p.grid.low, p.grid.high, p.grid.bins, p.grid.starts, p.agent.gamma, 0.5, epsilon,
-            np.random.default_rng(0), np.random.default_rng(1), params, 1,
-            np.zeros(state_size, dtype=twin.state_dtype),
-            np.zeros(observation_size, dtype=twin.observation_dtype),
-        )  # fmt: skip
 
     def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""

@@ -128,11 +128,14 @@ def compile_ahead(
     Returns:
         How many loops were compiled.
     """
-    from cartpole_q.engines import loop_name, resolve_engine
+    from cartpole_q.engines import loop_names, resolve_engine
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.numba_cache import is_cached
 
-    missing: dict[str, tuple[dict[str, Any], str]] = {}
+    # A config's loops are compiled by one job (the numba engine's two side by side); a
+    # loop another config's job compiles already is not counted again.
+    jobs: list[tuple[dict[str, Any], str]] = []
+    counted: set[str] = set()
     seen: set[tuple[Any, ...]] = set()
     for config in configs:
         signature = _loop_signature(config)
@@ -141,18 +144,22 @@ def compile_ahead(
         seen.add(signature)
         info = inspect_env(config)
         engine = resolve_engine(config, info)
-        name = loop_name(config, info, engine)
-        if name not in missing and not is_cached(name):
-            missing[name] = (config.to_dict(), engine)
-    if not missing:
+        missing = [
+            name for name in loop_names(config, info, engine)
+            if name not in counted and not is_cached(name)
+        ]  # fmt: skip
+        if missing:
+            counted.update(missing)
+            jobs.append((config.to_dict(), engine))
+    if not jobs:
         return 0
     if on_start is not None:
-        on_start(len(missing))
+        on_start(len(counted))
     execute(
-        _compile_loop, list(missing.values()), lambda index, item: None,
-        workers=min(workers, len(missing)), should_stop=should_stop,
+        _compile_loop, jobs, lambda index, item: None,
+        workers=min(workers, len(jobs)), should_stop=should_stop,
     )  # fmt: skip
-    return len(missing)
+    return len(counted)
 
 
 def _loop_signature(config: Config) -> tuple[Any, ...]:
@@ -166,6 +173,8 @@ def _loop_signature(config: Config) -> tuple[Any, ...]:
         None if grid is None else grid.tilings,
         bool(config.env.randomize),
         config.train.info_metric,
+        repr(config.agent.epsilon),  # which of the numba engine's two loops it plays
+        config.train.episodes,
     )
 
 
