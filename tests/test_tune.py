@@ -593,10 +593,8 @@ def test_a_full_disk_costs_at_most_the_trial_in_flight_and_resume_recovers(
 def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A real SIGINT right after the tune directory is created, before any trial."""
-    from cartpole_q.experiments import tune as tuning
-
-    monkeypatch.setattr(tuning, "start_tune", then_sigint(tuning.start_tune))
+    """A real SIGINT right after ``tune.yaml`` is written, before the study or any trial."""
+    monkeypatch.setattr(tunedir, "write_tune", then_sigint(tunedir.write_tune))
     directory = tmp_path / "early"
     path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 2, "seeds": "0-1"})
     result = invoke("tune", path, "--out", directory, "-q")

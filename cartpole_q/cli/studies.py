@@ -94,10 +94,9 @@ def sweep_command(
             # sweep answers (saying what it saved), however early it comes.
             started: list[Path] = []
             hint = _resume_hint("sweep", "finish", lambda: started[0] if started else None)
-            with stoppable(hint) as stop:
-                started.append(sweeping.start_sweep(spec, out))
-                with directory_lock(started[0], "sweep"):
-                    outcome = _run_sweep(spec, started[0], workers, backend, address, quiet, stop)
+            with stoppable(hint) as stop, sweeping.new_sweep(spec, out) as directory:
+                started.append(directory)
+                outcome = _run_sweep(spec, directory, workers, backend, address, quiet, stop)
         if not quiet and outcome.complete:
             from cartpole_q.cli.report import print_sweep_summary
 
@@ -259,10 +258,9 @@ def tune_command(
         # study answers (with how to go on), however early it comes.
         started: list[Path] = []
         hint = _resume_hint("tune", "go on", lambda: started[0] if started else None)
-        with stoppable(hint) as stop:
-            started.append(tuning.start_tune(spec, out, storage_url))
-            with directory_lock(started[0], "tune directory"):
-                _tune(spec, started[0], storage_url, trials, workers, backend, address, quiet, stop)
+        with stoppable(hint) as stop, tuning.new_tune(spec, out, storage_url) as directory:
+            started.append(directory)
+            _tune(spec, directory, storage_url, trials, workers, backend, address, quiet, stop)
 
 
 def _check_tune_size(spec: Any, trials: int | None, max_runs: int, yes: bool, where: str) -> None:

@@ -150,13 +150,14 @@ def train(
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
         _check_outputs(prepared.config, tensorboard, video_every)
         # Connected (or refused) before the run directory is created.
-        with backend_connection(backend, workers, address):
-            run_dir = runner.start_run(prepared, out)
-            with directory_lock(run_dir, "run"):
-                _train_into(
-                    run_dir, prepared, False, workers, backend, address, quiet, watch,
-                    video_every, seed_plots,
-                )  # fmt: skip
+        with (
+            backend_connection(backend, workers, address),
+            runner.new_run(prepared, out) as run_dir,
+        ):
+            _train_into(
+                run_dir, prepared, False, workers, backend, address, quiet, watch,
+                video_every, seed_plots,
+            )  # fmt: skip
 
 
 def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendChoice) -> None:

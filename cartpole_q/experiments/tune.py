@@ -273,16 +273,27 @@ def check_search(the_study: Any, spec: TuneSpec, where: str) -> None:
         )
 
 
-def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
-    """Create the tune directory, write ``tune.yaml``, and create (or join) the study.
+@contextlib.contextmanager
+def new_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Iterator[Path]:
+    """Create the tune directory, its ``tune.yaml`` and study, holding its lock inside.
 
-    Call :func:`check_storage` first: it refuses what this would do wrong.
+    The study is created, or joined when ``--storage`` holds it already. Call
+    :func:`check_storage` first: it refuses what this would do wrong. A failure before the
+    study exists (a full disk) removes the directory this created; after it, the directory
+    stays for ``tune --resume``.
     """
     check_tensorboard([spec.config_for({})])
-    directory = tunedir.create_tune_dir(spec.name, out)
-    tunedir.write_tune(directory, spec.to_dict(), storage_url)
-    study(spec, directory, storage_url, create=True)
-    return directory
+    with tunedir.new_tune_dir(spec.name, out) as claim:
+        tunedir.write_tune(claim.path, spec.to_dict(), storage_url)
+        study(spec, claim.path, storage_url, create=True)
+        claim.keep()
+        yield claim.path
+
+
+def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
+    """Create the tune directory and its study (the directory's lock released on return)."""
+    with new_tune(spec, out, storage_url) as directory:
+        return directory
 
 
 def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:

@@ -9,6 +9,7 @@ the end of every ``tune`` call.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,7 +19,7 @@ import yaml
 from cartpole_q.config import Config, ConfigError, read_yaml_mapping
 from cartpole_q.errors import RunError
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text
-from cartpole_q.store.rundir import create_run_dir
+from cartpole_q.store.rundir import NewDirectory, new_directory
 from cartpole_q.store.sweepdir import csv_text
 
 TUNE_FILE = "tune.yaml"
@@ -30,9 +31,13 @@ IMPORTANCE_FILE = "importance.png"
 TUNES_ROOT = Path("tunes")
 
 
-def create_tune_dir(name: str, out: Path | None) -> Path:
-    """Create the tune directory: ``out`` (new or empty), else ``tunes/<name>-<stamp>/``."""
-    return create_run_dir(name, out, runs_root=TUNES_ROOT, kind="tune")
+def new_tune_dir(name: str, out: Path | None) -> contextlib.AbstractContextManager[NewDirectory]:
+    """Claim the tune directory, holding its lock inside.
+
+    It is ``out`` (new or empty), else ``tunes/<name>-<stamp>/``; see
+    :func:`~cartpole_q.store.rundir.new_directory`.
+    """
+    return new_directory(name, out, runs_root=TUNES_ROOT, kind="tune")
 
 
 def write_tune(directory: Path, resolved: Mapping[str, Any], storage: str | None) -> None:
