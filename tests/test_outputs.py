@@ -130,6 +130,17 @@ def test_a_failed_write_leaves_no_partial_file(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.png"]
 
 
+def test_a_directory_that_cannot_be_made_is_a_write_error_naming_it(tmp_path: Path) -> None:
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("x")
+    with pytest.raises(WriteError, match=f"^{in_the_way}: cannot be created: a file is in the way"):
+        atomic.make_directory(in_the_way)
+    with pytest.raises(WriteError, match=f"{in_the_way} is not a directory"):
+        atomic.make_directory(in_the_way / "videos")
+    with pytest.raises(WriteError, match="/proc/x: cannot be created: "):
+        atomic.make_directory(Path("/proc/x"))
+
+
 # -- unwritable and full places ---------------------------------------------------------
 
 
@@ -166,6 +177,76 @@ def test_full_disk_plot_video_and_train(run_dir: Path, full_disk: Path) -> None:
     _refused(invoke("train", "--out", run, "-q"), str(run), "no space is left on the device")
     _no_temporaries(run)
     assert not (run / "summary.json").exists()
+
+
+@pytest.fixture
+def small_disk(tmp_path: Path) -> Iterator[Path]:
+    """A real 256 KiB file system (tmpfs; needs root, else skipped), to fill up by hand."""
+    if shutil.which("mount") is None or os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
+    yield from _mount_tmpfs(tmp_path / "small", "size=256k")
+
+
+def _fill(disk: Path, free_blocks: int) -> Path:
+    """Fill ``disk`` up to its last ``free_blocks`` blocks (a tmpfs block is a 4 KiB page)."""
+    stats = os.statvfs(disk)
+    filler = disk / "filler"
+    filler.write_bytes(b"\0" * (stats.f_bavail - free_blocks) * stats.f_frsize)
+    assert os.statvfs(disk).f_bavail == free_blocks
+    return filler
+
+
+@pytest.mark.parametrize(
+    ("free", "file"),
+    [(0, ".lock"), (1, "config.yaml")],
+    ids=["no block: the lock file", "one block: the lock file, not config.yaml"],
+)
+def test_train_into_a_nearly_full_disk_leaves_nothing_half_started(
+    small_disk: Path, free: int, file: str
+) -> None:
+    """The lock file (written first) or config.yaml cannot be written: the directory goes."""
+    filler = _fill(small_disk, free)
+    run = small_disk / "run"
+    result = invoke("train", "--episodes", 30, "--out", run, "-q")
+    _refused(result, f"{run / file}: cannot be written", "no space is left on the device")
+    assert "The new run directory was removed." in result.stderr
+    assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
+    filler.unlink()
+    assert invoke("train", "--episodes", 30, "--out", run, "-q").exit_code == 0
+
+
+def test_a_disk_full_during_training_keeps_a_run_that_resumes(
+    small_disk: Path, tmp_path: Path
+) -> None:
+    """Room for the lock file and config.yaml, not for the first checkpoint."""
+    filler = _fill(small_disk, 2)
+    run = small_disk / "run"
+    args = ("train", "--episodes", 30, "--set", "train.checkpoint_every=10", "-q")
+    result = invoke(*args, "--out", run)
+    _refused(result, f"{run}/", "no space is left on the device")
+    assert (
+        f"make room (or fix what refused the write), then resume with `cartpole-q train --resume {run}`"
+        in result.stderr
+    )
+    assert sorted(p.name for p in run.iterdir()) == [".lock", "config.yaml"]
+    filler.unlink()
+    resumed = invoke("train", "--resume", run, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    reference = tmp_path / "reference"
+    assert invoke(*args, "--out", reference).exit_code == 0
+    assert (run / "q_table.npy").read_bytes() == (reference / "q_table.npy").read_bytes()
+
+
+def test_a_sweep_that_cannot_write_its_points_leaves_nothing(small_disk: Path) -> None:
+    """Room for the lock file and one point's config.yaml, not the second's."""
+    sweep = small_disk.parent / "s.yaml"
+    sweep.write_text("seeds: 0\ngrid:\n  agent.alpha: [0.1, 0.2, 0.3]\n")
+    filler = _fill(small_disk, 2)
+    out = small_disk / "sweep"
+    result = invoke("sweep", sweep, "--out", out, "-q")
+    _refused(result, f"{out}/points/", "no space is left on the device", "was removed")
+    assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
+    filler.unlink()
 
 
 # -- extensions, defaults, --force ------------------------------------------------------

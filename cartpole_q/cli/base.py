@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-from cartpole_q.errors import UserError
+from cartpole_q.errors import UserError, WriteError
 
 if TYPE_CHECKING:
     from cartpole_q.experiments.run import StopRequest
@@ -194,6 +194,25 @@ def stoppable(hint: str | Callable[[], str]) -> Iterator[StopRequest]:
             saved = getattr(error, "text", None)
             how = hint() if callable(hint) else hint
             exit_interrupted(f"interrupted at once: {f'{saved}; ' if saved else ''}{how}")
+
+
+@contextmanager
+def kept_on_write_error(kept: str, how: str) -> Iterator[None]:
+    """Once a directory holds what ``--resume`` needs, a failed write says it is kept.
+
+    A full disk in the middle of a run or study is bad input of a kind (exit code 2), not
+    a bug: the message names the file, then says what is kept and how to go on.
+
+    Args:
+        kept: what stays, e.g. ``The run directory runs/x is kept as far as it got``.
+        how: how to go on, e.g. ``resume it with `cartpole-q train --resume runs/x```.
+    """
+    try:
+        yield
+    except WriteError as error:
+        raise WriteError(
+            f"{error} {kept}; make room (or fix what refused the write), then {how}."
+        ) from None
 
 
 def exit_if_stopped(stopped: bool, hint: str) -> None:

@@ -15,6 +15,7 @@ from cartpole_q.cli.base import (
     backend_connection,
     exit_codes,
     exit_if_stopped,
+    kept_on_write_error,
     note,
     say_if_compiling,
     stoppable,
@@ -157,11 +158,14 @@ def _run_sweep(
     if not quiet and backend is BackendChoice.ray:
         say_if_compiling(spec.points[0].config)
     progress = make_sweep_progress(quiet)
-    return sweeping.run_sweep(
-        spec, directory, workers=workers or default_workers(spec.runs),
-        backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
-        on_compile=say_compiling,
-    )  # fmt: skip
+    kept = f"The sweep directory {directory} keeps every run saved so far"
+    how = f"finish it with `cartpole-q sweep --resume {directory}`"
+    with kept_on_write_error(kept, how):
+        return sweeping.run_sweep(
+            spec, directory, workers=workers or default_workers(spec.runs),
+            backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
+            on_compile=say_compiling,
+        )  # fmt: skip
 
 
 @app.command("tune", cls=Command)
@@ -299,11 +303,13 @@ def _tune(
     hint = f"go on with `cartpole-q tune --resume {directory}`"
     if not quiet:
         say_if_compiling(spec.config_for({}))
-    outcome = tuning.run_tune(
-        spec, directory, storage_url, trials=trials,
-        workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
-        address=address, should_stop=stop.is_set, on_trial=report,
-    )  # fmt: skip
+    kept = "The study is kept, less the trial in flight"
+    with kept_on_write_error(kept, hint):
+        outcome = tuning.run_tune(
+            spec, directory, storage_url, trials=trials,
+            workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
+            address=address, should_stop=stop.is_set, on_trial=report,
+        )  # fmt: skip
     if not quiet and outcome.best is not None:
         best = outcome.best
         typer.echo(

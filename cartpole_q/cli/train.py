@@ -16,6 +16,7 @@ from cartpole_q.cli.base import (
     backend_connection,
     exit_codes,
     exit_if_stopped,
+    kept_on_write_error,
     say_if_compiling,
     stoppable,
 )
@@ -218,8 +219,9 @@ def _train_into(
         say_if_compiling(prepared.config, prepared)
     reporter = make_reporter(quiet)
     hint = f"resume with `cartpole-q train --resume {run_dir}`"
+    kept = f"The run directory {run_dir} is kept as far as it got"
     summary: RunSummary | MultiSeedSummary
-    with stoppable(hint) as stop:
+    with kept_on_write_error(kept, hint), stoppable(hint) as stop:
         try:
             if seeds is None:
                 outcome = runner.execute_run(

@@ -35,7 +35,7 @@ from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.results import RunSummary, SeedResult
 from cartpole_q.store import rundir
-from cartpole_q.store.atomic import remove_stale_temporaries
+from cartpole_q.store.atomic import make_directory, remove_stale_temporaries
 from cartpole_q.store.checkpoint import (
     CHECKPOINT_FILE,
     load_checkpoint,
@@ -270,7 +270,7 @@ def _greedy_viewer(
             from cartpole_q.store.video import VideoRecorder, offscreen_rendering
 
             videos = run_dir / VIDEOS_DIR
-            videos.mkdir(exist_ok=True)
+            make_directory(videos)
             path = videos / f"episode-{episode:06d}.gif"
             with VideoRecorder(path, episodes=1, force=True) as recorder:
                 with offscreen_rendering():

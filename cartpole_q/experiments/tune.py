@@ -150,26 +150,21 @@ def storage_errors(where: Path | str) -> Iterator[None]:
 
     The study in the storage stays usable: what a failed write cut short is removed when
     the storage is opened again, and the trial that was running is marked failed by the
-    next ``tune --resume``. So a full disk costs at most the trial in flight.
+    next ``tune --resume``. So a full disk costs at most the trial in flight (the command
+    line says so, and how to go on, once the study exists).
     """
     try:
         yield
     except OSError as error:
         path = Path(getattr(error, "filename", None) or where)
-        raise WriteError(
-            f"{path}: cannot be written: {write_failure(path, error)}. The study is kept, "
-            "less the trial in flight; make room, then go on with `cartpole-q tune --resume "
-            "DIR`."
-        ) from None
+        raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
     except Exception as error:
         if type(error).__module__.split(".")[0] not in ("sqlalchemy", "optuna"):
             raise
         if "disk" not in str(error).lower() and "OperationalError" not in type(error).__name__:
             raise
         raise WriteError(
-            f"--storage {where}: the database could not be written ({error}). The study is "
-            "kept, less the trial in flight; fix the database, then go on with `cartpole-q "
-            "tune --resume DIR`."
+            f"--storage {where}: the database could not be written ({error})."
         ) from None
 
 

@@ -120,6 +120,21 @@ def check_output_file(path: Path, option: str, suffixes: tuple[str, ...], force:
     return suffix
 
 
+def make_directory(path: Path) -> None:
+    """Create the directory ``path`` (and its parents) unless it exists.
+
+    Raises:
+        WriteError: it cannot be created (a full disk, no permission, a file in the way),
+            naming it.
+    """
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise WriteError(f"{path}: cannot be created: a file is in the way.") from None
+    except OSError as error:
+        raise WriteError(f"{path}: cannot be created: {write_failure(path, error)}.") from None
+
+
 def remove_stale_temporaries(run_dir: Path) -> None:
     """Delete temporary files a killed process left behind (never a finished file)."""
     for temporary in run_dir.glob(".*.tmp"):

@@ -38,7 +38,7 @@ import numpy as np
 
 from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.engines.base import EpisodeMetrics
-from cartpole_q.errors import RunError
+from cartpole_q.errors import RunError, WriteError
 from cartpole_q.evaluation import check_q_table
 from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
 from cartpole_q.store import lock
@@ -46,6 +46,7 @@ from cartpole_q.store.atomic import (
     atomic_save_npy,
     atomic_write_bytes,
     atomic_write_text,
+    make_directory,
     write_failure,
     write_json,
 )
@@ -137,9 +138,13 @@ def new_directory(
         try:
             held.name_holder()
             yield claim
-        except BaseException:
-            if not claim.kept:
-                _undo_start(claim, held.created)
+        except BaseException as error:
+            if claim.kept:
+                raise
+            _undo_start(claim, held.created)
+            if isinstance(error, WriteError):
+                undone = "was removed" if created else "was emptied again"
+                raise WriteError(f"{error} The new {kind} directory {undone}.") from None
             raise
     finally:
         held.release()
@@ -340,7 +345,7 @@ def write_run(
             f"{run_dir}: is not empty; write_run never overwrites a run. Choose a new "
             "directory, or pass overwrite=True to replace this run's files."
         )
-    run_dir.mkdir(parents=True, exist_ok=True)
+    make_directory(run_dir)
     write_config(run_dir, result.config)
     atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
     atomic_save_npy(run_dir / VISITS_FILE, result.visits)

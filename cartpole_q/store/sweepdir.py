@@ -26,7 +26,12 @@ from cartpole_q.config import parse_seeds, read_yaml_mapping
 from cartpole_q.errors import RunError
 from cartpole_q.results import SeedResult
 from cartpole_q.statistics import PointStatistics
-from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
+from cartpole_q.store.atomic import (
+    atomic_write_bytes,
+    atomic_write_text,
+    make_directory,
+    remove_stale_temporaries,
+)
 from cartpole_q.store.rundir import CONFIG_FILE, NewDirectory, new_directory, write_config
 
 SWEEP_FILE = "sweep.yaml"
@@ -79,7 +84,7 @@ def write_sweep(
     text = yaml.safe_dump(dict(resolved), sort_keys=False, default_flow_style=None)
     for point_id, config in configs:
         point_dir = directory / POINTS_DIR / point_id
-        point_dir.mkdir(parents=True, exist_ok=True)
+        make_directory(point_dir)
         write_config(point_dir, config)
     atomic_write_text(directory / SWEEP_FILE, header + text)
 
