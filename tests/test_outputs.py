@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import importlib
 import importlib.util
+import json
 import os
 import shutil
 import socket
@@ -247,6 +248,44 @@ def test_a_sweep_that_cannot_write_its_points_leaves_nothing(small_disk: Path) -
     _refused(result, f"{out}/points/", "no space is left on the device", "was removed")
     assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
     filler.unlink()
+
+
+# -- directory names that are not UTF-8 -------------------------------------------------
+
+
+def test_a_directory_name_that_is_not_utf8_works_end_to_end(tmp_path: Path) -> None:
+    """``--out $'bad\\xffname'``: the name reaches Python with a surrogate escape."""
+    run = tmp_path / os.fsdecode(b"bad\xffname")
+    result = invoke("train", "--episodes", 30, "--out", run)
+    assert result.exit_code == 0, result.output
+    assert result.stdout_bytes.splitlines()[-1] == os.fsencode(run)  # the name's own bytes
+    for name in ("summary.json", "reward_curve.png", "q_table.npy"):
+        assert (run / name).is_file(), name
+    resumed = invoke("train", "--resume", run, "--episodes", 40, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert json.loads((run / "summary.json").read_text())["episodes"] == 40
+    assert invoke("plot", run, run, "--out", tmp_path / "two.png").exit_code == 0
+
+
+def test_a_tune_directory_name_that_is_not_utf8_gets_its_best_yaml(tmp_path: Path) -> None:
+    pytest.importorskip("optuna")
+    tune = tmp_path / "t.yaml"
+    tune.write_text(
+        "base: {train: {episodes: 20}, eval: {episodes: 2}}\nseeds: 0-1\ntrials: 2\n"
+        "space: {agent.alpha: {low: 0.1, high: 1.0}}\n"
+    )
+    out = tmp_path / os.fsdecode(b"tune\xfe")
+    result = invoke("tune", tune, "--out", out, "--workers", 1, "-q")
+    assert result.exit_code == 0, result.output
+    header = (out / "best.yaml").read_text(encoding="utf-8").splitlines()[1]
+    assert header.endswith("tune\ufffd/best.yaml")
+
+
+def test_text_that_cannot_be_utf8_is_a_write_error_naming_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "notes.yaml"
+    with pytest.raises(WriteError, match=r"notes\.yaml: cannot be written: .*not UTF-8"):
+        atomic.atomic_write_text(path, "name: " + os.fsdecode(b"\xff"))
+    assert list(tmp_path.iterdir()) == []
 
 
 # -- extensions, defaults, --force ------------------------------------------------------

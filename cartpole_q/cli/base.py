@@ -44,6 +44,7 @@ class _App(TyperGroup):
         """Run the command line; usage errors become one line and exit code 2."""
         import sys
 
+        _print_file_names_as_given(sys.stdout)
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
         try:
@@ -59,6 +60,18 @@ class _App(TyperGroup):
             typer.echo(f"error: {message}{where}", err=True)
             sys.exit(exit_code)
         sys.exit(code if isinstance(code, int) else 0)
+
+
+def _print_file_names_as_given(stream: Any) -> None:
+    r"""Print a path that is not UTF-8 as its own bytes instead of failing.
+
+    Such a name (``--out $'bad\xffname'``) reaches Python with surrogate escapes, which a
+    UTF-8 stdout refuses under most locales: the command would fail at its last line, the
+    run directory's path, which scripts read back (and need byte for byte).
+    """
+    reconfigure = getattr(stream, "reconfigure", None)
+    if reconfigure is not None and getattr(stream, "encoding", "").lower() in ("utf-8", "utf8"):
+        reconfigure(errors="surrogateescape")
 
 
 app = typer.Typer(

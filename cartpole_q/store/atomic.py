@@ -142,8 +142,21 @@ def remove_stale_temporaries(run_dir: Path) -> None:
 
 
 def atomic_write_text(path: Path, text: str) -> None:
-    """Write UTF-8 text atomically."""
-    atomic_write_bytes(path, text.encode("utf-8"))
+    """Write UTF-8 text atomically.
+
+    Raises:
+        WriteError: the file cannot be written, or ``text`` cannot be UTF-8 (it holds
+            an undecodable file name's surrogate escapes).
+    """
+    try:
+        data = text.encode("utf-8")
+    except UnicodeEncodeError as error:
+        raise WriteError(
+            f"{os.fsencode(path).decode('utf-8', 'replace')}: cannot be written: its text "
+            f"would hold {error.object[error.start : error.end]!a}, which is not UTF-8 (a "
+            "file name that is not UTF-8 text?)."
+        ) from None
+    atomic_write_bytes(path, data)
 
 
 def atomic_save_npy(path: Path, array: np.ndarray) -> None:

@@ -10,6 +10,7 @@ the end of every ``tune`` call.
 from __future__ import annotations
 
 import contextlib
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -74,9 +75,11 @@ def write_trials(directory: Path, header: Sequence[str], rows: Iterable[Mapping[
 
 def write_best(directory: Path, config: Config, trial: int) -> None:
     """Write ``best.yaml``: the best trial's complete config (``train --config`` takes it)."""
+    # A directory name that is not UTF-8 is shown with U+FFFD: the comment is for reading.
+    shown = os.fsencode(directory / BEST_FILE).decode("utf-8", "replace")
     header = (
         f"# The best trial ({trial}) of this study: a complete config.\n"
-        f"# cartpole-q train --config {directory / BEST_FILE}\n"
+        f"# cartpole-q train --config {shown}\n"
     )
     atomic_write_text(directory / BEST_FILE, header + config.to_yaml())
 
