@@ -419,6 +419,18 @@ def test_not_a_run_directory(tmp_path: Path, command: str) -> None:
         ),
         (lambda d: (d / "config.yaml").write_text("agent: {alpha: 7}\n"), "config.yaml"),
         (lambda d: (d / "summary.json").write_text("{truncated"), "summary.json"),
+        (
+            lambda d: ((d / "q_table.npy").unlink(), (d / "q_table.npy").mkdir()),
+            "q_table.npy: is a directory, but a .npy array file is expected here",
+        ),
+        (
+            lambda d: ((d / "summary.json").unlink(), (d / "summary.json").mkdir()),
+            "summary.json: is a directory, not a JSON file",
+        ),
+        (
+            lambda d: ((d / "metrics.csv").unlink(), (d / "metrics.csv").mkdir()),
+            "metrics.csv: is a directory, not a CSV file",
+        ),
         (lambda d: (d / "metrics.csv").write_text("a,b\n1,2\n"), "metrics.csv"),
     ],
 )

@@ -485,8 +485,11 @@ def load_array(path: Path, dtype: type) -> np.ndarray:
     Raises:
         RunError: the file is missing, truncated, an object array, or of another dtype.
     """
-    if not path.is_file():
+    if not path.exists():
         raise RunError(f"{path}: is missing.")
+    if not path.is_file():
+        kind = "a directory" if path.is_dir() else "not a regular file"
+        raise RunError(f"{path}: is {kind}, but a .npy array file is expected here.")
     try:
         with open(path, "rb") as stream:
             magic = stream.read(len(NPY_MAGIC))
@@ -537,6 +540,8 @@ def read_metric_columns(
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise RunError(f"{path}: is missing.") from None
+    except IsADirectoryError:
+        raise RunError(f"{path}: is a directory, not a CSV file.") from None
     except (OSError, UnicodeDecodeError) as error:
         raise RunError(f"{path}: cannot be read ({error}).") from None
     rows = list(csv.reader(io.StringIO(text)))
@@ -595,7 +600,13 @@ def _read_json(path: Path) -> object:
         return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         return None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+    except NotADirectoryError:
+        raise RunError(f"{path.parent}: is a file, but a run directory was expected here.") from None
+    except IsADirectoryError:
+        raise RunError(f"{path}: is a directory, not a JSON file.") from None
+    except OSError as error:
+        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise RunError(f"{path}: is not valid JSON ({error}).") from None
 
 
