@@ -214,9 +214,11 @@ def check_storage(spec: TuneSpec, storage_url: str | None, join: bool, where: st
         where: the tune file, for messages.
 
     Raises:
-        ConfigError: the storage already holds a study of this name and ``join`` is not
-            set; ``join`` without a study (or without ``--storage``) to join; or the
-            study's search differs from the file's (naming the key and both values).
+        ConfigError: ``storage_url`` is a directory; the storage already holds a study of
+            this name and ``join`` is not set; ``join`` without a study (or without
+            ``--storage``) to join; or the study's search differs from the file's (naming
+            the key and both values).
+        WriteError: the storage cannot be opened for writing (naming it).
     """
     if storage_url is None:
         if join:
@@ -224,6 +226,12 @@ def check_storage(spec: TuneSpec, storage_url: str | None, join: bool, where: st
                 "--join adds trials to a study in a shared storage: give its --storage too."
             )
         return
+    if "://" not in storage_url and Path(storage_url).is_dir():
+        raise ConfigError(
+            f"--storage {storage_url}: is a directory; give a journal file's path (such as "
+            f"{Path(storage_url) / tunedir.JOURNAL_FILE}) or an Optuna storage URL "
+            "(sqlite:///study.db, postgresql://...)."
+        )
     optuna = optuna_module()
     storage = storage_for(Path(), storage_url)
     with storage_errors(storage_url):
