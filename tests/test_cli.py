@@ -349,6 +349,13 @@ def test_bad_command_line_values(in_tmp: Path) -> None:
     assert not (in_tmp / "runs").exists()
 
 
+@pytest.mark.parametrize("args", [("--seeds", "0,0"), ("--set", "train.seeds=[0, 3, 0]")])
+def test_a_seed_given_twice_is_refused(in_tmp: Path, args: tuple[str, ...]) -> None:
+    """Not one run silently: a repeated seed is more likely a typo."""
+    assert_refused(invoke("train", *args), "train.seeds: seed 0 is given twice")
+    assert not (in_tmp / "runs").exists()
+
+
 def test_out_must_be_new_or_empty(tmp_path: Path) -> None:
     existing = tmp_path / "existing"
     existing.mkdir()

@@ -329,8 +329,8 @@ class TrainConfig:
     seeds: tuple[int, ...] | None = field(
         metadata=spec(
             "seeds",
-            'e.g. `"0-99"` or `[0, 1, 2]`: one run per seed, in parallel; `null` trains the '
-            "single `seed`",
+            'e.g. `"0-99"` or `[0, 1, 2]`: one run per seed, in parallel (each seed once); '
+            "`null` trains the single `seed`",
             nullable=True,
         )
     )

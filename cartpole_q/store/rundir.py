@@ -601,7 +601,9 @@ def _read_json(path: Path) -> object:
     except FileNotFoundError:
         return None
     except NotADirectoryError:
-        raise RunError(f"{path.parent}: is a file, but a run directory was expected here.") from None
+        raise RunError(
+            f"{path.parent}: is a file, but a run directory was expected here."
+        ) from None
     except IsADirectoryError:
         raise RunError(f"{path}: is a directory, not a JSON file.") from None
     except OSError as error:
