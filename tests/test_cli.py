@@ -94,6 +94,24 @@ def test_train_prints_the_run_directory_last(in_tmp: Path) -> None:
     assert (in_tmp / last / "summary.json").is_file()
 
 
+@pytest.mark.parametrize(
+    ("args", "prefix"),
+    [
+        (("--set", "env.id=FrozenLake-v1"), "frozenlake-"),
+        (("--set", "env.id=FrozenLake-v1", "--set", "name=mine"), "mine-"),
+        (("--set", "env.id=FrozenLake-v1", "--set", "name=default"), "default-"),
+    ],
+)
+def test_a_run_of_another_env_is_named_after_it_unless_named(
+    in_tmp: Path, args: tuple[str, ...], prefix: str
+) -> None:
+    result = invoke("train", *args, "--episodes", "2", "--engine", "gymnasium", "-q")
+    assert result.exit_code == 0, result.output
+    run = in_tmp / result.stdout.strip()
+    assert run.parent.name == "runs" and run.name.startswith(prefix), run
+    assert load_config(run / "config.yaml").name == prefix[:-1]
+
+
 def test_two_runs_in_the_same_second_get_different_directories(in_tmp: Path) -> None:
     first = invoke("train", "--episodes", "5", "-q").stdout.strip()
     second = invoke("train", "--episodes", "5", "-q").stdout.strip()

@@ -410,7 +410,13 @@ class EvalConfig:
 class Config:
     """A complete, validated run configuration. Never mutated after loading."""
 
-    name: str = field(metadata=spec("name", "run-name prefix: letters, digits, `-`, `_`"))
+    name: str = field(
+        metadata=spec(
+            "name",
+            "run-name prefix: letters, digits, `-`, `_`; left out with another `env.id`, "
+            "made from it (`frozenlake` for `FrozenLake-v1`)",
+        )
+    )
     seed: int = field(
         metadata=spec(
             "int",
