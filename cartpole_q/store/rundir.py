@@ -150,22 +150,6 @@ def new_directory(
         held.release()
 
 
-def create_run_dir(
-    name: str, out: Path | None, runs_root: Path = Path("runs"), kind: str = "run"
-) -> Path:
-    """Create an empty directory for a new run (or sweep, or study), never a non-empty one.
-
-    The lock is released on return: a command that goes on to write the directory uses
-    :func:`new_directory`, which holds it.
-
-    Raises:
-        RunError: ``out`` is a file or a non-empty directory.
-    """
-    with new_directory(name, out, runs_root, kind) as claim:
-        claim.keep()
-        return claim.path
-
-
 def check_output_dir(out: Path, runs_root: Path = Path("runs"), kind: str = "run") -> None:
     """Refuse an output path that is a file or a non-empty directory (a lock file aside).
 
