@@ -12,10 +12,11 @@ refused.
 
 A new directory is locked before anything looks into it (see
 :func:`cartpole_q.store.rundir.new_directory`); a command that fails while starting
-removes the directory it created, lock file included, while it still holds the lock. A
-writer that was waiting for that lock then holds a file that is no longer in the
-directory: :func:`acquire_lock` checks for this and says so (``None``), instead of
-handing out a lock that nobody else can see.
+removes the directory it created (or the lock file it created), while it still holds the
+lock. A writer that was waiting for that lock then holds a file that is no longer in the
+directory: :func:`acquire_lock` checks for this and locks the directory's new lock file,
+or says that the directory is gone (``None``), instead of handing out a lock that nobody
+else can see.
 """
 
 from __future__ import annotations
