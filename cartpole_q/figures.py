@@ -345,8 +345,36 @@ def project_policy(
     return q_map, q_map.max(axis=-1), state_visits.sum(axis=2)
 
 
+def drawable(text: str) -> str:
+    r"""``text`` as a font can draw it: undecodable file-name bytes become U+FFFD.
+
+    A directory name that is not UTF-8 (``--out $'bad\xffname'``) reaches Python as a
+    string with surrogate escapes, which matplotlib cannot lay out; titles and labels
+    name run directories, so every text of a figure goes through this before rendering.
+
+    >>> drawable("bad\udcffname") == "bad\ufffdname", drawable("seed 3")
+    (True, 'seed 3')
+    """
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "replace")
+    except UnicodeEncodeError:  # a surrogate that no undecodable byte made
+        return text.encode("utf-8", "replace").decode("utf-8")
+
+
+def _make_drawable(figure: Figure) -> None:
+    """Make every text of ``figure`` drawable (see :func:`drawable`)."""
+    from matplotlib.text import Text
+
+    for artist in figure.findobj(Text):
+        assert isinstance(artist, Text)
+        text = artist.get_text()
+        if text != drawable(text):
+            artist.set_text(drawable(text))
+
+
 def figure_png(figure: Figure) -> bytes:
     """Render a figure to PNG bytes."""
+    _make_drawable(figure)
     canvas = FigureCanvasAgg(figure)
     buffer = io.BytesIO()
     canvas.print_png(buffer)  # type: ignore[no-untyped-call]
@@ -357,6 +385,7 @@ def figure_bytes(figure: Figure, file_format: str) -> bytes:
     """Render a figure as ``png``, ``svg`` or ``pdf`` bytes."""
     if file_format == "png":
         return figure_png(figure)
+    _make_drawable(figure)
     buffer = io.BytesIO()
     # The date would make every SVG or PDF of the same run differ.
     metadata = {"Date": None}

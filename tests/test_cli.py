@@ -94,6 +94,24 @@ def test_train_prints_the_run_directory_last(in_tmp: Path) -> None:
     assert (in_tmp / last / "summary.json").is_file()
 
 
+@pytest.mark.parametrize(
+    ("args", "prefix"),
+    [
+        (("--set", "env.id=FrozenLake-v1"), "frozenlake-"),
+        (("--set", "env.id=FrozenLake-v1", "--set", "name=mine"), "mine-"),
+        (("--set", "env.id=FrozenLake-v1", "--set", "name=default"), "default-"),
+    ],
+)
+def test_a_run_of_another_env_is_named_after_it_unless_named(
+    in_tmp: Path, args: tuple[str, ...], prefix: str
+) -> None:
+    result = invoke("train", *args, "--episodes", "2", "--engine", "gymnasium", "-q")
+    assert result.exit_code == 0, result.output
+    run = in_tmp / result.stdout.strip()
+    assert run.parent.name == "runs" and run.name.startswith(prefix), run
+    assert load_config(run / "config.yaml").name == prefix[:-1]
+
+
 def test_two_runs_in_the_same_second_get_different_directories(in_tmp: Path) -> None:
     first = invoke("train", "--episodes", "5", "-q").stdout.strip()
     second = invoke("train", "--episodes", "5", "-q").stdout.strip()
@@ -349,6 +367,13 @@ def test_bad_command_line_values(in_tmp: Path) -> None:
     assert not (in_tmp / "runs").exists()
 
 
+@pytest.mark.parametrize("args", [("--seeds", "0,0"), ("--set", "train.seeds=[0, 3, 0]")])
+def test_a_seed_given_twice_is_refused(in_tmp: Path, args: tuple[str, ...]) -> None:
+    """Not one run silently: a repeated seed is more likely a typo."""
+    assert_refused(invoke("train", *args), "train.seeds: seed 0 is given twice")
+    assert not (in_tmp / "runs").exists()
+
+
 def test_out_must_be_new_or_empty(tmp_path: Path) -> None:
     existing = tmp_path / "existing"
     existing.mkdir()
@@ -419,6 +444,18 @@ def test_not_a_run_directory(tmp_path: Path, command: str) -> None:
         ),
         (lambda d: (d / "config.yaml").write_text("agent: {alpha: 7}\n"), "config.yaml"),
         (lambda d: (d / "summary.json").write_text("{truncated"), "summary.json"),
+        (
+            lambda d: ((d / "q_table.npy").unlink(), (d / "q_table.npy").mkdir()),
+            "q_table.npy: is a directory, but a .npy array file is expected here",
+        ),
+        (
+            lambda d: ((d / "summary.json").unlink(), (d / "summary.json").mkdir()),
+            "summary.json: is a directory, not a JSON file",
+        ),
+        (
+            lambda d: ((d / "metrics.csv").unlink(), (d / "metrics.csv").mkdir()),
+            "metrics.csv: is a directory, not a CSV file",
+        ),
         (lambda d: (d / "metrics.csv").write_text("a,b\n1,2\n"), "metrics.csv"),
     ],
 )

@@ -394,7 +394,11 @@ def test_an_env_module_that_cannot_be_imported_is_a_config_error() -> None:
 
 def test_seed_lists() -> None:
     assert parse_seeds("0-3,7") == (0, 1, 2, 3, 7)
-    assert parse_seeds([3, 1, 3]) == (1, 3)
+    assert parse_seeds([3, 1]) == (1, 3)
+    with pytest.raises(ValueError, match=r"^seed 3 is given twice"):
+        parse_seeds([3, 1, 3])
+    with pytest.raises(ValueError, match=r"^seeds 0-1,5 are given twice"):
+        parse_seeds("0-9,0-1,5")
     assert parse_seeds(5) == (5,)
     assert format_seeds(range(100)) == "0-99"
     assert format_seeds([0, 2, 3, 4, 9]) == "0,2-4,9"

@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -64,3 +67,55 @@ def test_the_lock_is_free_after_kill_9(tmp_path: Path) -> None:
     holder.wait()
     with lock.directory_lock(tmp_path, "sweep"):
         pass
+
+
+def _wait_for_the_lock_in_a_thread(
+    directory: Path, monkeypatch: pytest.MonkeyPatch
+) -> tuple[threading.Thread, list[lock.HeldLock | None]]:
+    """``acquire_lock(directory)`` in a thread, returned once it waits with the file open."""
+    waiting = threading.Event()
+    real = lock._try_lock
+
+    def try_lock(*args: Any) -> bool:
+        waiting.set()
+        return real(*args)
+
+    monkeypatch.setattr(lock, "_try_lock", try_lock)
+    got: list[lock.HeldLock | None] = []
+    thread = threading.Thread(target=lambda: got.append(lock.acquire_lock(directory)))
+    thread.start()
+    assert waiting.wait(10)
+    return thread, got
+
+
+def test_a_waiter_whose_directory_a_failed_start_removed_is_told(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Not a lock on a file nobody else can see: ``None``, so the claim starts over."""
+    directory = tmp_path / "new"
+    directory.mkdir()
+    first = lock.acquire_lock(directory)
+    assert first is not None
+    thread, got = _wait_for_the_lock_in_a_thread(directory, monkeypatch)
+    shutil.rmtree(directory)  # a failed start removes the directory it created
+    first.release()
+    thread.join()
+    assert got == [None]
+
+
+def test_a_waiter_whose_lock_file_was_removed_locks_the_new_one(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    first = lock.acquire_lock(tmp_path)
+    assert first is not None
+    thread, got = _wait_for_the_lock_in_a_thread(tmp_path, monkeypatch)
+    (tmp_path / lock.LOCK_FILE).unlink()  # a failed start removes the lock file it created
+    first.release()
+    thread.join()
+    (held,) = got
+    assert held is not None
+    try:
+        assert os.fstat(held.descriptor).st_ino == os.stat(tmp_path / lock.LOCK_FILE).st_ino
+        assert held.created
+    finally:
+        held.release()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import errno
 import importlib
 import importlib.util
+import json
 import os
 import shutil
 import socket
@@ -130,6 +131,17 @@ def test_a_failed_write_leaves_no_partial_file(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["curve.png"]
 
 
+def test_a_directory_that_cannot_be_made_is_a_write_error_naming_it(tmp_path: Path) -> None:
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("x")
+    with pytest.raises(WriteError, match=f"^{in_the_way}: cannot be created: a file is in the way"):
+        atomic.make_directory(in_the_way)
+    with pytest.raises(WriteError, match=f"{in_the_way} is not a directory"):
+        atomic.make_directory(in_the_way / "videos")
+    with pytest.raises(WriteError, match="/proc/x: cannot be created: "):
+        atomic.make_directory(Path("/proc/x"))
+
+
 # -- unwritable and full places ---------------------------------------------------------
 
 
@@ -166,6 +178,114 @@ def test_full_disk_plot_video_and_train(run_dir: Path, full_disk: Path) -> None:
     _refused(invoke("train", "--out", run, "-q"), str(run), "no space is left on the device")
     _no_temporaries(run)
     assert not (run / "summary.json").exists()
+
+
+@pytest.fixture
+def small_disk(tmp_path: Path) -> Iterator[Path]:
+    """A real 256 KiB file system (tmpfs; needs root, else skipped), to fill up by hand."""
+    if shutil.which("mount") is None or os.geteuid() != 0:
+        pytest.skip("mounting a tmpfs needs root")
+    yield from _mount_tmpfs(tmp_path / "small", "size=256k")
+
+
+def _fill(disk: Path, free_blocks: int) -> Path:
+    """Fill ``disk`` up to its last ``free_blocks`` blocks (a tmpfs block is a 4 KiB page)."""
+    stats = os.statvfs(disk)
+    filler = disk / "filler"
+    filler.write_bytes(b"\0" * (stats.f_bavail - free_blocks) * stats.f_frsize)
+    assert os.statvfs(disk).f_bavail == free_blocks
+    return filler
+
+
+@pytest.mark.parametrize(
+    ("free", "file"),
+    [(0, ".lock"), (1, "config.yaml")],
+    ids=["no block: the lock file", "one block: the lock file, not config.yaml"],
+)
+def test_train_into_a_nearly_full_disk_leaves_nothing_half_started(
+    small_disk: Path, free: int, file: str
+) -> None:
+    """The lock file (written first) or config.yaml cannot be written: the directory goes."""
+    filler = _fill(small_disk, free)
+    run = small_disk / "run"
+    result = invoke("train", "--episodes", 30, "--out", run, "-q")
+    _refused(result, f"{run / file}: cannot be written", "no space is left on the device")
+    assert "The new run directory was removed." in result.stderr
+    assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
+    filler.unlink()
+    assert invoke("train", "--episodes", 30, "--out", run, "-q").exit_code == 0
+
+
+def test_a_disk_full_during_training_keeps_a_run_that_resumes(
+    small_disk: Path, tmp_path: Path
+) -> None:
+    """Room for the lock file and config.yaml, not for the first checkpoint."""
+    filler = _fill(small_disk, 2)
+    run = small_disk / "run"
+    args = ("train", "--episodes", 30, "--set", "train.checkpoint_every=10", "-q")
+    result = invoke(*args, "--out", run)
+    _refused(result, f"{run}/", "no space is left on the device")
+    assert (
+        f"make room (or fix what refused the write), then resume with `cartpole-q train --resume {run}`"
+        in result.stderr
+    )
+    assert sorted(p.name for p in run.iterdir()) == [".lock", "config.yaml"]
+    filler.unlink()
+    resumed = invoke("train", "--resume", run, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    reference = tmp_path / "reference"
+    assert invoke(*args, "--out", reference).exit_code == 0
+    assert (run / "q_table.npy").read_bytes() == (reference / "q_table.npy").read_bytes()
+
+
+def test_a_sweep_that_cannot_write_its_points_leaves_nothing(small_disk: Path) -> None:
+    """Room for the lock file and one point's config.yaml, not the second's."""
+    sweep = small_disk.parent / "s.yaml"
+    sweep.write_text("seeds: 0\ngrid:\n  agent.alpha: [0.1, 0.2, 0.3]\n")
+    filler = _fill(small_disk, 2)
+    out = small_disk / "sweep"
+    result = invoke("sweep", sweep, "--out", out, "-q")
+    _refused(result, f"{out}/points/", "no space is left on the device", "was removed")
+    assert sorted(p.name for p in small_disk.iterdir()) == ["filler"]
+    filler.unlink()
+
+
+# -- directory names that are not UTF-8 -------------------------------------------------
+
+
+def test_a_directory_name_that_is_not_utf8_works_end_to_end(tmp_path: Path) -> None:
+    """``--out $'bad\\xffname'``: the name reaches Python with a surrogate escape."""
+    run = tmp_path / os.fsdecode(b"bad\xffname")
+    result = invoke("train", "--episodes", 30, "--out", run)
+    assert result.exit_code == 0, result.output
+    assert result.stdout_bytes.splitlines()[-1] == os.fsencode(run)  # the name's own bytes
+    for name in ("summary.json", "reward_curve.png", "q_table.npy"):
+        assert (run / name).is_file(), name
+    resumed = invoke("train", "--resume", run, "--episodes", 40, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert json.loads((run / "summary.json").read_text())["episodes"] == 40
+    assert invoke("plot", run, run, "--out", tmp_path / "two.png").exit_code == 0
+
+
+def test_a_tune_directory_name_that_is_not_utf8_gets_its_best_yaml(tmp_path: Path) -> None:
+    pytest.importorskip("optuna")
+    tune = tmp_path / "t.yaml"
+    tune.write_text(
+        "base: {train: {episodes: 20}, eval: {episodes: 2}}\nseeds: 0-1\ntrials: 2\n"
+        "space: {agent.alpha: {low: 0.1, high: 1.0}}\n"
+    )
+    out = tmp_path / os.fsdecode(b"tune\xfe")
+    result = invoke("tune", tune, "--out", out, "--workers", 1, "-q")
+    assert result.exit_code == 0, result.output
+    header = (out / "best.yaml").read_text(encoding="utf-8").splitlines()[1]
+    assert header.endswith("tune\ufffd/best.yaml")
+
+
+def test_text_that_cannot_be_utf8_is_a_write_error_naming_the_file(tmp_path: Path) -> None:
+    path = tmp_path / "notes.yaml"
+    with pytest.raises(WriteError, match=r"notes\.yaml: cannot be written: .*not UTF-8"):
+        atomic.atomic_write_text(path, "name: " + os.fsdecode(b"\xff"))
+    assert list(tmp_path.iterdir()) == []
 
 
 # -- extensions, defaults, --force ------------------------------------------------------

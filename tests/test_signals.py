@@ -237,6 +237,20 @@ def test_interrupted_multi_seed_summary_is_over_the_finished_seeds(
     assert "unfinished                 3 of 3: seeds 0-1 interrupted" in out
 
 
+def test_a_seed_that_is_a_file_is_named_as_such(reference: Path, tmp_path: Path) -> None:
+    """Not "summary.json is not valid JSON": the seed-NNN itself is what is wrong."""
+    parent = tmp_path / "parent"
+    shutil.copytree(reference, parent)
+    child = seed_dir(parent, 1, SEEDS)
+    shutil.rmtree(child)
+    child.write_text("not a run\n")
+    (parent / rundir.SUMMARY_FILE).unlink()
+    expected = f"error: {child}: is a file, but a run directory was expected here.\n"
+    for args in (("eval", parent), ("plot", parent), ("train", "--resume", parent, "-q")):
+        result = invoke(*args)
+        assert (result.exit_code, result.stderr) == (2, expected), args
+
+
 def test_multi_seed_eval_names_missing_and_unfinished_seeds(
     reference: Path, tmp_path: Path
 ) -> None:

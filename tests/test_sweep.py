@@ -568,7 +568,7 @@ def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """A real SIGINT right after ``sweep.yaml`` is written, before any run or compilation."""
-    monkeypatch.setattr(sweeping, "start_sweep", then_sigint(sweeping.start_sweep))
+    monkeypatch.setattr(sweepdir, "write_sweep", then_sigint(sweepdir.write_sweep))
     directory = tmp_path / "early"
     result = invoke("sweep", write_yaml(tmp_path / "s.yaml", SWEEP), "--out", directory, "-q")
     assert result.exit_code == 130, result.output

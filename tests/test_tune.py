@@ -446,6 +446,25 @@ def test_a_study_in_a_storage_is_joined_only_when_asked_and_alike(
     assert not (tmp_path / "o5").exists() and not (tmp_path / "o6").exists()
 
 
+def test_a_storage_that_cannot_be_used_is_refused_before_anything_starts(tmp_path: Path) -> None:
+    """No "the study is kept ... make room": nothing has started."""
+    path = write_yaml(tmp_path / "small.yaml", TUNE)
+    out = tmp_path / "out"
+    result = invoke("tune", path, "--out", out, "--storage", tmp_path)
+    assert result.exit_code == 2, result.output
+    assert result.stderr == (
+        f"error: --storage {tmp_path}: is a directory; give a journal file's path (such as "
+        f"{tmp_path / tunedir.JOURNAL_FILE}) or an Optuna storage URL (sqlite:///study.db, "
+        "postgresql://...).\n"
+    )
+    nowhere = tmp_path / "no" / "such.journal"
+    result = invoke("tune", path, "--out", out, "--storage", nowhere)
+    assert result.exit_code == 2, result.output
+    assert "kept" not in result.stderr and "--resume" not in result.stderr, result.stderr
+    assert f"the directory {nowhere.parent} does not exist" in result.stderr
+    assert not out.exists()
+
+
 @pytest.mark.slow
 def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path: Path) -> None:
     path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 40, "seeds": "0-19"})
@@ -593,10 +612,8 @@ def test_a_full_disk_costs_at_most_the_trial_in_flight_and_resume_recovers(
 def test_a_signal_as_soon_as_the_directory_exists_is_answered_like_any_other(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A real SIGINT right after the tune directory is created, before any trial."""
-    from cartpole_q.experiments import tune as tuning
-
-    monkeypatch.setattr(tuning, "start_tune", then_sigint(tuning.start_tune))
+    """A real SIGINT right after ``tune.yaml`` is written, before the study or any trial."""
+    monkeypatch.setattr(tunedir, "write_tune", then_sigint(tunedir.write_tune))
     directory = tmp_path / "early"
     path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 2, "seeds": "0-1"})
     result = invoke("tune", path, "--out", directory, "-q")

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Annotated, Any, NoReturn
 import typer
 from typer.core import TyperCommand, TyperGroup
 
-from cartpole_q.errors import UserError
+from cartpole_q.errors import UserError, WriteError
 
 if TYPE_CHECKING:
     from cartpole_q.experiments.run import StopRequest
@@ -44,6 +44,7 @@ class _App(TyperGroup):
         """Run the command line; usage errors become one line and exit code 2."""
         import sys
 
+        _print_file_names_as_given(sys.stdout)
         if not standalone_mode:
             return super().main(args, prog_name, complete_var, standalone_mode, **extra)
         try:
@@ -59,6 +60,18 @@ class _App(TyperGroup):
             typer.echo(f"error: {message}{where}", err=True)
             sys.exit(exit_code)
         sys.exit(code if isinstance(code, int) else 0)
+
+
+def _print_file_names_as_given(stream: Any) -> None:
+    r"""Print a path that is not UTF-8 as its own bytes instead of failing.
+
+    Such a name (``--out $'bad\xffname'``) reaches Python with surrogate escapes, which a
+    UTF-8 stdout refuses under most locales: the command would fail at its last line, the
+    run directory's path, which scripts read back (and need byte for byte).
+    """
+    reconfigure = getattr(stream, "reconfigure", None)
+    if reconfigure is not None and getattr(stream, "encoding", "").lower() in ("utf-8", "utf8"):
+        reconfigure(errors="surrogateescape")
 
 
 app = typer.Typer(
@@ -194,6 +207,25 @@ def stoppable(hint: str | Callable[[], str]) -> Iterator[StopRequest]:
             saved = getattr(error, "text", None)
             how = hint() if callable(hint) else hint
             exit_interrupted(f"interrupted at once: {f'{saved}; ' if saved else ''}{how}")
+
+
+@contextmanager
+def kept_on_write_error(kept: str, how: str) -> Iterator[None]:
+    """Once a directory holds what ``--resume`` needs, a failed write says it is kept.
+
+    A full disk in the middle of a run or study is bad input of a kind (exit code 2), not
+    a bug: the message names the file, then says what is kept and how to go on.
+
+    Args:
+        kept: what stays, e.g. ``The run directory runs/x is kept as far as it got``.
+        how: how to go on, e.g. ``resume it with `cartpole-q train --resume runs/x```.
+    """
+    try:
+        yield
+    except WriteError as error:
+        raise WriteError(
+            f"{error} {kept}; make room (or fix what refused the write), then {how}."
+        ) from None
 
 
 def exit_if_stopped(stopped: bool, hint: str) -> None:

@@ -15,6 +15,7 @@ from cartpole_q.cli.base import (
     backend_connection,
     exit_codes,
     exit_if_stopped,
+    kept_on_write_error,
     note,
     say_if_compiling,
     stoppable,
@@ -94,10 +95,9 @@ def sweep_command(
             # sweep answers (saying what it saved), however early it comes.
             started: list[Path] = []
             hint = _resume_hint("sweep", "finish", lambda: started[0] if started else None)
-            with stoppable(hint) as stop:
-                started.append(sweeping.start_sweep(spec, out))
-                with directory_lock(started[0], "sweep"):
-                    outcome = _run_sweep(spec, started[0], workers, backend, address, quiet, stop)
+            with stoppable(hint) as stop, sweeping.new_sweep(spec, out) as directory:
+                started.append(directory)
+                outcome = _run_sweep(spec, directory, workers, backend, address, quiet, stop)
         if not quiet and outcome.complete:
             from cartpole_q.cli.report import print_sweep_summary
 
@@ -158,11 +158,14 @@ def _run_sweep(
     if not quiet and backend is BackendChoice.ray:
         say_if_compiling(spec.points[0].config)
     progress = make_sweep_progress(quiet)
-    return sweeping.run_sweep(
-        spec, directory, workers=workers or default_workers(spec.runs),
-        backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
-        on_compile=say_compiling,
-    )  # fmt: skip
+    kept = f"The sweep directory {directory} keeps every run saved so far"
+    how = f"finish it with `cartpole-q sweep --resume {directory}`"
+    with kept_on_write_error(kept, how):
+        return sweeping.run_sweep(
+            spec, directory, workers=workers or default_workers(spec.runs),
+            backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
+            on_compile=say_compiling,
+        )  # fmt: skip
 
 
 @app.command("tune", cls=Command)
@@ -259,10 +262,9 @@ def tune_command(
         # study answers (with how to go on), however early it comes.
         started: list[Path] = []
         hint = _resume_hint("tune", "go on", lambda: started[0] if started else None)
-        with stoppable(hint) as stop:
-            started.append(tuning.start_tune(spec, out, storage_url))
-            with directory_lock(started[0], "tune directory"):
-                _tune(spec, started[0], storage_url, trials, workers, backend, address, quiet, stop)
+        with stoppable(hint) as stop, tuning.new_tune(spec, out, storage_url) as directory:
+            started.append(directory)
+            _tune(spec, directory, storage_url, trials, workers, backend, address, quiet, stop)
 
 
 def _check_tune_size(spec: Any, trials: int | None, max_runs: int, yes: bool, where: str) -> None:
@@ -301,11 +303,13 @@ def _tune(
     hint = f"go on with `cartpole-q tune --resume {directory}`"
     if not quiet:
         say_if_compiling(spec.config_for({}))
-    outcome = tuning.run_tune(
-        spec, directory, storage_url, trials=trials,
-        workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
-        address=address, should_stop=stop.is_set, on_trial=report,
-    )  # fmt: skip
+    kept = "The study is kept, less the trial in flight"
+    with kept_on_write_error(kept, hint):
+        outcome = tuning.run_tune(
+            spec, directory, storage_url, trials=trials,
+            workers=workers or default_workers(len(spec.seeds)), backend=backend.value,
+            address=address, should_stop=stop.is_set, on_trial=report,
+        )  # fmt: skip
     if not quiet and outcome.best is not None:
         best = outcome.best
         typer.echo(

@@ -16,6 +16,7 @@ from cartpole_q.cli.base import (
     backend_connection,
     exit_codes,
     exit_if_stopped,
+    kept_on_write_error,
     say_if_compiling,
     stoppable,
 )
@@ -150,13 +151,14 @@ def train(
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
         _check_outputs(prepared.config, tensorboard, video_every)
         # Connected (or refused) before the run directory is created.
-        with backend_connection(backend, workers, address):
-            run_dir = runner.start_run(prepared, out)
-            with directory_lock(run_dir, "run"):
-                _train_into(
-                    run_dir, prepared, False, workers, backend, address, quiet, watch,
-                    video_every, seed_plots,
-                )  # fmt: skip
+        with (
+            backend_connection(backend, workers, address),
+            runner.new_run(prepared, out) as run_dir,
+        ):
+            _train_into(
+                run_dir, prepared, False, workers, backend, address, quiet, watch,
+                video_every, seed_plots,
+            )  # fmt: skip
 
 
 def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendChoice) -> None:
@@ -217,8 +219,9 @@ def _train_into(
         say_if_compiling(prepared.config, prepared)
     reporter = make_reporter(quiet)
     hint = f"resume with `cartpole-q train --resume {run_dir}`"
+    kept = f"The run directory {run_dir} is kept as far as it got"
     summary: RunSummary | MultiSeedSummary
-    with stoppable(hint) as stop:
+    with kept_on_write_error(kept, hint), stoppable(hint) as stop:
         try:
             if seeds is None:
                 outcome = runner.execute_run(

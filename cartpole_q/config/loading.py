@@ -17,6 +17,7 @@ Schedule(kind='constant', start=0.0005, end=0.0005, rate=1.0)
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -96,7 +97,46 @@ def load_config(
         raw = merge(raw, nested)
         overridden.extend(leaf_paths(nested))
     raw = _without_default_grid(raw, user, overridden)
+    raw = _named_after_env(raw, user, overridden)
     return read_config(raw, Provenance(named, tuple(overridden), override_source))
+
+
+def _named_after_env(
+    raw: dict[str, Any], user: Mapping[Any, Any], overridden: list[str]
+) -> dict[str, Any]:
+    """Name a run of another environment after it when the config gives no ``name``.
+
+    The default's ``name: default`` describes its CartPole run; a config that moves to
+    another ``env.id`` without naming itself (``--set env.id=FrozenLake-v1``) gets a
+    name made from that id, so that its directory reads ``runs/frozenlake-...``. A
+    ``name`` given by the file or an override is kept, ``default`` included.
+
+    >>> load_config(overrides={"env.id": "FrozenLake-v1"}).name
+    'frozenlake'
+    >>> load_config({"name": "default", "env": {"id": "FrozenLake-v1"}}).name, load_config().name
+    ('default', 'default')
+    """
+    default = default_raw()
+    env = raw.get("env")
+    env_id = env.get("id") if isinstance(env, dict) else None
+    if "name" in user or "name" in overridden or raw.get("name") != default["name"]:
+        return raw
+    if not isinstance(env_id, str) or env_id == default["env"]["id"]:
+        return raw
+    return {**raw, "name": name_for_env(env_id) or default["name"]}
+
+
+def name_for_env(env_id: str) -> str:
+    """A run-name prefix made from an environment id: lower case, no namespace or version.
+
+    >>> name_for_env("FrozenLake-v1"), name_for_env("cartpole_q/WindyGridworld-v0")
+    ('frozenlake', 'windygridworld')
+    >>> name_for_env("my_package.envs:Maze 2-v3")
+    'maze-2'
+    """
+    stem = re.split(r"[/:]", env_id)[-1]
+    stem = re.sub(r"-v\d+$", "", stem).lower()
+    return re.sub(r"[^a-z0-9_-]+", "-", stem).strip("-")[:64]
 
 
 def _without_default_grid(

@@ -329,8 +329,8 @@ class TrainConfig:
     seeds: tuple[int, ...] | None = field(
         metadata=spec(
             "seeds",
-            'e.g. `"0-99"` or `[0, 1, 2]`: one run per seed, in parallel; `null` trains the '
-            "single `seed`",
+            'e.g. `"0-99"` or `[0, 1, 2]`: one run per seed, in parallel (each seed once); '
+            "`null` trains the single `seed`",
             nullable=True,
         )
     )
@@ -410,7 +410,13 @@ class EvalConfig:
 class Config:
     """A complete, validated run configuration. Never mutated after loading."""
 
-    name: str = field(metadata=spec("name", "run-name prefix: letters, digits, `-`, `_`"))
+    name: str = field(
+        metadata=spec(
+            "name",
+            "run-name prefix: letters, digits, `-`, `_`; left out with another `env.id`, "
+            "made from it (`frozenlake` for `FrozenLake-v1`)",
+        )
+    )
     seed: int = field(
         metadata=spec(
             "int",

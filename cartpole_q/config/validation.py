@@ -14,6 +14,7 @@ import copy
 import dataclasses
 import math
 import re
+from collections import Counter
 from collections.abc import Mapping
 from types import MappingProxyType
 from typing import Any
@@ -33,6 +34,7 @@ from cartpole_q.config.schema import (
     Key,
     Schedule,
     TrainConfig,
+    format_seeds,
     key_of,
 )
 from cartpole_q.errors import ConfigError
@@ -482,13 +484,18 @@ def parse_seeds(value: Any) -> tuple[int, ...]:
     """Parse a seed list: an integer, a list of integers, or a string like ``"0-9,20"``.
 
     Returns:
-        The distinct seeds in ascending order.
+        The seeds in ascending order.
 
     Raises:
-        ValueError: the value is not a seed list, a seed is negative, or there are too many.
+        ValueError: the value is not a seed list, a seed is negative or given twice (a
+            typo more likely than a wish to run it once), or there are too many.
 
     >>> parse_seeds("0-3,7")
     (0, 1, 2, 3, 7)
+    >>> parse_seeds("0-9,5")
+    Traceback (most recent call last):
+    ...
+    ValueError: seed 5 is given twice; each seed is one run, so give it once.
     """
     seeds: list[int] = []
     if isinstance(value, bool):
@@ -518,6 +525,14 @@ def parse_seeds(value: Any) -> tuple[int, ...]:
     if any(seed > MAX_SEED for seed in seeds):
         raise ValueError(f"seeds must be at most {MAX_SEED:,}.")
     unique = sorted(set(seeds))
+    if len(unique) < len(seeds):
+        repeated = sorted(seed for seed, count in Counter(seeds).items() if count > 1)
+        named = (
+            f"seed {repeated[0]} is"
+            if len(repeated) == 1
+            else f"seeds {format_seeds(repeated)} are"
+        )
+        raise ValueError(f"{named} given twice; each seed is one run, so give it once.")
     if len(unique) > MAX_SEEDS:
         raise ValueError(f"at most {MAX_SEEDS} seeds, got {len(unique)}.")
     return tuple(unique)

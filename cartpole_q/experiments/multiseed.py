@@ -35,7 +35,7 @@ from cartpole_q.experiments.workers import (
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.results import MultiSeedSummary, SeedEntry, SeedResult
 from cartpole_q.store import rundir
-from cartpole_q.store.atomic import atomic_write_bytes, write_json
+from cartpole_q.store.atomic import atomic_write_bytes, make_directory, write_json
 from cartpole_q.store.checkpoint import CHECKPOINT_FILE, load_checkpoint
 from cartpole_q.store.runsets import seed_dir
 from cartpole_q.training import Checkpoint, TrainResult
@@ -90,7 +90,7 @@ def run_seeds(
         # A started seed resumes from its checkpoint (or from episode 0 if it has none).
         child_resume = resume and (child / rundir.CONFIG_FILE).is_file()
         if not child_resume:
-            child.mkdir(parents=True, exist_ok=True)
+            make_directory(child)
             rundir.write_config(child, config.for_seed(seed))
         jobs.append((seed, child, child_resume))
 

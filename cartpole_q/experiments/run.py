@@ -2,7 +2,7 @@
 
 Order of events for a new run: the config is checked against its environment and the
 output path is checked, so bad input leaves nothing behind; only then is the directory
-created and ``config.yaml`` written. Training writes ``checkpoint.npz`` every
+created and locked, found empty under its lock, and ``config.yaml`` written. Training writes ``checkpoint.npz`` every
 ``train.checkpoint_every`` episodes. SIGINT or SIGTERM stops at the end of the current
 episode and the run directory is completed as ``interrupted``; a second signal stops at
 once. ``--resume`` continues from the checkpoint and gives byte-identical results.
@@ -10,10 +10,11 @@ once. ``--resume`` continues from the checkpoint and gives byte-identical result
 
 from __future__ import annotations
 
+import contextlib
 import math
 import signal
 import threading
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
@@ -34,7 +35,7 @@ from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.results import RunSummary, SeedResult
 from cartpole_q.store import rundir
-from cartpole_q.store.atomic import remove_stale_temporaries
+from cartpole_q.store.atomic import make_directory, remove_stale_temporaries
 from cartpole_q.store.checkpoint import (
     CHECKPOINT_FILE,
     load_checkpoint,
@@ -159,15 +160,32 @@ def prepare_new(
     return prepare(loaded, Provenance(file, tuple(overrides)))
 
 
+@contextlib.contextmanager
+def new_run(prepared: Prepared, out: Path | None) -> Iterator[Path]:
+    """Create the run directory and write its ``config.yaml``, holding its lock inside.
+
+    A failure before ``config.yaml`` is written (a full disk) removes the directory this
+    created; after it, the directory stays for ``train --resume``.
+
+    Raises:
+        RunError: ``out`` is a file or a non-empty directory, or another command is
+            writing it.
+        WriteError: ``config.yaml`` (or the lock file) cannot be written.
+    """
+    with rundir.new_directory(prepared.config.name, out) as claim:
+        rundir.write_config(claim.path, prepared.config)
+        claim.keep()
+        yield claim.path
+
+
 def start_run(prepared: Prepared, out: Path | None) -> Path:
-    """Create the run directory and write its ``config.yaml``.
+    """Create the run directory and write its ``config.yaml`` (its lock released on return).
 
     Raises:
         RunError: ``out`` is a file or a non-empty directory.
     """
-    run_dir = rundir.create_run_dir(prepared.config.name, out)
-    rundir.write_config(run_dir, prepared.config)
-    return run_dir
+    with new_run(prepared, out) as run_dir:
+        return run_dir
 
 
 def execute_run(
@@ -252,7 +270,7 @@ def _greedy_viewer(
             from cartpole_q.store.video import VideoRecorder, offscreen_rendering
 
             videos = run_dir / VIDEOS_DIR
-            videos.mkdir(exist_ok=True)
+            make_directory(videos)
             path = videos / f"episode-{episode:06d}.gif"
             with VideoRecorder(path, episodes=1, force=True) as recorder:
                 with offscreen_rendering():

@@ -10,6 +10,7 @@ workers or an interruption.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -193,12 +194,29 @@ def write_run_events(directory: Path, config: Config, finished: FinishedRun) -> 
     )
 
 
+@contextlib.contextmanager
+def new_sweep(spec: SweepSpec, out: Path | None) -> Iterator[Path]:
+    """Create the sweep directory and write its start files, holding its lock inside.
+
+    The start files are ``sweep.yaml`` and every point's ``config.yaml``. A failure before they are all written (a full disk) removes the directory this
+    created, ``points/`` included; after it, the directory stays for ``sweep --resume``.
+
+    Raises:
+        RunError: ``out`` is a file or a non-empty directory, or another command is
+            writing it.
+        WriteError: a start file cannot be written.
+    """
+    with sweepdir.new_sweep_dir(spec.name, out) as claim:
+        configs = [(spec.point_id(point.index), point.config) for point in spec.points]
+        sweepdir.write_sweep(claim.path, spec.to_dict(), configs)
+        claim.keep()
+        yield claim.path
+
+
 def start_sweep(spec: SweepSpec, out: Path | None) -> Path:
-    """Create the sweep directory and write ``sweep.yaml`` and the points' configs."""
-    directory = sweepdir.create_sweep_dir(spec.name, out)
-    configs = [(spec.point_id(point.index), point.config) for point in spec.points]
-    sweepdir.write_sweep(directory, spec.to_dict(), configs)
-    return directory
+    """Create the sweep directory and write its start files (its lock released on return)."""
+    with new_sweep(spec, out) as directory:
+        return directory
 
 
 def load_sweep_dir(directory: Path) -> SweepSpec:

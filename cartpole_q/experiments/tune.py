@@ -150,26 +150,21 @@ def storage_errors(where: Path | str) -> Iterator[None]:
 
     The study in the storage stays usable: what a failed write cut short is removed when
     the storage is opened again, and the trial that was running is marked failed by the
-    next ``tune --resume``. So a full disk costs at most the trial in flight.
+    next ``tune --resume``. So a full disk costs at most the trial in flight (the command
+    line says so, and how to go on, once the study exists).
     """
     try:
         yield
     except OSError as error:
         path = Path(getattr(error, "filename", None) or where)
-        raise WriteError(
-            f"{path}: cannot be written: {write_failure(path, error)}. The study is kept, "
-            "less the trial in flight; make room, then go on with `cartpole-q tune --resume "
-            "DIR`."
-        ) from None
+        raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
     except Exception as error:
         if type(error).__module__.split(".")[0] not in ("sqlalchemy", "optuna"):
             raise
         if "disk" not in str(error).lower() and "OperationalError" not in type(error).__name__:
             raise
         raise WriteError(
-            f"--storage {where}: the database could not be written ({error}). The study is "
-            "kept, less the trial in flight; fix the database, then go on with `cartpole-q "
-            "tune --resume DIR`."
+            f"--storage {where}: the database could not be written ({error})."
         ) from None
 
 
@@ -219,9 +214,11 @@ def check_storage(spec: TuneSpec, storage_url: str | None, join: bool, where: st
         where: the tune file, for messages.
 
     Raises:
-        ConfigError: the storage already holds a study of this name and ``join`` is not
-            set; ``join`` without a study (or without ``--storage``) to join; or the
-            study's search differs from the file's (naming the key and both values).
+        ConfigError: ``storage_url`` is a directory; the storage already holds a study of
+            this name and ``join`` is not set; ``join`` without a study (or without
+            ``--storage``) to join; or the study's search differs from the file's (naming
+            the key and both values).
+        WriteError: the storage cannot be opened for writing (naming it).
     """
     if storage_url is None:
         if join:
@@ -229,6 +226,12 @@ def check_storage(spec: TuneSpec, storage_url: str | None, join: bool, where: st
                 "--join adds trials to a study in a shared storage: give its --storage too."
             )
         return
+    if "://" not in storage_url and Path(storage_url).is_dir():
+        raise ConfigError(
+            f"--storage {storage_url}: is a directory; give a journal file's path (such as "
+            f"{Path(storage_url) / tunedir.JOURNAL_FILE}) or an Optuna storage URL "
+            "(sqlite:///study.db, postgresql://...)."
+        )
     optuna = optuna_module()
     storage = storage_for(Path(), storage_url)
     with storage_errors(storage_url):
@@ -273,16 +276,27 @@ def check_search(the_study: Any, spec: TuneSpec, where: str) -> None:
         )
 
 
-def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
-    """Create the tune directory, write ``tune.yaml``, and create (or join) the study.
+@contextlib.contextmanager
+def new_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Iterator[Path]:
+    """Create the tune directory, its ``tune.yaml`` and study, holding its lock inside.
 
-    Call :func:`check_storage` first: it refuses what this would do wrong.
+    The study is created, or joined when ``--storage`` holds it already. Call
+    :func:`check_storage` first: it refuses what this would do wrong. A failure before the
+    study exists (a full disk) removes the directory this created; after it, the directory
+    stays for ``tune --resume``.
     """
     check_tensorboard([spec.config_for({})])
-    directory = tunedir.create_tune_dir(spec.name, out)
-    tunedir.write_tune(directory, spec.to_dict(), storage_url)
-    study(spec, directory, storage_url, create=True)
-    return directory
+    with tunedir.new_tune_dir(spec.name, out) as claim:
+        tunedir.write_tune(claim.path, spec.to_dict(), storage_url)
+        study(spec, claim.path, storage_url, create=True)
+        claim.keep()
+        yield claim.path
+
+
+def start_tune(spec: TuneSpec, out: Path | None, storage_url: str | None) -> Path:
+    """Create the tune directory and its study (the directory's lock released on return)."""
+    with new_tune(spec, out, storage_url) as directory:
+        return directory
 
 
 def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:

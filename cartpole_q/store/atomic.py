@@ -120,6 +120,21 @@ def check_output_file(path: Path, option: str, suffixes: tuple[str, ...], force:
     return suffix
 
 
+def make_directory(path: Path) -> None:
+    """Create the directory ``path`` (and its parents) unless it exists.
+
+    Raises:
+        WriteError: it cannot be created (a full disk, no permission, a file in the way),
+            naming it.
+    """
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise WriteError(f"{path}: cannot be created: a file is in the way.") from None
+    except OSError as error:
+        raise WriteError(f"{path}: cannot be created: {write_failure(path, error)}.") from None
+
+
 def remove_stale_temporaries(run_dir: Path) -> None:
     """Delete temporary files a killed process left behind (never a finished file)."""
     for temporary in run_dir.glob(".*.tmp"):
@@ -127,8 +142,21 @@ def remove_stale_temporaries(run_dir: Path) -> None:
 
 
 def atomic_write_text(path: Path, text: str) -> None:
-    """Write UTF-8 text atomically."""
-    atomic_write_bytes(path, text.encode("utf-8"))
+    """Write UTF-8 text atomically.
+
+    Raises:
+        WriteError: the file cannot be written, or ``text`` cannot be UTF-8 (it holds
+            an undecodable file name's surrogate escapes).
+    """
+    try:
+        data = text.encode("utf-8")
+    except UnicodeEncodeError as error:
+        raise WriteError(
+            f"{os.fsencode(path).decode('utf-8', 'replace')}: cannot be written: its text "
+            f"would hold {error.object[error.start : error.end]!a}, which is not UTF-8 (a "
+            "file name that is not UTF-8 text?)."
+        ) from None
+    atomic_write_bytes(path, data)
 
 
 def atomic_save_npy(path: Path, array: np.ndarray) -> None:

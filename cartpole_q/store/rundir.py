@@ -26,7 +26,9 @@ import functools
 import io
 import json
 import platform
+import shutil
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -36,13 +38,16 @@ import numpy as np
 
 from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.engines.base import EpisodeMetrics
-from cartpole_q.errors import RunError
+from cartpole_q.errors import RunError, WriteError
 from cartpole_q.evaluation import check_q_table
 from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
+from cartpole_q.store import lock
 from cartpole_q.store.atomic import (
     atomic_save_npy,
     atomic_write_bytes,
     atomic_write_text,
+    make_directory,
+    write_failure,
     write_json,
 )
 from cartpole_q.store.checkpoint import CHECKPOINT_FILE
@@ -66,25 +71,115 @@ NPY_MAGIC = b"\x93NUMPY"
 # -- creating a run directory ---------------------------------------------------------
 
 
-def create_run_dir(
+@dataclass
+class NewDirectory:
+    """A directory claimed for a new run, sweep or tune: created (or found empty), locked."""
+
+    path: Path
+    created: bool
+    """this command created it (``--out`` may also name an existing empty directory)"""
+    kept: bool = False
+    """it holds what ``--resume`` needs, and stays whatever happens next"""
+
+    def keep(self) -> None:
+        """Say that the directory now holds what ``--resume`` needs (its start files)."""
+        self.kept = True
+
+
+_CLAIM_ATTEMPTS = 20
+"""how often a directory removed by a failed start, while waiting for it, is made anew"""
+
+
+@contextlib.contextmanager
+def new_directory(
     name: str, out: Path | None, runs_root: Path = Path("runs"), kind: str = "run"
-) -> Path:
-    """Create the directory a new run (or sweep, or study) writes to, never a non-empty one.
+) -> Iterator[NewDirectory]:
+    """Claim the directory a new run (or sweep, or study) writes to, holding its lock inside.
+
+    The directory is created (``out``, or ``<runs_root>/<name>-<YYYYmmdd-HHMMSS>``) and
+    locked before anything looks into it, and only then checked to be empty (but for its
+    lock file). So of two commands given the same ``--out``, exactly one writes there:
+    the other is refused without writing anything, whether it finds the first still
+    writing (refused by the lock) or already finished (refused by its files).
+
+    Until :meth:`NewDirectory.keep` is called, the directory holds nothing a command can
+    go on with: if the block fails (a full disk, a signal, bad input), what this command
+    wrote is removed, the directory too if it created it, so that nothing half-started is
+    left behind. After ``keep`` a failure leaves the directory for ``--resume``.
 
     Args:
-        name: the config's run-name prefix.
+        name: the config's (or study's) name, the prefix of a directory under ``runs_root``.
         out: the directory asked for with ``--out``; it must not exist, or be empty.
         runs_root: where ``<name>-<YYYYmmdd-HHMMSS>`` goes when ``out`` is ``None``.
         kind: what the directory holds, for messages ("run", "sweep", "tune").
 
     Raises:
-        RunError: ``out`` is a file or a non-empty directory.
+        RunError: ``out`` is a file or a non-empty directory, another command is writing
+            it, or it cannot be created.
+        WriteError: its lock file cannot be written (a full disk).
     """
+    if out is not None:
+        check_output_dir(out, runs_root, kind)  # a user's own directory stays untouched
+    advice = (
+        f"cartpole-q never writes a new {kind} into a directory another command writes. Choose "
+        f"a new directory (or leave --out out for a fresh one under {runs_root}/)."
+    )
+    for _ in range(_CLAIM_ATTEMPTS):
+        path, created = _make_directory(name, out, runs_root, kind)
+        held = lock.acquire_lock(path, kind, advice)
+        if held is not None:
+            break
+    else:
+        raise RunError(f"{path}: was removed again and again while this command started; retry.")
+    try:
+        # Under the lock: a writer that got here first has left its files.
+        _check_still_empty(path, runs_root, kind)
+        claim = NewDirectory(path, created)
+        try:
+            held.name_holder()
+            yield claim
+        except BaseException as error:
+            if claim.kept:
+                raise
+            _undo_start(claim, held.created)
+            if isinstance(error, WriteError):
+                undone = "was removed" if created else "was emptied again"
+                raise WriteError(f"{error} The new {kind} directory {undone}.") from None
+            raise
+    finally:
+        held.release()
+
+
+def check_output_dir(out: Path, runs_root: Path = Path("runs"), kind: str = "run") -> None:
+    """Refuse an output path that is a file or a non-empty directory (a lock file aside).
+
+    Raises:
+        RunError: naming the path and what is wrong with it.
+    """
+    if out.exists() and not out.is_dir():
+        raise RunError(f"{out}: --out must be a directory, but this is a file.")
+    if out.is_dir() and any(entry.name != lock.LOCK_FILE for entry in out.iterdir()):
+        raise RunError(
+            f"{out}: --out points at a non-empty directory; cartpole-q never writes a new "
+            f"{kind} into one. Choose a new directory (or leave --out out for a fresh one "
+            f"under {runs_root}/)."
+        )
+
+
+def _make_directory(name: str, out: Path | None, runs_root: Path, kind: str) -> tuple[Path, bool]:
+    """Create the directory (or find ``out`` there already): the path and whether it was made."""
+    where = out if out is not None else runs_root
     try:
         if out is not None:
-            check_output_dir(out, runs_root, kind)
-            out.mkdir(parents=True, exist_ok=True)
-            return out
+            try:
+                out.mkdir(parents=True)
+            except FileExistsError:
+                if not out.is_dir():
+                    raise RunError(
+                        f"{out}: --out must be a directory, but this is a file."
+                    ) from None
+                return out, False
+            return out, True
         stamp = time.strftime("%Y%m%d-%H%M%S")
         runs_root.mkdir(parents=True, exist_ok=True)
         for attempt in range(1000):
@@ -93,27 +188,38 @@ def create_run_dir(
                 path.mkdir()
             except FileExistsError:
                 continue
-            return path
+            return path, True
     except OSError as error:
-        where = out if out is not None else runs_root
-        raise RunError(f"{where}: cannot create the {kind} directory ({error.strerror}).") from None
+        reason = write_failure(where / "x", error)
+        raise RunError(f"{where}: cannot create the {kind} directory: {reason}.") from None
     raise RunError(f"{runs_root}: could not find a free {kind} directory name for {name!r}.")
 
 
-def check_output_dir(out: Path, runs_root: Path = Path("runs"), kind: str = "run") -> None:
-    """Refuse an output path that is a file or a non-empty directory.
-
-    Raises:
-        RunError: naming the path and what is wrong with it.
-    """
-    if out.exists() and not out.is_dir():
-        raise RunError(f"{out}: --out must be a directory, but this is a file.")
-    if out.is_dir() and any(out.iterdir()):
+def _check_still_empty(out: Path, runs_root: Path, kind: str) -> None:
+    """Refuse, holding the lock, a directory another command wrote into meanwhile."""
+    found = sorted(entry.name for entry in out.iterdir() if entry.name != lock.LOCK_FILE)
+    if found:
         raise RunError(
-            f"{out}: --out points at a non-empty directory; cartpole-q never writes a new "
-            f"{kind} into one. Choose a new directory (or leave --out out for a fresh one "
-            f"under {runs_root}/)."
+            f"{out}: another command wrote into this directory while this one was starting "
+            f"(it now holds {', '.join(found[:3])}{', ...' if len(found) > 3 else ''}); "
+            f"cartpole-q never writes a new {kind} into a non-empty directory. Choose a new "
+            f"directory (or leave --out out for a fresh one under {runs_root}/)."
         )
+
+
+def _undo_start(claim: NewDirectory, created_lock_file: bool) -> None:
+    """Remove what a failed start wrote (the caller still holds the lock)."""
+    with contextlib.suppress(OSError):
+        if claim.created:
+            shutil.rmtree(claim.path)
+            return
+        for entry in claim.path.iterdir():
+            if entry.name == lock.LOCK_FILE and not created_lock_file:
+                continue
+            if entry.is_dir() and not entry.is_symlink():
+                shutil.rmtree(entry)
+            else:
+                entry.unlink()
 
 
 def write_config(run_dir: Path, config: Config) -> None:
@@ -223,7 +329,7 @@ def write_run(
             f"{run_dir}: is not empty; write_run never overwrites a run. Choose a new "
             "directory, or pass overwrite=True to replace this run's files."
         )
-    run_dir.mkdir(parents=True, exist_ok=True)
+    make_directory(run_dir)
     write_config(run_dir, result.config)
     atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
     atomic_save_npy(run_dir / VISITS_FILE, result.visits)
@@ -363,8 +469,11 @@ def load_array(path: Path, dtype: type) -> np.ndarray:
     Raises:
         RunError: the file is missing, truncated, an object array, or of another dtype.
     """
-    if not path.is_file():
+    if not path.exists():
         raise RunError(f"{path}: is missing.")
+    if not path.is_file():
+        kind = "a directory" if path.is_dir() else "not a regular file"
+        raise RunError(f"{path}: is {kind}, but a .npy array file is expected here.")
     try:
         with open(path, "rb") as stream:
             magic = stream.read(len(NPY_MAGIC))
@@ -415,6 +524,8 @@ def read_metric_columns(
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise RunError(f"{path}: is missing.") from None
+    except IsADirectoryError:
+        raise RunError(f"{path}: is a directory, not a CSV file.") from None
     except (OSError, UnicodeDecodeError) as error:
         raise RunError(f"{path}: cannot be read ({error}).") from None
     rows = list(csv.reader(io.StringIO(text)))
@@ -473,7 +584,15 @@ def _read_json(path: Path) -> object:
         return json.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         return None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
+    except NotADirectoryError:
+        raise RunError(
+            f"{path.parent}: is a file, but a run directory was expected here."
+        ) from None
+    except IsADirectoryError:
+        raise RunError(f"{path}: is a directory, not a JSON file.") from None
+    except OSError as error:
+        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
+    except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise RunError(f"{path}: is not valid JSON ({error}).") from None
 
 

@@ -9,6 +9,7 @@ so a sweep killed at any moment resumes without losing or duplicating a finished
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -25,8 +26,13 @@ from cartpole_q.config import parse_seeds, read_yaml_mapping
 from cartpole_q.errors import RunError
 from cartpole_q.results import SeedResult
 from cartpole_q.statistics import PointStatistics
-from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, remove_stale_temporaries
-from cartpole_q.store.rundir import CONFIG_FILE, create_run_dir, write_config
+from cartpole_q.store.atomic import (
+    atomic_write_bytes,
+    atomic_write_text,
+    make_directory,
+    remove_stale_temporaries,
+)
+from cartpole_q.store.rundir import CONFIG_FILE, NewDirectory, new_directory, write_config
 
 SWEEP_FILE = "sweep.yaml"
 RESULTS_FILE = "results.csv"
@@ -55,13 +61,16 @@ TIMING_COLUMNS = ("train_seconds",)
 """the only columns that depend on the machine, the backend or an interruption"""
 
 
-def create_sweep_dir(name: str, out: Path | None) -> Path:
-    """Create the sweep directory: ``out`` (new or empty), else ``sweeps/<name>-<stamp>/``.
+def new_sweep_dir(name: str, out: Path | None) -> contextlib.AbstractContextManager[NewDirectory]:
+    """Claim the sweep directory, holding its lock inside.
+
+    It is ``out`` (new or empty), else ``sweeps/<name>-<stamp>/``; see
+    :func:`~cartpole_q.store.rundir.new_directory`.
 
     Raises:
         RunError: ``out`` is a file or a non-empty directory, or cannot be created.
     """
-    return create_run_dir(name, out, runs_root=SWEEPS_ROOT, kind="sweep")
+    return new_directory(name, out, runs_root=SWEEPS_ROOT, kind="sweep")
 
 
 def write_sweep(
@@ -75,7 +84,7 @@ def write_sweep(
     text = yaml.safe_dump(dict(resolved), sort_keys=False, default_flow_style=None)
     for point_id, config in configs:
         point_dir = directory / POINTS_DIR / point_id
-        point_dir.mkdir(parents=True, exist_ok=True)
+        make_directory(point_dir)
         write_config(point_dir, config)
     atomic_write_text(directory / SWEEP_FILE, header + text)
 

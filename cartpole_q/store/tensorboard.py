@@ -54,7 +54,7 @@ import numpy as np
 
 from cartpole_q.errors import UserError
 from cartpole_q.rl.solve import SOLVE_WINDOW
-from cartpole_q.store.atomic import atomic_write_bytes
+from cartpole_q.store.atomic import atomic_write_bytes, make_directory
 
 if TYPE_CHECKING:
     from cartpole_q.results import SeedResult
@@ -181,7 +181,7 @@ def write_session(directory: Path, session: Session) -> Path:
         WriteError: the event file cannot be written.
     """
     require_writer("train.tensorboard")
-    directory.mkdir(parents=True, exist_ok=True)
+    make_directory(directory)
     earlier = sorted(directory.glob(f"{EVENT_FILE_PREFIX}*"))
     with tempfile.TemporaryDirectory(prefix="cartpole-q-tensorboard-") as scratch:
         _write_events(Path(scratch), session)

@@ -9,6 +9,8 @@ the end of every ``tune`` call.
 
 from __future__ import annotations
 
+import contextlib
+import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -18,7 +20,7 @@ import yaml
 from cartpole_q.config import Config, ConfigError, read_yaml_mapping
 from cartpole_q.errors import RunError
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text
-from cartpole_q.store.rundir import create_run_dir
+from cartpole_q.store.rundir import NewDirectory, new_directory
 from cartpole_q.store.sweepdir import csv_text
 
 TUNE_FILE = "tune.yaml"
@@ -30,9 +32,13 @@ IMPORTANCE_FILE = "importance.png"
 TUNES_ROOT = Path("tunes")
 
 
-def create_tune_dir(name: str, out: Path | None) -> Path:
-    """Create the tune directory: ``out`` (new or empty), else ``tunes/<name>-<stamp>/``."""
-    return create_run_dir(name, out, runs_root=TUNES_ROOT, kind="tune")
+def new_tune_dir(name: str, out: Path | None) -> contextlib.AbstractContextManager[NewDirectory]:
+    """Claim the tune directory, holding its lock inside.
+
+    It is ``out`` (new or empty), else ``tunes/<name>-<stamp>/``; see
+    :func:`~cartpole_q.store.rundir.new_directory`.
+    """
+    return new_directory(name, out, runs_root=TUNES_ROOT, kind="tune")
 
 
 def write_tune(directory: Path, resolved: Mapping[str, Any], storage: str | None) -> None:
@@ -69,9 +75,11 @@ def write_trials(directory: Path, header: Sequence[str], rows: Iterable[Mapping[
 
 def write_best(directory: Path, config: Config, trial: int) -> None:
     """Write ``best.yaml``: the best trial's complete config (``train --config`` takes it)."""
+    # A directory name that is not UTF-8 is shown with U+FFFD: the comment is for reading.
+    shown = os.fsencode(directory / BEST_FILE).decode("utf-8", "replace")
     header = (
         f"# The best trial ({trial}) of this study: a complete config.\n"
-        f"# cartpole-q train --config {directory / BEST_FILE}\n"
+        f"# cartpole-q train --config {shown}\n"
     )
     atomic_write_text(directory / BEST_FILE, header + config.to_yaml())
 
