@@ -8,11 +8,15 @@ the command line.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import pytest
 
 from cartpole_q.config import ConfigError, load_config
+from cartpole_q.config.schema import AgentConfig
+from cartpole_q.rl.algorithm import Param
+from cartpole_q.rl.algorithms import RESERVED_KEYS, register
 from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
 from cartpole_q.training import Checkpoint, train
 from tests import plugin_algorithm
@@ -60,6 +64,19 @@ def test_it_trains_on_both_engines_to_the_same_bytes_and_resumes(
     assert resumed.q_table.tobytes() == whole.q_table.tobytes()
     assert resumed.visits.tobytes() == whole.visits.tobytes()
     assert resumed.returns.tobytes() == whole.returns.tobytes()
+
+
+@pytest.mark.parametrize("key", sorted(RESERVED_KEYS))
+def test_a_parameter_named_like_a_key_every_algorithm_has_is_refused(key: str) -> None:
+    """agent.tie_break and agent.params too (issue 30: they were missing from the list)."""
+    clashing = dataclasses.replace(plugin_algorithm.ALGORITHM, name=f"clash_{key}",
+                                   params=(Param(key, 0.5, "clashes"),))  # fmt: skip
+    with pytest.raises(ValueError, match=f"parameter {key!r} is a base key"):
+        register(clashing)
+
+
+def test_the_reserved_keys_are_the_agent_section_s_fields() -> None:
+    assert {field.name for field in dataclasses.fields(AgentConfig)} == RESERVED_KEYS
 
 
 def test_the_command_line_trains_it(tmp_path: Path) -> None:

@@ -39,6 +39,12 @@ PACKAGE = (
 
 _REGISTRY: dict[str, Algorithm] = {}
 
+RESERVED_KEYS = frozenset(
+    {"algorithm", "params", "gamma", "alpha", "epsilon", "q_init", "max_q_table_bytes", "tie_break"}
+)
+"""the keys under ``agent`` every algorithm has (the fields of ``AgentConfig``; a test keeps
+the two the same): no algorithm may declare a parameter of one of these names"""
+
 
 def register(algorithm: Algorithm) -> Algorithm:
     """Add an algorithm to the registry (a new name, or the same module again).
@@ -50,8 +56,7 @@ def register(algorithm: Algorithm) -> Algorithm:
         ValueError: another algorithm has this name, or a parameter's name is used by a
             config key every algorithm has.
     """
-    reserved = {"algorithm", "gamma", "alpha", "epsilon", "q_init", "max_q_table_bytes"}
-    clash = [param.key for param in algorithm.params if param.key in reserved]
+    clash = [param.key for param in algorithm.params if param.key in RESERVED_KEYS]
     if clash:
         raise ValueError(f"algorithm {algorithm.name!r}: parameter {clash[0]!r} is a base key")
     keyed = _with_key(algorithm)
