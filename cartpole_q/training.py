@@ -26,6 +26,7 @@ from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingStat
 from cartpole_q.envs.gym import EnvInfo, inspect_env
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
+from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
 
@@ -99,6 +100,8 @@ class Checkpoint:
     """the config the run was trained with (``None`` in checkpoints older than this field)"""
     info: np.ndarray | None = None
     """the finished episodes' sums of ``info[train.info_metric]`` (``None`` without it)"""
+    errors: np.ndarray | None = None
+    """a prediction run's finished episodes' RMS errors (``None`` when none are measured)"""
 
 
 @dataclass(frozen=True)
@@ -110,7 +113,8 @@ class TrainResult:
     """the engine that ran"""
     q_table: np.ndarray
     """the kept table, shape ``(*bins, n_actions)`` (``(n, n_actions)`` for ``Discrete(n)``,
-    ``(a, b, ..., n_actions)`` for a Tuple of Discrete): from the solve point if it solved"""
+    ``(a, b, ..., n_actions)`` for a Tuple of Discrete): from the solve point if it solved.
+    A prediction run's is ``V`` with one column, ``(*bins, 1)`` (:attr:`v_table`)"""
     kept_episode: int
     """the episode after which the kept table was taken"""
     visits: np.ndarray
@@ -133,6 +137,22 @@ class TrainResult:
     info: np.ndarray | None = None
     """each training episode's sum of ``info[config.train.info_metric]`` over its steps
     (``None`` without ``train.info_metric``)"""
+    errors: np.ndarray | None = None
+    """a prediction run's RMS error of ``V`` against the true values after each episode
+    (``None`` for control, or when the world has no model to know them by)"""
+
+    @property
+    def predicts(self) -> bool:
+        """Whether the run learnt state values ``V`` (a prediction algorithm)."""
+        return get_algorithm(self.config.agent.algorithm).predicts
+
+    @property
+    def v_table(self) -> np.ndarray:
+        """A prediction run's ``V``, shape ``(*bins,)`` (``v_table.npy``)."""
+        if not self.predicts:
+            raise ValueError(f"{self.config.agent.algorithm} learns action values, not V")
+        values: np.ndarray = self.q_table[..., 0]
+        return values
 
     @property
     def episodes(self) -> int:
@@ -255,7 +275,11 @@ def _run(
         hooks.on_checkpoint,
     )
     snapshot_every, on_snapshot = hooks.snapshot_every, hooks.on_snapshot
-    table_shape = (*env_info.state_shape, env_info.n_actions)
+    table_shape = (*env_info.state_shape, state.tables.q.shape[1])  # V: one column
+    visits_shape = (*env_info.state_shape, env_info.n_actions)
+    # A prediction run follows a given policy: no greedy policy to evaluate, nothing solved.
+    predicts = state.algorithm.predicts
+    evaluate_every = 0 if predicts else settings.eval_every
     total = settings.episodes
     train_seconds = 0.0 if resume is None else resume.train_seconds
     wall_before = 0.0 if resume is None else resume.wall_seconds
@@ -280,6 +304,7 @@ def _run(
             wall_seconds=wall_before + time.perf_counter() - started,
             config=config,
             info=None if state.info is None else state.info[:episode],
+            errors=None if state.errors is None else state.errors[:episode],
         )
 
     finished = state.episode >= total or (
@@ -289,18 +314,18 @@ def _run(
         stop = min(
             total,
             state.episode + engine.chunk_episodes,
-            _next_multiple(state.episode, settings.eval_every),
+            _next_multiple(state.episode, evaluate_every),
             _next_multiple(state.episode, settings.checkpoint_every),
             _next_multiple(state.episode, snapshot_every if on_snapshot else 0),
         )
         chunk_started = time.perf_counter()
-        solved = engine.run(state, stop, check_solved=state.solved_episode is None)
+        solved = engine.run(state, stop, check_solved=state.solved_episode is None and not predicts)
         train_seconds += time.perf_counter() - chunk_started
         if solved is not None:
             state.solved_episode = solved + 1
             if not settings.stop_when_solved:
                 state.solved_q = state.policy_table().copy()
-        if settings.eval_every and state.episode % settings.eval_every == 0:
+        if evaluate_every and state.episode % evaluate_every == 0:
             periodic = EvalReport.from_returns(
                 engine.evaluate(state.policy_table(), settings.eval_episodes, config.eval.seed),
                 config.eval.seed,
@@ -336,7 +361,7 @@ def _run(
     else:
         kept, kept_episode = state.policy_table(), state.episode
     report: EvalReport | None = None
-    if final_eval:
+    if final_eval and not predicts:
         report = EvalReport.from_returns(
             engine.evaluate(kept, config.eval.episodes, config.eval.seed), config.eval.seed
         )
@@ -346,7 +371,7 @@ def _run(
         engine=engine.name,
         q_table=kept.reshape(table_shape).copy(),
         kept_episode=kept_episode,
-        visits=state.tables.visits.reshape(table_shape).copy(),
+        visits=state.tables.visits.reshape(visits_shape).copy(),
         metrics=state.metrics.head(episode),
         env_steps=state.env_steps,
         solved_episode=state.solved_episode,
@@ -357,6 +382,7 @@ def _run(
         wall_seconds=wall_seconds,
         interrupted=interrupted,
         info=None if state.info is None else state.info[:episode].copy(),
+        errors=None if state.errors is None else state.errors[:episode].copy(),
     )
 
 
@@ -385,6 +411,8 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
         )
     if state.info is not None and checkpoint.info is not None:
         state.info[:episode] = checkpoint.info
+    if state.errors is not None and checkpoint.errors is not None:
+        state.errors[:episode] = checkpoint.errors
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
     if checkpoint.physics_rng_state is not None:
         state.physics_rng.bit_generator.state = checkpoint.physics_rng_state

@@ -46,6 +46,7 @@ class ReferenceRun:
         returns: Every trained episode's return.
         lengths: Every trained episode's number of steps.
         solved_episode: The 1-based solve episode, or None.
+        errors: A prediction run's RMS error after each episode (None when not measured).
     """
 
     q_table: np.ndarray
@@ -53,6 +54,7 @@ class ReferenceRun:
     returns: list[float]
     lengths: list[int]
     solved_episode: int | None
+    errors: list[float] | None = None
 
 
 # Schedules (design.md, "Randomness and the training loop").
@@ -841,6 +843,182 @@ class OffPolicyMonteCarlo(MonteCarlo):
     off_policy = True
 
 
+# docs/algorithms.md: prediction. V is a table of one column; pi chooses every action.
+
+
+class Prediction(Agent):
+    """A prediction algorithm: ``V`` as ``q[x][0]``, actions drawn by the uniform ``pi``."""
+
+    def __init__(self, n_states: int, n: int, q_init: float, *args: Any) -> None:
+        super().__init__(n_states, n, q_init, *args)
+        self.q = [[q_init] for _ in range(n_states)]
+
+    def draw(self, x: int) -> int:
+        """``pi``'s action: ``agent.policy: random``, one ``rng.integers(0, n)``."""
+        return int(self.rng.integers(0, self.n))
+
+    def v(self, x: int) -> float:
+        return self.q[x][0]
+
+
+class TD(Prediction):
+    """``td``: TD(0)."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        y = r if terminated else r + self.gamma * self.v(s2)
+        self.update(s, 0, y)
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+
+class NStepTD(Prediction):
+    """``n_step_td``: n-step returns of V, settled as n_step_sarsa settles Q."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.pending: deque[tuple[int, float]] = deque()
+
+    def settle(self, bootstrap: bool, s2: int) -> None:
+        k = len(self.pending)
+        g = self.pending[0][1]
+        for i in range(1, k):
+            g = g + self.gamma ** float(i) * self.pending[i][1]
+        if bootstrap:
+            g = g + self.gamma ** float(k) * self.v(s2)
+        self.update(self.pending[0][0], 0, g)
+        self.pending.popleft()
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.pending.append((s, r))
+        if terminated or truncated:
+            while self.pending:
+                self.settle(not terminated, s2)
+            return None
+        if len(self.pending) == int(self.params["n"]):
+            self.settle(True, s2)
+        return self.draw(s2)
+
+
+class MCPrediction(Prediction):
+    """``mc_prediction``: constant-alpha or sample-average, every- or first-visit returns."""
+
+    def __init__(self, n_states: int, *args: Any) -> None:
+        super().__init__(n_states, *args)
+        self.buffer_length = NO_TIME_LIMIT_LENGTH
+        self.episode: list[tuple[int, float]] = []
+        self.counts = [0.0] * n_states
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.episode.append((s, r))
+        if not terminated and not truncated and len(self.episode) < self.buffer_length:
+            return self.draw(s2)
+        first: dict[int, int] = {}
+        for t, (x, _) in enumerate(self.episode):
+            first.setdefault(x, t)
+        g = 0.0 if terminated else self.v(s2)
+        for t in range(len(self.episode) - 1, -1, -1):
+            x, reward = self.episode[t]
+            g = self.gamma * g + reward
+            if self.params["visits"] == "every" or first[x] == t:
+                if self.params["update"] == "sample_average":
+                    self.counts[x] = self.counts[x] + 1.0
+                    self.q[x][0] = self.q[x][0] + (g - self.q[x][0]) / self.counts[x]
+                else:
+                    self.update(x, 0, g)
+        self.episode = []
+        return None
+
+
+class TDLambda(Prediction, TraceAgent):
+    """``td_lambda``: TD(0)'s error along SARSA(lambda)'s traces, with the action 0."""
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        y = r if terminated else r + self.gamma * self.v(s2)
+        delta = y - self.v(s)
+        self.give_trace(s, 0)
+        self.apply(delta)
+        if terminated or truncated:
+            self.traces.clear()
+            return None
+        self.decay()
+        return self.draw(s2)
+
+
+class TrueOnlineTDLambda(Prediction, TraceAgent):
+    """``true_online_td_lambda``: true online SARSA(lambda) with V."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.v_old = 0.0
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        v_next = 0.0 if terminated else self.v(s2)
+        v_s = self.v(s)
+        delta = r + self.gamma * v_next - v_s
+        flat = s * self.n  # the pair (s, 0), as the traces key it
+        z_s = self.traces.get(flat, 0.0)
+        self.decay()
+        if flat not in self.traces:
+            self.traces[flat] = 0.0
+        self.traces[flat] = self.traces[flat] + (1.0 - self.alpha * self.gamma * self.lam * z_s)
+        self.apply_scaled(self.alpha * (delta + v_s - self.v_old))
+        self.q[s][0] = self.q[s][0] + -(self.alpha * (v_s - self.v_old))
+        self.v_old = v_next
+        if terminated or truncated:
+            self.traces.clear()
+            self.v_old = 0.0
+            return None
+        return self.draw(s2)
+
+
+def true_values(
+    env: gymnasium.Env[Any, Any], n: int, gamma: float
+) -> tuple[list[int], list[float]]:
+    """docs/algorithms.md, "The error": the uniform policy's values on the non-terminal states.
+
+    ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; a
+    terminal state is one whose every outcome stays in it, pays 0 and terminates.
+    """
+    table = env.unwrapped.P  # type: ignore[attr-defined]
+    states = len(table)
+    matrix = np.zeros((states, states))
+    expected = np.zeros(states)
+    terminal = []
+    for x in range(states):
+        ends = True
+        for b in range(n):
+            for probability, following, reward, done in table[x][b]:
+                weight = (1.0 / n) * probability
+                expected[x] += weight * reward
+                if not done:
+                    matrix[x, following] += weight
+                ends = ends and done and reward == 0.0 and following == x
+        terminal.append(ends)
+    values = np.linalg.solve(np.eye(states) - gamma * matrix, expected)
+    measured = [x for x in range(states) if not terminal[x]]
+    return measured, [float(values[x]) for x in measured]
+
+
+def rms_error(agent: Prediction, measured: list[int], truth: list[float]) -> float:
+    """``math.sqrt(S / k)``, ``S`` the squared differences summed in state order from 0.0."""
+    total = 0.0
+    for x, value in zip(measured, truth, strict=True):
+        difference = agent.v(x) - value
+        total = total + difference * difference
+    return math.sqrt(total / len(measured))
+
+
 ALGORITHMS: dict[str, type[Agent]] = {
     "q_learning": QLearning,
     "sarsa": Sarsa,
@@ -855,6 +1033,11 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "dyna_q_plus": DynaQPlus,
     "monte_carlo": MonteCarlo,
     "off_policy_monte_carlo": OffPolicyMonteCarlo,
+    "td": TD,
+    "n_step_td": NStepTD,
+    "mc_prediction": MCPrediction,
+    "td_lambda": TDLambda,
+    "true_online_td_lambda": TrueOnlineTDLambda,
 }
 
 # docs/algorithms.md, "Config keys the algorithms add": the defaults.
@@ -866,7 +1049,11 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "kappa": 0.001,
     "update": "sample_average",
     "tie_break": "lowest",  # agent.tie_break, a key of every algorithm
+    "policy": "random",
+    "visits": "every",
 }
+PREDICTION_DEFAULTS: dict[str, Any] = {"update": "constant_alpha"}
+"""mc_prediction's own default of a key another algorithm defaults otherwise"""
 
 
 def env_threshold(env: gymnasium.Env[Any, Any], env_id: str) -> float | None:
@@ -950,11 +1137,23 @@ def reference_train(
     tilings = int((discretization or {}).get("tilings", 1))  # type: ignore[call-overload]
     # docs/algorithms.md, "Tile coding": every weight starts at q_init / T.
     weight_init = float(q_init) / tilings if tilings > 1 else float(q_init)
+    defaults = {
+        **PARAMETER_DEFAULTS,
+        **(PREDICTION_DEFAULTS if algorithm == "mc_prediction" else {}),
+    }
     agent = ALGORITHMS[algorithm](
         n_states, n, weight_init, float(gamma), rng,
-        {**PARAMETER_DEFAULTS, **(params or {}), "tilings": tilings},
+        {**defaults, **(params or {}), "tilings": tilings},
     )  # fmt: skip
-    if isinstance(agent, MonteCarlo):
+    measured: list[int] = []
+    truth: list[float] = []
+    errors: list[float] | None = None
+    if isinstance(agent, Prediction):
+        threshold = None  # a prediction run never solves
+        if hasattr(env.unwrapped, "P"):
+            measured, truth = true_values(env, n, float(gamma))
+            errors = []
+    if isinstance(agent, (MonteCarlo, MCPrediction)):
         assert env.spec is not None
         limit = env.spec.max_episode_steps
         agent.buffer_length = int(limit) if limit is not None else NO_TIME_LIMIT_LENGTH
@@ -990,6 +1189,8 @@ def reference_train(
             s, a = s2, a2
         returns.append(episode_return)
         lengths.append(length)
+        if errors is not None:
+            errors.append(rms_error(agent, measured, truth))
         if solved is None and threshold is not None and episode >= 99:
             total = 0.0
             for value in returns[episode - 99 : episode + 1]:
@@ -1002,6 +1203,6 @@ def reference_train(
     env.close()
     if kept is None:
         kept = agent.kept_table()
-    q_table = np.array(kept, dtype=np.float64).reshape(*state_shape, n)
+    q_table = np.array(kept, dtype=np.float64).reshape(*state_shape, len(kept[0]))  # V: 1
     visit_table = np.array(visits, dtype=np.int64).reshape(*state_shape, n)
-    return ReferenceRun(q_table, visit_table, returns, lengths, solved)
+    return ReferenceRun(q_table, visit_table, returns, lengths, solved, errors)

@@ -87,7 +87,12 @@ def no_play(monkeypatch: pytest.MonkeyPatch) -> None:
     def played(*args: object, **kwargs: object) -> None:
         raise AssertionError("episodes were played before the output was checked")
 
+    # evaluate_runs binds the name when first imported: imported now, patched in both places,
+    # so that no later test finds the patch bound there (the file failed when run alone).
+    import cartpole_q.experiments.evaluate_runs
+
     monkeypatch.setattr("cartpole_q.evaluation.evaluate", played)
+    monkeypatch.setattr(cartpole_q.experiments.evaluate_runs, "evaluate", played)
 
 
 # -- atomic writes ----------------------------------------------------------------------

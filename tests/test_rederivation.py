@@ -127,14 +127,47 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         )
     },
 }
+# docs/algorithms.md, "Prediction": the state values of the uniformly random policy.
+PREDICTION_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    "td": ("td", {}),
+    "mc_prediction": ("mc_prediction", {}),
+    "mc_prediction-sample-average-first-visit": (
+        "mc_prediction",
+        {"update": "sample_average", "visits": "first"},
+    ),
+    "n_step_td": ("n_step_td", {"n": 3}),
+    "n_step_td-n1": ("n_step_td", {"n": 1}),
+    "td_lambda-accumulating": ("td_lambda", {"lambda": 0.8, "trace": "accumulating"}),
+    "td_lambda-dutch": ("td_lambda", {"lambda": 0.6, "trace": "dutch"}),
+    "td_lambda-lambda0": ("td_lambda", {"lambda": 0.0}),
+    "true_online_td_lambda": ("true_online_td_lambda", {"lambda": 0.8}),
+}
 AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init"}
 """keys a variant may give that are the agent's own, not its algorithm's"""
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
 LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")
-ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS}
+ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS, **PREDICTION_VARIANTS}
 
 # The worlds: name -> everything but the algorithm (env, grid, agent, episodes, seed, ...).
 CASES: dict[str, dict[str, Any]] = {
+    # Sutton & Barto's random walks (Example 6.2, Example 7.1), evaluated undiscounted.
+    "walk5": {
+        "env": {"id": "cartpole_q/RandomWalk5-v0"},
+        "agent": {"gamma": 1.0, "alpha": 0.1, "epsilon": 0.1, "q_init": 0.5},
+        "episodes": 100,
+        "seed": 7,
+    },
+    "walk19": {
+        "env": {"id": "cartpole_q/RandomWalk-v0"},
+        "agent": {
+            "gamma": 1.0,
+            "alpha": {"type": "exponential", "start": 0.4, "decay": 0.97, "end": 0.05},
+            "epsilon": 0.1,
+            "q_init": 0.0,
+        },
+        "episodes": 40,
+        "seed": 8,
+    },
     # The default config (log epsilon schedule); it solves near episode 180 and goes on.
     "cartpole": {
         "env": {"id": "CartPole-v1"},
@@ -287,6 +320,7 @@ CASES: dict[str, dict[str, Any]] = {
 }
 # Worlds with a compiled twin train on both engines.
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
+NUMBA_WORLDS |= {"walk5", "walk19"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
 NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack"}
@@ -378,6 +412,11 @@ def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
     assert result.q_table.shape == expected.q_table.shape
     assert result.q_table.dtype == np.float64
     assert result.q_table.tobytes() == expected.q_table.tobytes()
+    if expected.errors is None:
+        assert result.errors is None
+    else:
+        assert result.errors is not None
+        assert result.errors.tolist() == expected.errors
     return expected
 
 
@@ -411,10 +450,22 @@ def _params(worlds: list[str], variants: list[str], slow: str = "none") -> list[
     return out
 
 
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    _params(["walk5", "walk19", "frozenlake"], list(PREDICTION_VARIANTS)),
+)
+def test_prediction(world: str, variant: str, engine: str) -> None:
+    """V of the random policy, and its RMS error after every episode, on three worlds."""
+    expected = _assert_same(world, variant, engine)
+    assert expected.errors is not None and len(expected.errors) == CASES[world]["episodes"]
+    assert expected.solved_episode is None
+
+
 def test_every_package_algorithm_is_re_derived() -> None:
     """A new algorithm in the package fails here until the re-derivation covers it."""
     package = {module.ALGORITHM.name for module in PACKAGE}
-    assert {algorithm for algorithm, _ in VARIANTS.values()} == package
+    covered = {**VARIANTS, **PREDICTION_VARIANTS}.values()
+    assert {algorithm for algorithm, _ in covered} == package
 
 
 @pytest.mark.parametrize(("world", "variant", "engine"), _params(["cartpole"], list(VARIANTS)))

@@ -19,7 +19,9 @@ from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
+from cartpole_q.rl.prediction import policy_table
 from cartpole_q.rl.schedules import schedule_value
+from cartpole_q.rl.value_iteration import evaluate_policy
 
 
 def kernel_name(
@@ -79,6 +81,29 @@ def loops_played(epsilon: ScheduleRecord, start: int, stop: int) -> tuple[bool, 
         for episode in (start, stop - 1)
     )
     return tuple(sorted({first, last}))
+
+
+class Truth(NamedTuple):
+    """The true values a prediction run's ``V`` is measured against after every episode.
+
+    Empty arrays for a control run, or where the values cannot be known (no model of the
+    world, tile coding): nothing is measured then.
+    """
+
+    rows: np.ndarray
+    """int64: the table rows (states) measured, the world's non-terminal states in order"""
+    values: np.ndarray
+    """float64: the evaluated policy's exact value of each"""
+
+    @classmethod
+    def none(cls) -> Truth:
+        """Nothing to measure."""
+        return cls(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.float64))
+
+    @property
+    def measured(self) -> bool:
+        """Whether there is anything to measure."""
+        return bool(self.rows.shape[0])
 
 
 class AgentRecord(NamedTuple):
@@ -181,6 +206,8 @@ class AgentParams:
     """tile coding's tilings (1: plain rows; see :mod:`cartpole_q.rl.tiles`)"""
     max_steps: int = 0
     """the longest episode (its time limit, or the greedy cap): on tiles, the handles"""
+    truth: Truth = field(default_factory=Truth.none)
+    """a prediction run's true values (:func:`prediction_truth`; empty: none measured)"""
 
     @property
     def tiled(self) -> bool:
@@ -215,7 +242,34 @@ class AgentParams:
             params=algorithm.hook_params(config.agent.params, config.agent.tie_break),
             tilings=tilings,
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
+            truth=prediction_truth(config, env_info) if algorithm.predicts else Truth.none(),
         )
+
+
+def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
+    """The evaluated policy's exact values on the world's non-terminal states.
+
+    From the world's model (its transition table, or Blackjack's), by
+    :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
+    ``agent.gamma``; each model state is measured on the table row it is observed as.
+    Nothing is measured for a world without a model, or on tiles.
+    """
+    from cartpole_q.envs.models import EnvModel, env_model
+
+    tiled = config.discretization is not None and config.discretization.tilings > 1
+    model = env_model(config.env, env_info.max_episode_steps)
+    if not isinstance(model, EnvModel) or tiled:
+        return Truth.none()
+    tabular, row_of_state = model.model, model.row_of_state
+    rows_pi = policy_table(
+        MemoryContext(
+            math.prod(env_info.state_shape), env_info.n_actions, 0.0,
+            dict(config.agent.params), 0,
+        )
+    )  # fmt: skip
+    values = evaluate_policy(tabular, rows_pi[row_of_state], config.agent.gamma)
+    states = np.flatnonzero(~tabular.terminal_states())
+    return Truth(row_of_state[states].astype(np.int64), values[states].astype(np.float64))
 
 
 @dataclass
@@ -248,6 +302,9 @@ class TrainingState:
     """float64, one value per configured episode: the sum of ``info[train.info_metric]``
     over the episode's steps (``None`` without ``train.info_metric``; the gymnasium engine
     fills it)"""
+    errors: np.ndarray | None = None
+    """float64, one value per configured episode: a prediction run's RMS error of ``V``
+    against the true values after the episode (``None`` when nothing is measured)"""
 
     @classmethod
     def fresh(
@@ -270,9 +327,10 @@ class TrainingState:
             params=dict(config.agent.params),
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
         )
+        columns = algorithm.table_columns(env_info.n_actions)  # V: one column
         return cls(
             tables=Tables(
-                q=np.full((n_states, env_info.n_actions), q_init, dtype=np.float64),
+                q=np.full((n_states, columns), q_init, dtype=np.float64),
                 visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
                 memory=tuple(algorithm.memory(context)),
             ),
@@ -284,6 +342,11 @@ class TrainingState:
                 None
                 if config.train.info_metric is None
                 else np.zeros(config.train.episodes, dtype=np.float64)
+            ),
+            errors=(
+                np.zeros(config.train.episodes, dtype=np.float64)
+                if algorithm.predicts and prediction_truth(config, env_info).measured
+                else None
             ),
         )
 

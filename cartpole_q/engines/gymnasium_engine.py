@@ -14,7 +14,7 @@ from gymnasium import spaces
 
 from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, TrainingState, step_function_name
-from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.compile import jit, specialise
 from cartpole_q.engines.context import StepContext, step_context
 from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
 from cartpole_q.engines.play import play_greedy
@@ -22,6 +22,7 @@ from cartpole_q.engines.rows import STATE_RULES
 from cartpole_q.envs.gym import info_value, make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithm import Algorithm
+from cartpole_q.rl.prediction import value_error
 from cartpole_q.rl.tabular import ENDED, no_episode_end, visit
 
 configure_numba_cache()  # before any cache=True function is defined
@@ -134,6 +135,7 @@ class GymnasiumEngine:
         self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
         self._step_cap = step_cap
         self._info_key = config.train.info_metric
+        self._value_error: Any = jit(value_error) if params.truth.measured else None
         self._context: StepContext | None = None
         self._context_of: tuple[Any, ...] = ()
 
@@ -161,6 +163,7 @@ class GymnasiumEngine:
         randomize = self._config.env.randomize
         first, following, as_ints = self._first, self._next, self._as_ints
         info_key, info_sums, env_id = self._info_key, state.info, self._config.env.id
+        truth, errors, measure = self._params.truth, state.errors, self._value_error
         for episode in range(state.episode, stop):
             epsilon, alpha = episode_rates(agent, episode)
             if randomize:  # one draw per key, in the config's (canonical) order
@@ -190,6 +193,8 @@ class GymnasiumEngine:
             record_episode(metrics, episode, episode_return, length, epsilon, alpha)
             if info_sums is not None:
                 info_sums[episode] = info_sum
+            if errors is not None and measure is not None:  # (never on tiles: q is the table)
+                errors[episode] = measure(state.tables.q, truth.rows, truth.values)
             state.episode = episode + 1
             state.env_steps += length
             if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):

@@ -31,11 +31,12 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid, kernel_name
+from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid, Truth, kernel_name
 from cartpole_q.engines.compile import specialise
 from cartpole_q.engines.rows import ARRAY_STATE_RULES
 from cartpole_q.envs.registry import Twin
 from cartpole_q.rl.algorithm import Algorithm
+from cartpole_q.rl.prediction import value_error
 from cartpole_q.rl.schedules import schedule_value
 from cartpole_q.rl.solve import SOLVE_WINDOW
 from cartpole_q.rl.tabular import ENDED, best_action, compilable, visit
@@ -131,7 +132,7 @@ def train_episodes(
     q: Any, visits: np.ndarray, memory: Any, params: Any, grid: Grid, agent: AgentRecord,
     metrics: EpisodeMetrics, agent_rng: np.random.Generator, env_rng: np.random.Generator,
     env: Any, start: int, stop: int, check_solved: bool, physics_rng: np.random.Generator,
-    randomize: tuple[np.ndarray, np.ndarray, np.ndarray],
+    randomize: tuple[np.ndarray, np.ndarray, np.ndarray], truth: Truth, errors: np.ndarray,
 ) -> tuple[int, int, int]:  # fmt: skip
     """Train episodes ``start .. stop - 1`` on the twin, up to the first that is the other loop's.
 
@@ -157,6 +158,9 @@ def train_episodes(
         check_solved: stop right after the first solving episode.
         physics_rng: the generator of ``env.randomize``'s draws.
         randomize: ``(keys, lows, highs)`` of ``env.randomize`` (empty arrays: none).
+        truth: a prediction run's true values; when it measures any, each episode's RMS
+            error of ``V`` goes to ``errors`` at the episode's index.
+        errors: per-episode errors (empty when nothing is measured).
 
     Returns:
         ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
@@ -182,6 +186,8 @@ def train_episodes(
             agent_rng, env_rng, env_params, max_steps, env_state, observation,
         )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
+        if truth.rows.shape[0] > 0:
+            errors[episode] = value_error(q, truth.rows, truth.values)
         env_steps += length
         if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
             return episode + 1, env_steps, episode

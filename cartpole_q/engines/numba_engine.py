@@ -21,6 +21,9 @@ from cartpole_q.envs.registry import TwinSettings
 from cartpole_q.numba_cache import is_cached
 from cartpole_q.profiles import profile_for
 
+_NO_ERRORS = np.zeros(0, dtype=np.float64)
+"""the per-episode errors of a run that measures none"""
+
 NO_TIME_LIMIT = 2**63 - 1
 """the compiled loop's time limit for an environment without one: never reached"""
 
@@ -99,10 +102,11 @@ class NumbaEngine:
         p = self._params
         q, visits, memory = state.tables
         _, loop = self._kernel.loop(greedy)
+        errors = _NO_ERRORS if state.errors is None else state.errors
         finished, env_steps, solved = loop(
             self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
             self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
-            self._randomize,
+            self._randomize, p.truth, errors,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps

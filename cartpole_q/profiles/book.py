@@ -29,7 +29,7 @@ def gridworld_grid(world: Any) -> GridCells:
 
 
 def random_walk_grid(world: Any) -> GridCells:
-    """The walk as one row: its left end (``E``, -1), the start, its right end (``G``, +1)."""
+    """The walk as one row: its left end (``E``), the start, its right end (``G``, +1)."""
     states = int(world.observation_space.n)
     start = int(world.initial_state_distrib.argmax())
     cells = ["E" if state == 0 else "G" if state == states - 1 else "F" for state in range(states)]
@@ -88,8 +88,9 @@ MAXIMIZATION_BIAS = EnvProfile(
 
 RANDOM_WALK = EnvProfile(
     name="RandomWalk",
-    description="a walk of 19 states between a -1 end and a +1 end (Sutton & Barto's Example 7.1)",
-    ids=("cartpole_q/RandomWalk-v0",),
+    description="a walk between two ends, +1 on the right: 5 states from a 0 end (Sutton & "
+    "Barto's Example 6.2), 19 from a -1 end (Example 7.1)",
+    ids=("cartpole_q/RandomWalk5-v0", "cartpole_q/RandomWalk-v0"),
     entry_points=("cartpole_q.worlds.random_walk:RandomWalkEnv",),
     action_names=("left", "right"),
     policy_map="grid",

@@ -67,6 +67,8 @@ class Param:
         '[0, 1]'
         """
         if self.kind == "choice":
+            if len(self.choices) == 1:
+                return self.choices[0]
             return ", ".join(self.choices[:-1]) + f" or {self.choices[-1]}"
         if self.kind == "int":
             parts = [f">= {self.low:g}" if self.low is not None else ""]
@@ -134,6 +136,10 @@ class Algorithm:
     """a name for each memory array (checkpoints and messages)"""
     book: str = ""
     """where Sutton & Barto (2nd ed.) state it"""
+    task: str = "control"
+    """``control`` (learns ``Q`` and acts epsilon-greedily on it) or ``prediction`` (learns
+    the state values ``V`` of the policy ``agent.policy``, which chooses the actions; its
+    table has one column: :mod:`cartpole_q.rl.prediction`)"""
     not_on_tiles: str = ""
     """why it does not run on tile coding (empty: it does). On tiles a hook's state is a
     handle of one episode's observations (:mod:`cartpole_q.rl.tiles`), so memory that keys
@@ -146,6 +152,15 @@ class Algorithm:
     key: str = field(default="", compare=False)
     """the name and a digest of the module's source: compiled code is cached under it, so
     an edited algorithm is compiled again (set when registered)"""
+
+    @property
+    def predicts(self) -> bool:
+        """Whether it learns state values ``V`` (``task: prediction``) instead of ``Q``."""
+        return self.task == "prediction"
+
+    def table_columns(self, n_actions: int) -> int:
+        """The columns of its table: the actions (``Q``), or 1 (``V``)."""
+        return 1 if self.predicts else n_actions
 
     def param(self, key: str) -> Param:
         """The parameter ``key`` (raises ``KeyError`` for another)."""

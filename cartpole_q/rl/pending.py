@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.tabular import compilable
+from cartpole_q.rl.tabular import Table, compilable, update, value
 
 N = Param(
     "n", 4, "the number of rewards before bootstrapping (1: the one-step method)",
@@ -53,6 +53,25 @@ def drop_oldest(counter: np.ndarray, n: int) -> None:
     """Remove the oldest pending step."""
     counter[0] = (counter[0] + 1) % n
     counter[1] -= 1
+
+
+@compilable
+def settle_oldest(
+    q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
+    counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, alpha: float,
+    gamma: float,
+) -> None:  # fmt: skip
+    """Update the oldest pending step toward its return, and remove it from the queue."""
+    n = states.shape[0]
+    pending = counter[1]
+    oldest = slot(counter, n, 0)
+    target = rewards[oldest]
+    for i in range(1, pending):
+        target = target + gamma ** float(i) * rewards[slot(counter, n, i)]
+    if bootstrap:
+        target = target + gamma ** float(pending) * value(q, next_state, next_action)
+    update(q, states[oldest], actions[oldest], target, alpha)
+    drop_oldest(counter, n)
 
 
 def queue_memory(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -149,6 +149,55 @@ class TabularModel:
         )
         return expected, matrix
 
+    def stochastic_policy_matrix(self, pi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`policy_matrix` of a stochastic policy, ``pi[s, a]`` the probability of ``a``."""
+        weight = pi[self.state, self.action] * self.probability
+        expected = np.bincount(self.state, weights=weight * self.reward, minlength=self.n_states)
+        going_on = ~self.terminated
+        matrix = np.zeros((self.n_states, self.n_states))
+        np.add.at(matrix, (self.state[going_on], self.next_state[going_on]), weight[going_on])
+        return expected, matrix
+
+    def terminal_states(self) -> np.ndarray:
+        """bool, ``(n_states,)``: the absorbing states where every action ends the episode.
+
+        Every outcome of every action stays in the state, pays 0 and terminates: the
+        book's terminal states (the ends of a random walk, FrozenLake's holes and goal),
+        whose value is 0 under every policy; prediction errors leave them out.
+        """
+        ends = np.ones(self.n_states, dtype=bool)
+        absorbing = self.terminated & (self.reward == 0.0) & (self.next_state == self.state)
+        np.logical_and.at(ends, self.state, absorbing)
+        return ends
+
+
+def evaluate_policy(model: TabularModel, pi: np.ndarray, gamma: float) -> np.ndarray:
+    """The exact values ``v_pi`` of a stochastic stationary policy: ``(I - gamma P_pi) v = r_pi``.
+
+    ``pi[s, a]`` is the probability of ``a`` in ``s`` (each row sums to 1). With ``gamma =
+    1`` the policy must end every episode with probability 1 (the system is then regular).
+    Sutton & Barto's 5-state random walk (Example 6.2), uniformly random, undiscounted:
+
+    >>> P = {s: {a: [(1.0, s + (1 if a else -1), float(s == 5 and a == 1), s + (1 if a else -1) in (0, 6))]
+    ...          for a in (0, 1)} for s in range(1, 6)}
+    >>> P[0] = P[6] = None
+    >>> P = {s: (P[s] or {a: [(1.0, s, 0.0, True)] for a in (0, 1)}) for s in range(7)}
+    >>> model = TabularModel.from_transitions(P, initial=[0, 0, 0, 1, 0, 0, 0])
+    >>> [round(float(v) * 6, 12) for v in evaluate_policy(model, np.full((7, 2), 0.5), 1.0)]
+    [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 0.0]
+
+    Raises:
+        ValueError: ``gamma`` outside [0, 1], or a policy that never ends (a singular system).
+    """
+    if not 0.0 <= gamma <= 1.0:
+        raise ValueError(f"gamma must be in [0, 1], got {gamma}")
+    expected, matrix = model.stochastic_policy_matrix(np.asarray(pi, dtype=np.float64))
+    try:
+        values: np.ndarray = np.linalg.solve(np.eye(model.n_states) - gamma * matrix, expected)
+    except np.linalg.LinAlgError:
+        raise ValueError("the policy's values are not defined: it does not end episodes") from None
+    return values
+
 
 @dataclass(frozen=True)
 class Solution:

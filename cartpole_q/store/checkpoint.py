@@ -31,6 +31,8 @@ MEMORY_PREFIX = "memory_"
 """the keys of the algorithm's memory arrays: ``memory_0``, ``memory_1``, ..."""
 INFO_ARRAY = "info"
 """the finished episodes' sums of ``info[train.info_metric]``, when the config names one"""
+ERRORS_ARRAY = "rms_errors"
+"""a prediction run's finished episodes' RMS errors, when it measures them"""
 
 
 def write_checkpoint(run_dir: Path, checkpoint: Checkpoint) -> None:
@@ -65,6 +67,8 @@ def checkpoint_bytes(checkpoint: Checkpoint) -> bytes:
         arrays["solved_q"] = checkpoint.solved_q
     if checkpoint.info is not None:  # train.info_metric's sums (absent without it)
         arrays[INFO_ARRAY] = checkpoint.info
+    if checkpoint.errors is not None:  # a prediction run's errors (absent without them)
+        arrays[ERRORS_ARRAY] = checkpoint.errors
     buffer = io.BytesIO()
     np.savez(buffer, allow_pickle=False, **arrays)
     return buffer.getvalue()
@@ -114,6 +118,7 @@ def checkpoint_from_bytes(content: bytes, where: str) -> Checkpoint:
                 wall_seconds=float(meta["wall_seconds"]),
                 config=_checkpoint_config(meta.get("config")),
                 info=data[INFO_ARRAY] if INFO_ARRAY in data.files else None,
+                errors=data[ERRORS_ARRAY] if ERRORS_ARRAY in data.files else None,
             )
     except (
         OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError

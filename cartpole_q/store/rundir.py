@@ -41,6 +41,7 @@ from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError, WriteError
 from cartpole_q.evaluation import check_q_table
 from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
+from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.store import lock
 from cartpole_q.store.atomic import (
     atomic_save_npy,
@@ -55,12 +56,16 @@ from cartpole_q.training import TrainResult
 
 CONFIG_FILE = "config.yaml"
 Q_TABLE_FILE = "q_table.npy"
+V_TABLE_FILE = "v_table.npy"
+"""a prediction run's table: the state values ``V``, in place of ``q_table.npy``"""
 VISITS_FILE = "visits.npy"
 METRICS_FILE = "metrics.csv"
 EVALUATIONS_FILE = "evaluations.csv"
 CURVE_FILE = "reward_curve.png"
 SUMMARY_FILE = "summary.json"
 METRICS_HEADER = ("episode", "return", "length", "epsilon", "alpha")
+ERRORS_COLUMN = "rms_error"
+"""``metrics.csv``'s last column in a prediction run that measures its error"""
 INFO_COLUMN_PREFIX = "info_"
 """``metrics.csv``'s last column with ``train.info_metric: KEY`` is ``info_KEY``"""
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
@@ -263,29 +268,36 @@ def summarize(result: TrainResult) -> RunSummary:
 
 
 def metrics_csv(
-    metrics: EpisodeMetrics, info: np.ndarray | None = None, info_key: str | None = None
+    metrics: EpisodeMetrics,
+    info: np.ndarray | None = None,
+    info_key: str | None = None,
+    errors: np.ndarray | None = None,
 ) -> str:
     """Per-episode metrics as CSV; floats written with ``repr`` so they round-trip exactly.
 
-    With ``info`` (the sums of ``info[info_key]``), a last column ``info_<info_key>``.
+    With ``info`` (the sums of ``info[info_key]``), a column ``info_<info_key>``; with
+    ``errors`` (a prediction run's), a last column ``rms_error``.
 
     >>> one = EpisodeMetrics(np.array([1.0]), np.array([2]), np.array([0.1]), np.array([0.5]))
     >>> print(metrics_csv(one, np.array([1.0]), "left_from_a"), end="")
     episode,return,length,epsilon,alpha,info_left_from_a
     1,1.0,2,0.1,0.5,1.0
+    >>> print(metrics_csv(one, errors=np.array([0.25])), end="")
+    episode,return,length,epsilon,alpha,rms_error
+    1,1.0,2,0.1,0.5,0.25
     """
-    if info is None:
-        lines = [",".join(METRICS_HEADER)]
-        lines.extend(
-            f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r}"
-            for i, (r, n, e, a) in enumerate(zip(*metrics, strict=True))
-        )
-        return "\n".join(lines) + "\n"
-    lines = [",".join((*METRICS_HEADER, f"{INFO_COLUMN_PREFIX}{info_key}"))]
-    lines.extend(
-        f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r},{float(v)!r}"
-        for i, (r, n, e, a, v) in enumerate(zip(*metrics, info, strict=True))
-    )
+    header = [*METRICS_HEADER]
+    extra: list[np.ndarray] = []
+    if info is not None:
+        header.append(f"{INFO_COLUMN_PREFIX}{info_key}")
+        extra.append(info)
+    if errors is not None:
+        header.append(ERRORS_COLUMN)
+        extra.append(errors)
+    lines = [",".join(header)]
+    for i, (r, n, e, a, *more) in enumerate(zip(*metrics, *extra, strict=True)):
+        tail = "".join(f",{float(value)!r}" for value in more)
+        lines.append(f"{i + 1},{float(r)!r},{int(n)},{float(e)!r},{float(a)!r}{tail}")
     return "\n".join(lines) + "\n"
 
 
@@ -331,11 +343,14 @@ def write_run(
         )
     make_directory(run_dir)
     write_config(run_dir, result.config)
-    atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
+    if result.predicts:
+        atomic_save_npy(run_dir / V_TABLE_FILE, result.v_table)
+    else:
+        atomic_save_npy(run_dir / Q_TABLE_FILE, result.q_table)
     atomic_save_npy(run_dir / VISITS_FILE, result.visits)
     atomic_write_text(
         run_dir / METRICS_FILE,
-        metrics_csv(result.metrics, result.info, result.config.train.info_metric),
+        metrics_csv(result.metrics, result.info, result.config.train.info_metric, result.errors),
     )
     atomic_write_text(run_dir / EVALUATIONS_FILE, evaluations_csv(result.evaluations))
     if plot:
@@ -379,6 +394,11 @@ class Run:
     """each episode's sum of ``info[config.train.info_metric]`` (``metrics.csv``'s
     ``info_KEY`` column; ``None`` without ``train.info_metric``, or a sweep point that kept
     no curves)"""
+    errors: np.ndarray | None = None
+    """a prediction run's RMS error after each episode (``metrics.csv``'s ``rms_error``)"""
+    predicts: bool = False
+    """a prediction run: ``q_table`` is its ``V`` (``v_table.npy``) with one column, and it
+    has no greedy policy"""
 
     @property
     def name(self) -> str:
@@ -422,27 +442,34 @@ def load_run(path: str | Path) -> Run:
             else ""
         )
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
-    q_table = load_array(path / Q_TABLE_FILE, np.float64)
     grid = config.discretization
-    check_q_table(
-        q_table, None if grid is None else grid.table_shape, None, str(path / Q_TABLE_FILE)
-    )
+    predicts = get_algorithm(config.agent.algorithm).predicts
+    table_file = V_TABLE_FILE if predicts else Q_TABLE_FILE
+    table = load_array(path / table_file, np.float64)
+    if predicts:  # V as the one-column table the algorithms learnt it as
+        table = table.reshape(*table.shape, 1)
+    check_q_table(table, None if grid is None else grid.table_shape, None, str(path / table_file))
     visits = None
     if (path / VISITS_FILE).is_file():
         visits = load_array(path / VISITS_FILE, np.int64)
-        if visits.shape != q_table.shape:
+        if visits.shape[:-1] != table.shape[:-1] or (not predicts and visits.shape != table.shape):
             raise RunError(
-                f"{path / VISITS_FILE}: has shape {visits.shape}, but the Q-table's is {q_table.shape}."
+                f"{path / VISITS_FILE}: has shape {visits.shape}, but {table_file}'s is "
+                f"{table.shape[:-1] if predicts else table.shape}."
             )
-    metrics, info = read_metric_columns(path / METRICS_FILE, config.train.info_metric)
+    metrics, info, errors = read_metric_columns(
+        path / METRICS_FILE, config.train.info_metric, errors=predicts
+    )
     return Run(
         path=path,
         config=config,
-        q_table=q_table,
+        q_table=table,
         visits=visits,
         metrics=metrics,
         result=_with_threshold(summary.result(config.seed), config),
         info=info,
+        errors=errors,
+        predicts=predicts,
     )
 
 
@@ -509,9 +536,12 @@ def read_metrics(path: Path) -> EpisodeMetrics:
 
 
 def read_metric_columns(
-    path: Path, info_key: str | None
-) -> tuple[EpisodeMetrics, np.ndarray | None]:
-    """Read ``metrics.csv``: its metrics, and its ``info_<info_key>`` column when given.
+    path: Path, info_key: str | None, errors: bool = False
+) -> tuple[EpisodeMetrics, np.ndarray | None, np.ndarray | None]:
+    """Read ``metrics.csv``: its metrics and its ``info_KEY`` and ``rms_error`` columns.
+
+    The ``info_<info_key>`` column is read when ``info_key`` is given, the ``rms_error``
+    column when there may be one (``errors``: a prediction run's, if it measured them).
 
     Raises:
         RunError: the file is missing, has another header (``info_KEY`` exactly when
@@ -519,7 +549,7 @@ def read_metric_columns(
     """
     header: tuple[str, ...] = METRICS_HEADER
     if info_key is not None:
-        header = (*METRICS_HEADER, f"{INFO_COLUMN_PREFIX}{info_key}")
+        header = (*header, f"{INFO_COLUMN_PREFIX}{info_key}")
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -529,6 +559,8 @@ def read_metric_columns(
     except (OSError, UnicodeDecodeError) as error:
         raise RunError(f"{path}: cannot be read ({error}).") from None
     rows = list(csv.reader(io.StringIO(text)))
+    if errors and rows and tuple(rows[0]) == (*header, ERRORS_COLUMN):
+        header = (*header, ERRORS_COLUMN)  # measured (a world with a model)
     if not rows or tuple(rows[0]) != header:
         because = ""
         if info_key is not None:
@@ -551,7 +583,9 @@ def read_metric_columns(
         epsilons=columns[:, 3],
         alphas=columns[:, 4],
     )
-    return metrics, (columns[:, 5].copy() if info_key is not None else None)
+    info = columns[:, 5].copy() if info_key is not None else None
+    measured = columns[:, -1].copy() if header[-1] == ERRORS_COLUMN else None
+    return metrics, info, measured
 
 
 def read_summary(run_dir: Path) -> RunSummary | None:

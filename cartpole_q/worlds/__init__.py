@@ -10,7 +10,8 @@ id                                         world
 ``cartpole_q/BlockingMaze-v0``             Example 8.2, Figure 8.4 (``change_at=1000``)
 ``cartpole_q/ShortcutMaze-v0``             Example 8.3, Figure 8.5 (``change_at=3000``)
 ``cartpole_q/MaximizationBias-v0``         Example 6.7, Figure 6.5 (:mod:`~cartpole_q.worlds.bias`)
-``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2 (:mod:`~cartpole_q.worlds.random_walk`)
+``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.worlds.random_walk`)
+``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
 =========================================  ==================================================
 
 **Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
@@ -76,6 +77,12 @@ WORLDS: Sequence[World] = (
     World(f"{NAMESPACE}/BlockingMaze-v0", f"{_GRIDS}:BlockingMazeEnv", GRID_TIME_LIMIT),
     World(f"{NAMESPACE}/ShortcutMaze-v0", f"{_GRIDS}:ShortcutMazeEnv", GRID_TIME_LIMIT),
     World(f"{NAMESPACE}/MaximizationBias-v0", "cartpole_q.worlds.bias:MaximizationBiasEnv", None),
+    World(
+        f"{NAMESPACE}/RandomWalk5-v0",
+        "cartpole_q.worlds.random_walk:RandomWalkEnv",
+        WALK_TIME_LIMIT,
+        MappingProxyType({"states": 5, "left_reward": 0.0}),
+    ),
     World(
         f"{NAMESPACE}/RandomWalk-v0", "cartpole_q.worlds.random_walk:RandomWalkEnv", WALK_TIME_LIMIT
     ),

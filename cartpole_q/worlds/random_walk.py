@@ -1,15 +1,18 @@
-"""Sutton & Barto's 19-state random walk (Example 7.1, Figure 7.2).
+"""Sutton & Barto's random walks: 5 states (Example 6.2) and 19 states (Example 7.1).
 
-States 1-19 are the walk, numbered left to right; 0 and 20 are its two ends (absorbing, as
-FrozenLake's goal). Episodes start in the middle, state 10. Stepping into the left end
-earns -1, into the right end +1, any other step 0.
+A walk's states ``1 .. states`` are numbered left to right; ``0`` and ``states + 1`` are its
+two ends (absorbing, as FrozenLake's goal). Episodes start in the middle. Stepping into
+the right end earns +1, into the left end ``left_reward``, any other step 0:
 
-The book's walk has no actions: Figure 7.2 is n-step TD *prediction* of the random policy's
-state values (true values -0.9, -0.8, ..., 0.9), which this tool, a control tool, does not
-do. Here the walk has two actions, left (0) and right (1), so it can be trained; a uniformly
-random policy is the book's walk (``agent.epsilon: 1``), and with Expected SARSA at epsilon 1
-the learnt ``(Q(s, left) + Q(s, right)) / 2`` estimates the book's ``v(s)`` (undiscounted).
-The optimal policy goes right (+1).
+- ``cartpole_q/RandomWalk5-v0``: Example 6.2's walk, states A-E (1-5) between a 0 end and a
+  +1 end, started in C; the random policy's values are 1/6, 2/6, ..., 5/6 (undiscounted).
+- ``cartpole_q/RandomWalk-v0``: Example 7.1's 19 states between a -1 end and a +1 end
+  (Figure 7.2, chapter 12), started in state 10; true values -0.9, -0.8, ..., 0.9.
+
+The book's walks have no actions: a step goes left or right with equal probability. Here
+the walk has two actions, left (0) and right (1), so that it can be trained as well as
+evaluated: the prediction algorithms (``agent.policy: random``) learn the book's ``v(s)``;
+a uniformly random policy is the book's walk. The optimal policy goes right (+1).
 """
 
 from __future__ import annotations
@@ -17,30 +20,39 @@ from __future__ import annotations
 from cartpole_q.worlds.table import Table, TableWorld
 
 WALK_STATES = 19
-"""the non-terminal states (Example 7.1: 19)"""
-LEFT_END, START, RIGHT_END = 0, (WALK_STATES + 1) // 2, WALK_STATES + 1
+"""the non-terminal states of Example 7.1's walk"""
 MOVES = (-1, 1)
 """per action: the step along the walk (left, right)"""
 
 
 class RandomWalkEnv(TableWorld):
-    """Example 7.1: a walk of 19 states between a -1 end and a +1 end, started in the middle."""
+    """A walk of ``states`` states between a ``left_reward`` end and a +1 end, started in the middle.
 
-    def __init__(self) -> None:
-        super().__init__(n_states=WALK_STATES + 2, n_actions=len(MOVES), start=START)
+    Args:
+        states: the non-terminal states (an odd number, so that there is a middle).
+        left_reward: the reward of stepping into the left end.
+    """
+
+    def __init__(self, states: int = WALK_STATES, left_reward: float = -1.0) -> None:
+        if states < 1 or states % 2 == 0:
+            raise ValueError(f"a random walk needs an odd number of states, got {states}")
+        super().__init__(n_states=states + 2, n_actions=len(MOVES), start=(states + 1) // 2)
+        self.states = states
+        self.left_reward = float(left_reward)
         self.P = self._table()
 
     def _table(self) -> Table:
         """``P``: a step moves one state; the ends are absorbing."""
+        left_end, right_end = 0, self.states + 1
+        rewards = {left_end: self.left_reward, right_end: 1.0}
         table: Table = {}
-        for state in range(WALK_STATES + 2):
+        for state in range(self.states + 2):
             table[state] = {}
             for action, move in enumerate(MOVES):
-                if state in (LEFT_END, RIGHT_END):
+                if state in (left_end, right_end):
                     table[state][action] = [(1.0, state, 0.0, True)]
                     continue
                 following = state + move
-                reward = {LEFT_END: -1.0, RIGHT_END: 1.0}.get(following, 0.0)
-                ended = following in (LEFT_END, RIGHT_END)
-                table[state][action] = [(1.0, following, reward, ended)]
+                ended = following in (left_end, right_end)
+                table[state][action] = [(1.0, following, rewards.get(following, 0.0), ended)]
         return table

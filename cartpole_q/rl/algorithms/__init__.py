@@ -19,23 +19,29 @@ from cartpole_q.rl.algorithms import (
     dyna_q,
     dyna_q_plus,
     expected_sarsa,
+    mc_prediction,
     monte_carlo,
     n_step_sarsa,
+    n_step_td,
     n_step_tree_backup,
     off_policy_monte_carlo,
     q_learning,
     sarsa,
     sarsa_lambda,
+    td,
+    td_lambda,
     true_online_sarsa_lambda,
+    true_online_td_lambda,
     watkins_q_lambda,
 )
 
 PACKAGE = (
     q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
     sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus, monte_carlo,
-    off_policy_monte_carlo,
+    off_policy_monte_carlo, td, mc_prediction, n_step_td, td_lambda, true_online_td_lambda,
 )  # fmt: skip
-"""the package's algorithm modules, in the order the documentation lists them"""
+"""the package's algorithm modules, in the order the documentation lists them (control,
+then prediction)"""
 
 _REGISTRY: dict[str, Algorithm] = {}
 

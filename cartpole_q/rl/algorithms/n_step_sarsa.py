@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.pending import N, drop_oldest, push, queue_memory, slot
+from cartpole_q.rl.pending import N, push, queue_memory, settle_oldest
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -28,29 +28,7 @@ from cartpole_q.rl.tabular import (
     Rng,
     Table,
     behaviour_action,
-    compilable,
-    update,
-    value,
 )
-
-
-@compilable
-def settle_oldest(
-    q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
-    counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, alpha: float,
-    gamma: float,
-) -> None:  # fmt: skip
-    """Update the oldest pending step toward its return, and remove it from the queue."""
-    n = states.shape[0]
-    pending = counter[1]
-    oldest = slot(counter, n, 0)
-    target = rewards[oldest]
-    for i in range(1, pending):
-        target = target + gamma ** float(i) * rewards[slot(counter, n, i)]
-    if bootstrap:
-        target = target + gamma ** float(pending) * value(q, next_state, next_action)
-    update(q, states[oldest], actions[oldest], target, alpha)
-    drop_oldest(counter, n)
 
 
 def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,

@@ -1,0 +1,135 @@
+"""Prediction: the state values of a fixed policy, their true values, and the run's files.
+
+The algorithms' bytes are compared with the plain re-derivation in test_rederivation.py
+(``test_prediction``); here: the true values the errors are measured against, what a
+prediction run writes and reads back, resuming, and the equalities docs/algorithms.md
+states.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cartpole_q.config import load_config
+from cartpole_q.engines.base import prediction_truth
+from cartpole_q.envs.gym import inspect_env
+from cartpole_q.experiments.run import execute_run, prepare, start_run
+from cartpole_q.store import rundir
+from cartpole_q.training import train
+from tests.conftest import invoke
+
+WALK5 = {"env.id": "cartpole_q/RandomWalk5-v0", "discretization": None, "agent.gamma": 1.0}
+WALK19 = {"env.id": "cartpole_q/RandomWalk-v0", "discretization": None, "agent.gamma": 1.0}
+
+
+def _config(overrides: dict[str, object], algorithm: str = "td", **more: object) -> object:
+    return load_config(
+        overrides={
+            **overrides, "agent.algorithm": algorithm, "agent.alpha": 0.1, "agent.q_init": 0.5,
+            "train.episodes": 60, "seed": 4, **more,
+        }
+    )  # fmt: skip
+
+
+def test_the_walks_true_values_are_the_book_s() -> None:
+    """Example 6.2: 1/6 ... 5/6; Example 7.1 (Figure 7.2): -0.9 ... 0.9 (to within 1e-15)."""
+    for overrides, expected in (
+        (WALK5, [k / 6 for k in range(1, 6)]),
+        (WALK19, [k / 10 for k in range(-9, 10)]),
+    ):
+        config = _config(overrides)
+        truth = prediction_truth(config, inspect_env(config))
+        assert truth.rows.tolist() == list(range(1, len(expected) + 1))  # the ends are left out
+        np.testing.assert_allclose(truth.values, expected, rtol=0, atol=1e-15)
+
+
+def test_control_and_worlds_without_a_model_measure_nothing() -> None:
+    assert train(_config(WALK5, "q_learning"), final_eval=False).errors is None
+    cartpole = load_config(overrides={"agent.algorithm": "td", "train.episodes": 3})
+    assert not prediction_truth(cartpole, inspect_env(cartpole)).measured
+    result = train(cartpole, final_eval=False)
+    assert result.errors is None and result.v_table.shape == (1, 1, 2, 10)
+    assert result.eval is None and result.solved_episode is None
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_a_prediction_run_writes_v_and_its_errors(tmp_path: Path, engine: str) -> None:
+    out = tmp_path / "run"
+    result = invoke(
+        "train", "--set", f"env.id={WALK5['env.id']}", "--set", "discretization=null",
+        "--set", "agent.algorithm=td", "--set", "agent.gamma=1", "--set", "agent.q_init=0.5",
+        "--episodes", "40", "--engine", engine, "--out", str(out), "-q",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert not (out / rundir.Q_TABLE_FILE).exists()
+    values = np.load(out / rundir.V_TABLE_FILE)
+    assert values.shape == (7,) and values.dtype == np.float64
+    assert values[0] == values[6] == 0.5  # the ends are never learnt
+    header = (out / "metrics.csv").read_text().splitlines()[0]
+    assert header == "episode,return,length,epsilon,alpha,rms_error"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["eval"] is None and summary["solved_episode"] is None
+    run = rundir.load_run(out)
+    assert run.predicts and run.errors is not None and len(run.errors) == 40
+    assert run.q_table[..., 0].tobytes() == values.tobytes()
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_an_interrupted_prediction_run_resumes_byte_identically(
+    tmp_path: Path, engine: str
+) -> None:
+    overrides = {
+        **WALK19, "engine": engine, "agent.algorithm": "true_online_td_lambda",
+        "agent.lambda": 0.8, "agent.alpha": 0.1, "train.episodes": 50,
+        "train.checkpoint_every": 10,
+    }  # fmt: skip
+    whole = train(load_config(overrides=overrides), final_eval=False)
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= 2)
+    assert outcome.result.interrupted
+    resumed = invoke("train", "--resume", str(run), "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert np.load(run / rundir.V_TABLE_FILE).tobytes() == whole.v_table.tobytes()
+    loaded = rundir.load_run(run)
+    assert whole.errors is not None and loaded.errors is not None
+    assert loaded.errors.tolist() == whole.errors.tolist()
+
+
+@pytest.mark.parametrize(
+    ("special", "general"),
+    [
+        ({"agent.algorithm": "n_step_td", "agent.n": 1}, {"agent.algorithm": "td"}),
+        ({"agent.algorithm": "td_lambda", "agent.lambda": 0.0}, {"agent.algorithm": "td"}),
+    ],
+    ids=["n_step_td-n1-is-td", "td_lambda-lambda0-is-td"],
+)
+def test_the_equalities_the_contract_states(special: dict, general: dict) -> None:
+    base = {**WALK19, "agent.alpha": 0.2, "train.episodes": 30, "seed": 11}
+    one = train(load_config(overrides={**base, **special}), final_eval=False)
+    other = train(load_config(overrides={**base, **general}), final_eval=False)
+    assert one.v_table.tobytes() == other.v_table.tobytes()
+
+
+@pytest.mark.slow
+def test_td_learns_the_walk_faster_than_mc() -> None:
+    """Example 6.2's right panel: from V = 0.5 (error 0.236), TD at alpha 0.1 ends below MC
+    at alpha 0.02 (mean error of episodes 91-100 over 10 seeds)."""
+    ends = {}
+    for algorithm, alpha in (("td", 0.1), ("mc_prediction", 0.02)):
+        errors = []
+        for seed in range(10):
+            config = _config(
+                WALK5, algorithm, **{"agent.alpha": alpha, "train.episodes": 100, "seed": seed}
+            )
+            result = train(config, final_eval=False)
+            assert result.errors is not None
+            assert result.errors[0] == pytest.approx(0.236, abs=0.05)
+            errors.append(float(result.errors[-10:].mean()))
+        ends[algorithm] = float(np.mean(errors))
+    assert ends["td"] < ends["mc_prediction"] < 0.12
