@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from cartpole_q.config import shown
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
 from cartpole_q.statistics import PointStatistics, summarize_point
@@ -662,7 +663,7 @@ class _Reader:
         return {key: value for key, value in self._data.items() if key not in known}
 
     def _wrong(self, key: str, kind: str) -> RunError:
-        return RunError(f"{self._where}: {key}: must be {kind}, got {self._data.get(key)!r}.")
+        return RunError(f"{self._where}: {key}: must be {kind}, got {shown(self._data.get(key))}.")
 
     def _required(self, key: str) -> object:
         if key not in self._data:

@@ -17,7 +17,7 @@ import yaml
 
 from cartpole_q.config.messages import shown, type_name, unknown_key
 from cartpole_q.config.schema import Config, key_of, sections
-from cartpole_q.config.yaml_io import UniqueKeyLoader
+from cartpole_q.config.yaml_io import YamlLimitError, load_yaml_text
 from cartpole_q.errors import ConfigError
 from cartpole_q.rl.algorithms import algorithms
 
@@ -88,15 +88,17 @@ def parse_assignment(text: str, option: str = "--set") -> tuple[str, Any]:
     key = key.strip()
     if not equals or not key:
         raise ConfigError(
-            f"{option} {text!r}: expected KEY=VALUE, e.g. {_ASSIGNMENT_EXAMPLES.get(option, option)}."
+            f"{option} {shown(text)}: expected KEY=VALUE, e.g. {_ASSIGNMENT_EXAMPLES.get(option, option)}."
         )
     try:
-        parsed = yaml.load(value, Loader=UniqueKeyLoader) if value.strip() else None
+        parsed = load_yaml_text(value) if value.strip() else None
+    except YamlLimitError as error:
+        raise ConfigError(f"{option} {shown(text)}: the value {error}.") from None
     except yaml.YAMLError as error:
         problem = getattr(error, "problem", None) or "invalid syntax"
         raise ConfigError(
-            f"{option} {text!r}: the value is not plain YAML ({problem}); quote strings that "
-            "contain ':', '#', '[' or '{'."
+            f"{option} {shown(text)}: the value is not plain YAML ({problem}); quote strings "
+            "that contain ':', '#', '[' or '{'."
         ) from None
     return key, parsed
 

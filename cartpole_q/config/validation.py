@@ -162,7 +162,7 @@ def _physics_mapping(
         raise reader.error(
             field,
             f"applies to environments with physics to set ({', '.join(with_physics)}), but "
-            f"env.id is {env_id!r}.",
+            f"env.id is {shown(env_id)}.",
         )
     keys = physics.keys if kind == "physics" else physics.randomizable
     for key in value:

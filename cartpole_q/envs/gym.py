@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
+from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame, shorten, shown
 from cartpole_q.errors import RunError
 from cartpole_q.profiles import profile_for
 
@@ -83,7 +83,7 @@ def make_env(
     except gymnasium.error.DependencyNotInstalled as error:
         raise ConfigError(
             f"{blame(source, 'env.id')}: env.id: {env.id!r} needs a package that is not "
-            f"installed ({error})."
+            f"installed ({shorten(str(error), 200)})."
         ) from None
     except gymnasium.error.Error as error:
         raise ConfigError(
@@ -114,15 +114,16 @@ def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> 
         named = [key for key, value in kwargs.items() if value == error.args[0]]
     if not named and len(kwargs) == 1:
         named = list(kwargs)
-    field = f"env.kwargs.{named[0]}" if len(named) == 1 else "env.kwargs"
-    shown = (
-        f"{named[0]}={kwargs[named[0]]!r}"
+    field = f"env.kwargs.{shorten(named[0])}" if len(named) == 1 else "env.kwargs"
+    given = (
+        f"{shorten(named[0])}={shown(kwargs[named[0]])}"
         if len(named) == 1
-        else ", ".join(f"{key}={value!r}" for key, value in kwargs.items())
+        else shorten(", ".join(f"{key}={shown(value)}" for key, value in kwargs.items()))
     )
-    detail = f"{type(error).__name__}: {text}" if text else type(error).__name__
+    # The environment's message may quote the whole value it refused: cut it too.
+    detail = shorten(f"{type(error).__name__}: {text}" if text else type(error).__name__, 200)
     return ConfigError(
-        f"{blame(source, field)}: {field}: {env.id!r} cannot be made with {shown or 'no arguments'} "
+        f"{blame(source, field)}: {field}: {shown(env.id)} cannot be made with {given or 'no arguments'} "
         f"({detail}); check the value against the environment's documentation."
     )
 
@@ -162,7 +163,7 @@ def info_value(info: Mapping[str, Any], key: str, env_id: str) -> float:
         return float(value)
     raise RunError(
         f"train.info_metric: {key}: {env_id} reports a {type(value).__name__} there "
-        f"({value!r}); only a bool or a number can be summed per episode."
+        f"({shown(value)}); only a bool or a number can be summed per episode."
     )
 
 

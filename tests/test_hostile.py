@@ -1,0 +1,118 @@
+"""Hostile and mistaken input is refused in one paragraph, quickly, before anything is spent.
+
+Issue 29, "What a new user met": files that make readers recurse or allocate without
+bound, configs that expand without bound, a multi-seed directory holding another world's
+seed, a render mode no display can show, an ``env.id`` that imports modules, a robustness
+grid checked only as it is played, and messages that blamed the wrong cause.
+"""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+
+from cartpole_q.config import ConfigError, load_config, shown_value
+from tests.conftest import invoke, write_yaml
+from tests.test_cli import assert_refused
+
+SMALL = {"train": {"episodes": 30, "eval_every": 0}, "eval": {"episodes": 2}}
+QUICK = 10.0
+"""seconds within which every refusal here comes (the old code took minutes for some)"""
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """A CartPole run, a two-seed CartPole run and a FrozenLake run, small."""
+    base = tmp_path_factory.mktemp("hostile")
+    found = {}
+    for name, extra in (
+        ("one", []),
+        ("seeds", ["--seeds", "0-1"]),
+        ("lake", ["--set", "env.id=FrozenLake-v1"]),
+    ):
+        config = write_yaml(base / f"{name}.yaml", SMALL)
+        result = invoke("train", "-c", config, *extra, "--out", base / name, "-q")
+        assert result.exit_code == 0, result.output
+        found[name] = base / name
+    return found
+
+
+def _copy(run: Path, tmp_path: Path, name: str = "copy") -> Path:
+    copy = tmp_path / name
+    shutil.copytree(run, copy)
+    return copy
+
+
+def _refused_quickly(*args: object, named: tuple[str, ...] = ()) -> str:
+    start = time.perf_counter()
+    result = invoke(*args)
+    assert time.perf_counter() - start < QUICK
+    assert_refused(result, *named)
+    assert len(result.stderr) < 1500, f"a {len(result.stderr):,}-character message"
+    return result.stderr
+
+
+# -- item 6: configs without bounds ---------------------------------------------------------------
+
+BOMB = """env:
+  kwargs:
+    a: &a ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]
+    b: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]
+    c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]
+    d: &d [*c, *c, *c, *c, *c, *c, *c, *c, *c]
+    e: &e [*d, *d, *d, *d, *d, *d, *d, *d, *d]
+    f: &f [*e, *e, *e, *e, *e, *e, *e, *e, *e]
+"""
+
+
+@pytest.mark.parametrize(
+    ("text", "named"),
+    [
+        (BOMB, "holds more than 100,000 values once its aliases (*name) are expanded"),
+        (
+            "env:\n  kwargs:\n    x: " + "[" * 200 + "]" * 200 + "\n",
+            "nests lists and mappings more than 64 levels deep",
+        ),
+        ("a: &a [1, *a]\n", "has an alias inside the value it names"),
+        ("seed: 0\n" + "# padding\n" * (256 * 1024 // 10), "is larger than 256 KiB"),
+        ("env:\n  kwargs:\n    x: [" + "1, " * 120_000 + "1]\n", "is larger than 256 KiB"),
+        ("env:\n  kwargs:\n    x: [" + "1," * 110_000 + "1]\n", "holds more than 100,000 values"),
+    ],
+)
+def test_a_config_beyond_the_bounds_is_refused_quickly_and_briefly(
+    in_tmp: Path, text: str, named: str
+) -> None:
+    path = in_tmp / "c.yaml"
+    path.write_text(text)
+    _refused_quickly("train", "-c", path, named=(f"{path}: {named}",))
+    assert not (in_tmp / "runs").exists()
+    with pytest.raises(ConfigError, match=r"c\.yaml: "):
+        load_config(path)
+
+
+def test_aliases_within_the_bounds_still_work(tmp_path: Path) -> None:
+    path = tmp_path / "c.yaml"
+    path.write_text("agent:\n  alpha: &rate {type: exponential, start: 0.5, decay: 0.99, end: 0.1}\n"
+                    "  epsilon: *rate\n")  # fmt: skip
+    config = load_config(path)
+    assert config.agent.alpha == config.agent.epsilon
+
+
+def test_an_alias_bomb_on_the_command_line_is_refused(in_tmp: Path) -> None:
+    bomb = "[&a [1,2,3,4,5,6,7,8,9,10], &b [*a,*a,*a,*a,*a,*a,*a,*a,*a,*a], " \
+        "&c [*b,*b,*b,*b,*b,*b,*b,*b,*b,*b], &d [*c,*c,*c,*c,*c,*c,*c,*c,*c,*c], " \
+        "[*d,*d,*d,*d,*d,*d,*d,*d,*d,*d]]"  # fmt: skip
+    _refused_quickly("train", "--set", f"env.kwargs.x={bomb}", named=("--set", "100,000 values"))
+
+
+def test_a_large_value_is_quoted_briefly(in_tmp: Path) -> None:
+    big = write_yaml(in_tmp / "c.yaml", {"env": {"kwargs": {"foo": list(range(20_000))}}})
+    message = _refused_quickly("train", "-c", big, named=("env.kwargs.foo", "foo=[0, 1, 2"))
+    assert len(message) < 600, message
+    from cartpole_q.config import shown
+
+    assert len(shown(list(range(10**6)))) <= 80
+    assert len(shown("x" * 10**6)) <= 80 and len(shown_value({"k": ["x" * 10**6]})) <= 80
