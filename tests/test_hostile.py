@@ -116,3 +116,41 @@ def test_a_large_value_is_quoted_briefly(in_tmp: Path) -> None:
 
     assert len(shown(list(range(10**6)))) <= 80
     assert len(shown("x" * 10**6)) <= 80 and len(shown_value({"k": ["x" * 10**6]})) <= 80
+
+
+# -- item 11: messages that named the wrong cause ----------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [(10, 10), (10.0, 10), ("1e3", 1000), ("10.0", 10), (1e3, 1000)],
+)
+def test_an_integer_may_be_written_as_a_whole_float(value: object, expected: int) -> None:
+    assert load_config(overrides={"train.episodes": value}).train.episodes == expected
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "named"),
+    [
+        ("train.episodes", 1e30, "train.episodes: must be an integer no larger than 10000000"),
+        ("train.episodes", "1e30", "train.episodes: must be an integer no larger than 10000000"),
+        ("train.episodes", 10**30, "train.episodes: must be an integer no larger than 10000000"),
+        (
+            "train.episodes",
+            20_000_000.0,
+            "train.episodes: must be an integer no larger than 10000000",
+        ),
+        ("seed", 1e30, "seed: must be an integer no larger than 4294967295"),
+        (
+            "train.checkpoint_every",
+            1e30,
+            "train.checkpoint_every: must be an integer no larger than 9007199254740991",
+        ),
+        ("train.episodes", 2.5, "train.episodes: must be an integer, got 2.5"),
+    ],
+)
+def test_an_integer_too_large_is_refused_alike_however_written(
+    key: str, value: object, named: str
+) -> None:
+    with pytest.raises(ConfigError, match=f"^overrides: {named}"):
+        load_config(overrides={key: value})

@@ -19,6 +19,7 @@ from cartpole_q.config.diff import NOT_SET, config_differences, mapping_differen
 from cartpole_q.config.loading import load_config
 from cartpole_q.config.messages import QUOTE_LIMIT, shorten, shown
 from cartpole_q.config.overrides import (
+    COMMAND_LINE,
     OVERRIDE_SOURCE,
     Provenance,
     blame,
@@ -54,6 +55,7 @@ from cartpole_q.errors import ConfigError
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 __all__ = [
+    "COMMAND_LINE",
     "ENGINES",
     "MAX_EPISODES",
     "MAX_SEED",

@@ -21,8 +21,11 @@ from cartpole_q.config.yaml_io import YamlLimitError, load_yaml_text
 from cartpole_q.errors import ConfigError
 from cartpole_q.rl.algorithms import algorithms
 
-OVERRIDE_SOURCE = "command line"
-"""how errors name the source of an override (``--set``, ``--seed`` and the like)"""
+OVERRIDE_SOURCE = "overrides"
+"""how errors name overrides by default: the ``overrides`` argument of the Python API's
+:func:`~cartpole_q.config.load_config` (the command line passes :data:`COMMAND_LINE`)"""
+COMMAND_LINE = "command line"
+"""how errors name the command line's overrides (``--set``, ``--seed`` and the like)"""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,7 +35,7 @@ class Provenance:
     Checks made after loading (against the environment, say) name a field; the field's
     value came from the file, or from an override (``--set env.id=...``).
 
-    >>> where = Provenance("blog.yaml", ("env.id", "agent.alpha"))
+    >>> where = Provenance("blog.yaml", ("env.id", "agent.alpha"), COMMAND_LINE)
     >>> where.of("env.id"), where.of("discretization.bins"), where.of("agent"), str(where)
     ('command line', 'blog.yaml', 'command line', 'blog.yaml')
     """
@@ -64,7 +67,7 @@ def blame(source: str | Provenance, field: str) -> str:
     A plain label as it is; a :class:`Provenance`, the file or the overrides that gave it.
 
     >>> blame("a.yaml", "env.id"), blame(Provenance("a.yaml", ("env.id",)), "env.id")
-    ('a.yaml', 'command line')
+    ('a.yaml', 'overrides')
     """
     return source.of(field) if isinstance(source, Provenance) else str(source)
 

@@ -324,19 +324,21 @@ class _Reader:
     def integer(
         self, field: str, value: Any, minimum: float | None, maximum: float | None = None
     ) -> int:
+        # Written as digits (10), as a float (10.0, 1e3) or as a string YAML left (5e3):
+        # the same integer, within the same range. No field's range reaches 2^53, so a
+        # float inside it is an integer exactly, and one outside it is refused the same
+        # way, however large, as the integer it would stand for.
+        highest = EXACT_INTEGER - 1 if maximum is None else min(int(maximum), EXACT_INTEGER - 1)
         number = _as_number(value)
         if number is None or not math.isfinite(number) or number != int(number):
             raise self.error(field, f"must be an integer, got {shown(value)}.")
-        if not isinstance(value, int) and abs(number) >= EXACT_INTEGER:
+        if minimum is not None and number < minimum:
+            raise self.error(field, f"must be at least {int(minimum)}, got {shown(value)}.")
+        if (value if isinstance(value, int) else number) > highest:
             raise self.error(
-                field, f"must be an integer written out in digits, got {shown(value)}."
+                field, f"must be an integer no larger than {highest}, got {shown(value)}."
             )
-        integer = int(value) if isinstance(value, int) else int(number)
-        if minimum is not None and integer < minimum:
-            raise self.error(field, f"must be at least {int(minimum)}, got {integer}.")
-        if maximum is not None and integer > maximum:
-            raise self.error(field, f"must be at most {int(maximum)}, got {integer}.")
-        return integer
+        return int(value) if isinstance(value, int) else int(number)
 
     def boolean(self, field: str, value: Any) -> bool:
         if not isinstance(value, bool):
