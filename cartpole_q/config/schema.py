@@ -193,7 +193,8 @@ class EnvConfig:
             "kwargs",
             "passed to `gymnasium.make`, e.g. `sutton_barto_reward: true`, "
             "`max_episode_steps: 200` (a positive whole number); whatever the environment "
-            "refuses is an error naming the key",
+            "refuses is an error naming the key. `render_mode` is refused: training never "
+            "renders (`eval --render`, `eval --video FILE.gif`, `train --watch N` draw)",
         )
     )
     physics: Mapping[str, float | str] = field(

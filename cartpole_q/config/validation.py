@@ -447,6 +447,16 @@ class _Reader:
             raise self.error(
                 field, f"must be a mapping of argument names to values, got {shown(value)}."
             )
+        if "render_mode" in value:
+            # Training never draws, and a window opened with no display fails only after
+            # the environment is made; the commands that draw set the mode themselves.
+            raise self.error(
+                f"{field}.render_mode",
+                "cannot be set in a config: training never renders, and cartpole-q sets the "
+                "render mode itself where it draws. Watch a policy with `cartpole-q eval RUN "
+                "--render` (needs a display), record it with `cartpole-q eval RUN --video "
+                "FILE.gif`, or use `train --watch N` or `--video-every N` while training.",
+            )
         steps = value.get("max_episode_steps")
         if "max_episode_steps" in value and (
             isinstance(steps, bool) or not isinstance(steps, int) or steps < 1
