@@ -9,7 +9,9 @@ grid checked only as it is played, and messages that blamed the wrong cause.
 from __future__ import annotations
 
 import shutil
+import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -118,7 +120,68 @@ def test_a_large_value_is_quoted_briefly(in_tmp: Path) -> None:
     assert len(shown("x" * 10**6)) <= 80 and len(shown_value({"k": ["x" * 10**6]})) <= 80
 
 
+# -- item 9: an env.id that imports modules ----------------------------------------------------------
+
+PROBE = "hostile_probe_29"
+
+
+@pytest.fixture
+def probe(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A module on the path that leaves a mark when imported."""
+    mark = tmp_path / "imported"
+    (tmp_path / f"{PROBE}.py").write_text(f"open({str(mark)!r}, 'w').close()\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    sys.modules.pop(PROBE, None)
+    yield mark
+    sys.modules.pop(PROBE, None)
+
+
+def test_a_run_directory_cannot_make_cartpole_q_import_a_module(
+    runs: dict[str, Path], tmp_path: Path, probe: Path
+) -> None:
+    run = _copy(runs["one"], tmp_path, "run")
+    config = run / "config.yaml"
+    config.write_text(config.read_text().replace("id: CartPole-v1", f"id: {PROBE}:Foo-v0"))
+    named = ("config.yaml: env.id:", f"would import the module '{PROBE}'")
+    for args in (("eval", run), ("plot", run, "--policy"), ("compare", run, runs["one"])):
+        _refused_quickly(*args, named=named)
+    _refused_quickly("robustness", run, "--vary", "length=0.5:1:2", named=named)
+    assert not probe.exists() and PROBE not in sys.modules
+
+
+@pytest.mark.parametrize(
+    ("env_id", "named"),
+    [
+        ("no_such_module_29:Foo-v0", "the module 'no_such_module_29' cannot be imported"),
+        ("CartPol-v1", "did you mean 'CartPole-v1'?"),
+        ("a:b:c", "is not an environment id"),
+        ("not-a-module:Foo-v0", "'not-a-module' before ':' is not a module name"),
+    ],
+)
+def test_an_env_id_is_checked_before_anything_is_imported(
+    in_tmp: Path, env_id: str, named: str
+) -> None:
+    _refused_quickly("train", "--set", f"env.id={env_id}", named=(f"env.id: {env_id!r}", named))
+    assert not (in_tmp / "runs").exists()
+
+
+def test_a_module_in_the_users_own_config_is_imported_by_design(in_tmp: Path, probe: Path) -> None:
+    _refused_quickly(
+        "train", "--set", f"env.id={PROBE}:Foo-v0",
+        named=(f"importing '{PROBE}' registered no environment 'Foo-v0'",),
+    )  # fmt: skip
+    assert probe.exists()
+
+
 # -- item 11: messages that named the wrong cause ----------------------------------------------------
+
+
+def test_an_unversioned_id_is_blamed_not_the_default_grid(in_tmp: Path) -> None:
+    message = _refused_quickly(
+        "train", "--set", "env.id=CartPole",
+        named=("command line: env.id: 'CartPole' gives no version; write 'CartPole-v1'",),
+    )  # fmt: skip
+    assert "discretization" not in message
 
 
 @pytest.mark.parametrize(

@@ -65,6 +65,7 @@ def make_env(
     """
     import gymnasium
 
+    check_env_id(env.id, source)
     kwargs = dict(env.kwargs)
     if render_mode is not None:
         kwargs["render_mode"] = render_mode
@@ -86,14 +87,123 @@ def make_env(
             f"installed ({shorten(str(error), 200)})."
         ) from None
     except gymnasium.error.Error as error:
+        imported, name = env_module(env.id), env.id.rpartition(":")[2]
+        detail = shorten(str(error), 200)
+        if imported is not None and name not in gymnasium.registry:
+            detail = f"importing {imported!r} registered no environment {name!r}"
         raise ConfigError(
-            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: {error}"
+            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: {detail.rstrip('.')}."
         ) from None
     except Exception as error:  # whatever the environment raises for arguments it refuses
         raise kwargs_error(env, error, source) from None
     if env.physics:
         set_physics(made, env.physics)
     return made
+
+
+def check_env_id(env_id: str, source: str | Provenance = "config") -> None:
+    """Refuse an ``env.id`` Gymnasium cannot make, before anything it names is imported.
+
+    A plain id must be registered (an id without its version is refused with the
+    version to give: Gymnasium would pick its latest silently, and the run would not say
+    which). ``module:Name-vN`` is Gymnasium's way to make an environment another package
+    registers: making it imports ``module``, which runs that module's code, by design, as
+    ``python -m module`` would; so the module is checked to exist first (without running
+    it), and a config read back from a run or sweep directory may not name one
+    (:func:`check_recorded_env_id`).
+
+    >>> check_env_id("CartPole-v1")
+    >>> check_env_id("CartPole")
+    Traceback (most recent call last):
+    ...
+    cartpole_q.errors.ConfigError: config: env.id: 'CartPole' gives no version; write 'CartPole-v1' (the latest version Gymnasium has), so that the run records which environment it trained on.
+
+    Raises:
+        ConfigError: naming ``env.id``: a malformed id, an unknown one (with the closest
+            registered id), an id without its version, or a module that does not exist.
+    """
+    import difflib
+    import importlib.util
+
+    from gymnasium import error as gym_error
+    from gymnasium.envs.registration import (
+        find_highest_version,
+        get_env_id,
+        parse_env_id,
+        registry,
+    )
+
+    where = f"{blame(source, 'env.id')}: env.id: {shown(env_id)}"
+    module, colon, name = env_id.partition(":")
+    if not colon:
+        module, name = "", env_id
+    if ":" in name or (colon and not module):
+        raise ConfigError(
+            f"{where} is not an environment id such as 'CartPole-v1' or 'module:Name-v0'."
+        )
+    try:
+        namespace, base, version = parse_env_id(name)
+    except gym_error.Error:
+        raise ConfigError(
+            f"{where} is not an environment id such as 'CartPole-v1' ([namespace/]name-vN)."
+        ) from None
+    if module:
+        parts = module.split(".")
+        if not all(part.isidentifier() for part in parts):
+            raise ConfigError(f"{where}: {shown(module)} before ':' is not a module name.")
+        if module not in sys.modules and importlib.util.find_spec(parts[0]) is None:
+            raise ConfigError(
+                f"{where}: the module {shown(parts[0])} cannot be imported (no module of that "
+                "name is installed); install it, or check the part of env.id before ':'."
+            )
+        return  # the module registers it when gymnasium.make imports it
+    if name in registry:
+        return
+    latest = find_highest_version(namespace, base) if version is None else None
+    if latest is not None:
+        versioned = get_env_id(namespace, base, latest)
+        raise ConfigError(
+            f"{where} gives no version; write {versioned!r} (the latest version Gymnasium "
+            "has), so that the run records which environment it trained on."
+        )
+    close = difflib.get_close_matches(name, list(registry), n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]!r}?" if close else "."
+    raise ConfigError(
+        f"{where} is not a registered Gymnasium environment{hint} An environment another "
+        "package registers is made as 'package:Name-v0' (which imports that package)."
+    )
+
+
+def env_module(env_id: str) -> str | None:
+    """The module ``env.id`` asks Gymnasium to import (``module:Name-v0``), if any.
+
+    >>> env_module("mygame.envs:Maze-v0"), env_module("CartPole-v1")
+    ('mygame.envs', None)
+    """
+    module, colon, _ = env_id.partition(":")
+    return module if colon and module else None
+
+
+def check_recorded_env_id(env_id: str, where: str) -> None:
+    """Refuse a config read back from a directory whose ``env.id`` would import a module.
+
+    Importing runs the module's code. cartpole-q imports what ``env.id`` names only
+    from a config the user gives (``train``, ``sweep``, ``tune``, ``load_config``), never
+    from one it reads back to evaluate, plot or compare (a run directory may come from
+    anyone), unless that module is imported already: from Python, import it first.
+
+    Raises:
+        RunError: naming ``where`` (the config file) and the module.
+    """
+    module = env_module(env_id)
+    if module is None or module in sys.modules:
+        return
+    raise RunError(
+        f"{where}: env.id: {shown(env_id)} would import the module {shown(module)}, which "
+        "runs its code; cartpole-q imports a module named by env.id only from a config you "
+        "give it (train, sweep, tune), never from a run or sweep directory it reads. To use "
+        f"this run, import {module} yourself and call the Python API (cartpole_q.load_run)."
+    )
 
 
 def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> ConfigError:

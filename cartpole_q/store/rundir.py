@@ -478,7 +478,23 @@ def _read_json(path: Path) -> object:
 
 
 def _config_of(path: Path) -> Config:
+    return read_config_file(path / CONFIG_FILE)
+
+
+def read_config_file(path: Path) -> Config:
+    """The ``config.yaml`` of a directory cartpole-q wrote (a run, a multi-seed run, a sweep point).
+
+    Read as data: an ``env.id`` that would import a module is refused
+    (:func:`~cartpole_q.envs.gym.check_recorded_env_id`).
+
+    Raises:
+        RunError: the file is not a valid config, or its ``env.id`` names a module to import.
+    """
+    from cartpole_q.envs.gym import check_recorded_env_id
+
     try:
-        return load_config(path / CONFIG_FILE)
+        config = load_config(path)
     except ConfigError as error:
-        raise RunError(f"{path}: its {CONFIG_FILE} is not a valid config. {error}") from None
+        raise RunError(f"{path.parent}: its {path.name} is not a valid config. {error}") from None
+    check_recorded_env_id(config.env.id, str(path))
+    return config

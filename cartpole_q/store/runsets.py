@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, Schedule, load_config
+from cartpole_q.config import Config, Schedule
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.store import rundir, sweepdir
@@ -85,7 +85,7 @@ def load_run_set(path: Path) -> RunSet:
 
 def _multi_seed(parent: Path) -> RunSet:
     """A multi-seed run's finished seeds; interrupted and missing ones are named, left out."""
-    config = load_config(parent / rundir.CONFIG_FILE)
+    config = rundir.read_config_file(parent / rundir.CONFIG_FILE)
     seeds = config.train.seeds
     assert seeds is not None
     runs: list[rundir.Run] = []
@@ -130,12 +130,7 @@ def _names(names: list[str], limit: int = 8) -> str:
 def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
     """A sweep point's seeds as runs: rows, tables and (when kept) learning curves."""
     sweep = point_dir.parent.parent
-    try:
-        config = load_config(point_dir / rundir.CONFIG_FILE)
-    except ConfigError as error:
-        raise RunError(
-            f"{point_dir}: its {rundir.CONFIG_FILE} is not a valid config ({error})."
-        ) from None
+    config = rundir.read_config_file(point_dir / rundir.CONFIG_FILE)
     tables = sweepdir.read_tables(sweep, point_dir.name)
     curves = sweepdir.read_curves(sweep, point_dir.name)
     info_key = config.train.info_metric
