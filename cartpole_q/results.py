@@ -15,6 +15,7 @@ Strings live only in :mod:`cartpole_q.store`, where CSV is written and read; JSO
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -595,7 +596,11 @@ class MultiSeedSummary:
             if statistics is None
             else PointStatistics(
                 statistics.integer("seeds"),
-                *(statistics.optional_number(name) for name in PointStatistics.columns()[1:]),
+                # a statistic of no finished seed is NaN: written so, read back so
+                *(
+                    statistics.optional_number(name, finite=False)
+                    for name in PointStatistics.columns()[1:]
+                ),
             ),
             wall_seconds=reader.optional_number("wall_seconds") or 0.0,
             per_seed=MappingProxyType(
@@ -670,14 +675,21 @@ class _Reader:
             raise RunError(f"{self._where}: misses the key {key}.")
         return self._data[key]
 
-    def number(self, key: str) -> float:
+    def number(self, key: str, *, finite: bool = True) -> float:
+        """A number; NaN and infinities (JSON's ``NaN``, ``Infinity``) only when not ``finite``.
+
+        A run's figures are finite: a NaN would pass every comparison silently (and make
+        statistics fail far from the file that holds it).
+        """
         value = self._required(key)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self._wrong(key, "a number")
+        if finite and not math.isfinite(value):
+            raise self._wrong(key, "a finite number")
         return float(value)
 
-    def optional_number(self, key: str) -> float | None:
-        return None if self._data.get(key) is None else self.number(key)
+    def optional_number(self, key: str, *, finite: bool = True) -> float | None:
+        return None if self._data.get(key) is None else self.number(key, finite=finite)
 
     def integer(self, key: str) -> int:
         value = self._required(key)

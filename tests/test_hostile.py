@@ -8,15 +8,21 @@ grid checked only as it is played, and messages that blamed the wrong cause.
 
 from __future__ import annotations
 
+import io
+import json
 import shutil
 import sys
 import time
+import zipfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cartpole_q.config import ConfigError, load_config, shown_value
+from cartpole_q.errors import RunError
+from cartpole_q.store import sweepdir
 from tests.conftest import invoke, write_yaml
 from tests.test_cli import assert_refused
 
@@ -55,6 +61,143 @@ def _refused_quickly(*args: object, named: tuple[str, ...] = ()) -> str:
     assert_refused(result, *named)
     assert len(result.stderr) < 1500, f"a {len(result.stderr):,}-character message"
     return result.stderr
+
+
+# -- item 5: files whose reading recursed or allocated without bound ----------------------------
+
+
+def test_a_deeply_nested_summary_is_refused_by_every_reader(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    run = _copy(runs["one"], tmp_path)
+    (run / "summary.json").write_text("[" * 100_000 + "]" * 100_000)
+    named = ("summary.json: nests arrays and objects more than 64 levels deep",)
+    _refused_quickly("eval", run, "--episodes", 1, named=named)
+    _refused_quickly("plot", run, "--out", tmp_path / "p.png", named=named)
+    _refused_quickly("compare", run, runs["one"], named=named)
+    from cartpole_q import load_run
+
+    with pytest.raises(RunError, match="nests arrays and objects"):
+        load_run(run)
+    assert not (tmp_path / "p.png").exists()
+
+
+def _npy_header(shape: tuple[int, ...], descr: str = "<f8") -> bytes:
+    """An ``.npy`` header declaring ``shape``, without the data it promises."""
+    buffer = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        buffer, {"descr": descr, "fortran_order": False, "shape": shape}
+    )
+    return buffer.getvalue()
+
+
+HUGE = (1, 1, 2, 10, 2**40)
+"""the default grid's states with 2^40 actions: 160 TiB of float64 the header declares"""
+
+
+@pytest.mark.parametrize(("file", "descr"), [("q_table.npy", "<f8"), ("visits.npy", "<i8")])
+def test_an_array_header_declaring_a_huge_shape_is_refused_before_allocating(
+    runs: dict[str, Path], tmp_path: Path, file: str, descr: str
+) -> None:
+    run = _copy(runs["one"], tmp_path)
+    (run / file).write_bytes(_npy_header(HUGE, descr))
+    _refused_quickly("eval", run, "--episodes", 1, named=(file,))
+    _refused_quickly("plot", run, "--policy", named=(file,))
+
+
+def test_an_array_whose_shape_does_not_fit_its_config_is_refused_from_its_header(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    run = _copy(runs["one"], tmp_path)
+    (run / "q_table.npy").write_bytes(_npy_header((2**20, 2**20, 2)))
+    _refused_quickly("eval", run, named=("q_table.npy: has shape (1048576, 1048576, 2)",))
+
+
+def test_a_sweep_points_table_declaring_a_huge_shape_is_refused(tmp_path: Path) -> None:
+    sweep = write_yaml(tmp_path / "s.yaml", {"name": "s", "base": SMALL, "seeds": "0"})
+    out = tmp_path / "sweep"
+    assert invoke("sweep", sweep, "--out", out, "--workers", 1, "-q").exit_code == 0
+    tables = sweepdir.tables_path(out, "000")
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        archive.writestr("seed-000.npy", _npy_header(HUGE))
+    tables.write_bytes(buffer.getvalue())
+    _refused_quickly("eval", out / "points" / "000", named=("q_tables.npz: seed-000",))
+    _refused_quickly("plot", out / "points" / "000", "--policy", named=("q_tables.npz",))
+
+
+def test_a_compressed_member_claiming_more_than_it_can_expand_to_is_refused(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "a.npz"
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("x.npy", _npy_header((4,)) + bytes(32))
+    data = bytearray(buffer.getvalue())
+    # Lie in both directories: 2^40 bytes uncompressed.
+    for signature, offset in ((b"PK\x03\x04", 22), (b"PK\x01\x02", 24)):
+        at = data.find(signature)
+        data[at + offset : at + offset + 4] = (2**32 - 2).to_bytes(4, "little")
+    path.write_bytes(bytes(data))
+    from cartpole_q.store.reading import load_npz
+
+    with pytest.raises(RunError, match=r"a\.npz: x: declares 4,294,967,294 bytes"):
+        load_npz(path, str(path))
+    np.savez_compressed(path, x=np.arange(4.0))
+    assert load_npz(path, str(path))["x"].tolist() == [0.0, 1.0, 2.0, 3.0]
+
+
+def test_plot_policy_of_a_run_whose_config_is_another_worlds(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    run = _copy(runs["one"], tmp_path)
+    shutil.copy(runs["lake"] / "config.yaml", run / "config.yaml")
+    named = ("q_table.npy: has shape (1, 1, 2, 10, 2)", "expected (*bins, n_actions) = (16, 4)")
+    _refused_quickly("plot", run, "--policy", named=named)
+    _refused_quickly("eval", run, "--episodes", 1, named=named)
+    assert not (run / "policy_map.png").exists()
+
+
+def test_compare_refuses_a_summary_holding_nan(runs: dict[str, Path], tmp_path: Path) -> None:
+    run = _copy(runs["one"], tmp_path)
+    summary = json.loads((run / "summary.json").read_text())
+    summary["eval"]["mean"] = float("nan")
+    (run / "summary.json").write_text(json.dumps(summary))  # json writes NaN
+    _refused_quickly(
+        "compare", run, runs["one"], named=("summary.json: eval: mean: must be a finite number",)
+    )
+
+
+@pytest.mark.parametrize("cell", ["nan", "inf", "-Infinity"])
+def test_a_results_row_holding_nan_is_damaged(cell: str) -> None:
+    row = {
+        "point": "000", "seed": "0", "episodes": "10", "env_steps": "100",
+        "solved_episode": "", "env_steps_to_solve": "", "first_greedy_success_env_steps": "",
+        "eval_mean": cell, "success": "false", "train_seconds": "0.1",
+    }  # fmt: skip
+    with pytest.raises(RunError, match=r"results\.csv: has a damaged row"):
+        sweepdir.parse_row(row, [], Path("results.csv"))
+    with pytest.raises(RunError, match=r"results\.csv: has a damaged row"):
+        sweepdir.parse_row(
+            {**row, "eval_mean": "1.0", "solved_episode": cell}, [], Path("results.csv")
+        )
+
+
+def test_tune_refuses_a_storage_file_that_is_not_a_journal(in_tmp: Path) -> None:
+    pytest.importorskip("optuna")
+    spec = write_yaml(in_tmp / "t.yaml", {
+        "name": "t", "base": SMALL, "seeds": "0", "trials": 1,
+        "space": {"agent.alpha": {"low": 0.1, "high": 0.5}},
+    })  # fmt: skip
+    for junk in ("junk\n", '{"op_code": 99}\n', "precious, no newline"):
+        journal = in_tmp / "junk.journal"
+        journal.write_text(junk)
+        _refused_quickly(
+            "tune", spec, "--storage", journal, "--out", in_tmp / "study",
+            named=("--storage", "junk.journal: is not an Optuna journal file"),
+        )  # fmt: skip
+        assert journal.read_text() == junk, "nothing written to it, nothing cut from it"
+        assert not (in_tmp / "study").exists()
 
 
 # -- item 6: configs without bounds ---------------------------------------------------------------

@@ -26,7 +26,7 @@ from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, robustness_figure
 from cartpole_q.profiles import Physics, profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, check_output_file
-from cartpole_q.store.runsets import RunSet, load_run_set
+from cartpole_q.store.runsets import RunSet, check_tables, load_run_set
 
 PRESETS = {
     "rl-generalization": {"force_mag": (5.0, 15.0), "length": (0.25, 0.75), "masspole": (0.05, 0.5)},
@@ -114,7 +114,7 @@ def measure(
     runs = run_set.runs
     config = run_set.config
     spec = varied_physics(run_set, axes)
-    info = inspect_env(config)
+    info = check_tables(run_set)
     grid = list(itertools.product(*(axis.values for axis in axes)))
     shape = (len(runs), *(len(axis.values) for axis in axes))
     means = np.empty((len(runs), len(grid)))

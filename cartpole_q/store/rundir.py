@@ -24,7 +24,6 @@ import csv
 import dataclasses
 import functools
 import io
-import json
 import platform
 import time
 from dataclasses import dataclass
@@ -37,7 +36,7 @@ import numpy as np
 from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
-from cartpole_q.evaluation import check_q_table
+from cartpole_q.evaluation import check_q_table, check_q_table_shape
 from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
 from cartpole_q.store.atomic import (
     atomic_save_npy,
@@ -46,6 +45,7 @@ from cartpole_q.store.atomic import (
     write_json,
 )
 from cartpole_q.store.checkpoint import CHECKPOINT_FILE
+from cartpole_q.store.reading import ShapeCheck, load_npy, read_json
 from cartpole_q.training import TrainResult
 
 CONFIG_FILE = "config.yaml"
@@ -59,8 +59,6 @@ METRICS_HEADER = ("episode", "return", "length", "epsilon", "alpha")
 INFO_COLUMN_PREFIX = "info_"
 """``metrics.csv``'s last column with ``train.info_metric: KEY`` is ``info_KEY``"""
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
-NPY_MAGIC = b"\x93NUMPY"
-"""the first bytes of every ``.npy`` file"""
 
 
 # -- creating a run directory ---------------------------------------------------------
@@ -316,18 +314,15 @@ def load_run(path: str | Path) -> Run:
             else ""
         )
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
-    q_table = load_array(path / Q_TABLE_FILE, np.float64)
     grid = config.discretization
-    check_q_table(
-        q_table, None if grid is None else grid.table_shape, None, str(path / Q_TABLE_FILE)
-    )
+    states = None if grid is None else grid.table_shape
+    q_table = load_array(path / Q_TABLE_FILE, np.float64, table_check(states))
+    check_q_table(q_table, states, None, str(path / Q_TABLE_FILE))
     visits = None
     if (path / VISITS_FILE).is_file():
-        visits = load_array(path / VISITS_FILE, np.int64)
-        if visits.shape != q_table.shape:
-            raise RunError(
-                f"{path / VISITS_FILE}: has shape {visits.shape}, but the Q-table's is {q_table.shape}."
-            )
+        visits = load_array(
+            path / VISITS_FILE, np.int64, _same_shape(q_table.shape, "the Q-table's")
+        )
     metrics, info = read_metric_columns(path / METRICS_FILE, config.train.info_metric)
     return Run(
         path=path,
@@ -357,37 +352,33 @@ def config_threshold(config: Config) -> float | None:
     return inspect_env(config).reward_threshold
 
 
-def load_array(path: Path, dtype: type) -> np.ndarray:
-    """Load an ``.npy`` file without pickle and check its dtype.
+def load_array(path: Path, dtype: type, check: ShapeCheck | None = None) -> np.ndarray:
+    """Load an ``.npy`` file without pickle, checking its dtype (and shape) before allocating it.
 
     Raises:
-        RunError: the file is missing, truncated, an object array, or of another dtype.
+        RunError: the file is missing, truncated, an object array, of another dtype, or
+            refused by ``check`` (see :func:`~cartpole_q.store.reading.load_npy`).
     """
-    if not path.is_file():
-        raise RunError(f"{path}: is missing.")
-    try:
-        with open(path, "rb") as stream:
-            magic = stream.read(len(NPY_MAGIC))
-    except OSError as error:
-        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
-    if magic != NPY_MAGIC:
-        raise RunError(
-            f"{path}: is not a NumPy array file (.npy); it was not written by cartpole-q."
-        )
-    try:
-        array = np.load(path, allow_pickle=False)
-    except ValueError as error:
-        if "allow_pickle" in str(error):
-            raise RunError(
-                f"{path}: holds Python objects; only numeric arrays are accepted."
-            ) from None
-        raise RunError(f"{path}: is not a valid .npy array ({error}).") from None
-    except (OSError, EOFError) as error:
-        raise RunError(f"{path}: cannot be read as a .npy array ({error}).") from None
-    if not isinstance(array, np.ndarray) or array.dtype != np.dtype(dtype):
-        found = getattr(array, "dtype", type(array).__name__)
-        raise RunError(f"{path}: must hold {np.dtype(dtype).name} values, found {found}.")
-    return array
+    return load_npy(path, dtype, check)
+
+
+def table_check(states: tuple[int, ...] | None) -> ShapeCheck:
+    """The check of a Q-table's header: float64, ``(*states, n_actions)`` (any states when ``None``)."""
+
+    def check(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+        if dtype != np.float64:
+            raise RunError(f"{where}: must hold float64 values, found {dtype}.")
+        check_q_table_shape(shape, states, None, where)
+
+    return check
+
+
+def _same_shape(expected: tuple[int, ...], whose: str) -> ShapeCheck:
+    def check(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+        if tuple(shape) != tuple(expected):
+            raise RunError(f"{where}: has shape {tuple(shape)}, but {whose} is {tuple(expected)}.")
+
+    return check
 
 
 def read_metrics(path: Path) -> EpisodeMetrics:
@@ -453,7 +444,7 @@ def read_summary(run_dir: Path) -> RunSummary | None:
         RunError: the file exists but is not a run's summary (naming the file and key).
     """
     path = run_dir / SUMMARY_FILE
-    data = _read_json(path)
+    data = read_json(path)
     return None if data is None else RunSummary.from_json(data, str(path))
 
 
@@ -464,17 +455,8 @@ def read_multi_seed_summary(parent: Path) -> MultiSeedSummary | None:
         RunError: the file exists but is not a multi-seed summary.
     """
     path = parent / SUMMARY_FILE
-    data = _read_json(path)
+    data = read_json(path)
     return None if data is None else MultiSeedSummary.from_json(data, str(path))
-
-
-def _read_json(path: Path) -> object:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        return None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise RunError(f"{path}: is not valid JSON ({error}).") from None
 
 
 def _config_of(path: Path) -> Config:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -20,6 +21,9 @@ from cartpole_q.config import Config, Schedule
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.store import rundir, sweepdir
+
+if TYPE_CHECKING:
+    from cartpole_q.envs.gym import EnvInfo
 
 
 def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
@@ -106,6 +110,27 @@ def _multi_seed(parent: Path) -> RunSet:
     return RunSet(parent, "multi-seed run", runs, [note] if note else [], missing, unfinished)
 
 
+def check_tables(run_set: RunSet) -> EnvInfo:
+    """The environment's facts, once every seed's Q-table is checked to fit them.
+
+    A run's ``config.yaml`` replaced by another world's would otherwise have its table
+    drawn (or played) as that world's: its states and actions must be the environment's.
+
+    Raises:
+        ConfigError: the environment cannot be made.
+        RunError: a table's shape is not ``(*states, n_actions)`` of the environment.
+    """
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.evaluation import check_q_table_shape
+
+    info = inspect_env(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
+    for run in run_set.runs:
+        file = run.path / rundir.Q_TABLE_FILE  # a sweep point's seeds have none of their own
+        where = str(file) if file.is_file() else f"{run.path}: its Q-table"
+        check_q_table_shape(run.q_table.shape, info.state_shape, info.n_actions, where)
+    return info
+
+
 def _left_out(parent: Path, total: int, missing: list[str], unfinished: list[str]) -> str:
     """``PARENT: 2 of 3 seeds left out: seed-001 is missing; seed-002 has not finished (...)``."""
     if not missing and not unfinished:
@@ -131,7 +156,10 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
     """A sweep point's seeds as runs: rows, tables and (when kept) learning curves."""
     sweep = point_dir.parent.parent
     config = rundir.read_config_file(point_dir / rundir.CONFIG_FILE)
-    tables = sweepdir.read_tables(sweep, point_dir.name)
+    grid = config.discretization
+    tables = sweepdir.read_tables(
+        sweep, point_dir.name, rundir.table_check(None if grid is None else grid.table_shape)
+    )
     curves = sweepdir.read_curves(sweep, point_dir.name)
     info_key = config.train.info_metric
     infos = {} if info_key is None else sweepdir.read_info_curves(sweep, point_dir.name, info_key)
