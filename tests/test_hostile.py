@@ -263,6 +263,41 @@ def test_a_large_value_is_quoted_briefly(in_tmp: Path) -> None:
     assert len(shown("x" * 10**6)) <= 80 and len(shown_value({"k": ["x" * 10**6]})) <= 80
 
 
+# -- item 7: a multi-seed directory holding a seed of another world ---------------------------
+
+
+def test_a_seed_of_another_world_in_a_multi_seed_run_is_refused(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    parent = _copy(runs["seeds"], tmp_path)
+    shutil.rmtree(parent / "seed-001")
+    shutil.copytree(runs["lake"], parent / "seed-001")
+    named = (
+        "seed-001: is not a seed of the multi-seed run",
+        'env.id is "FrozenLake-v1" in seed-001 but "CartPole-v1" in',
+    )
+    _refused_quickly("eval", parent, "--episodes", 1, named=named)
+    _refused_quickly("compare", parent, runs["seeds"], named=named)
+    _refused_quickly("plot", parent, "--out", tmp_path / "p.png", named=named)
+
+
+def test_a_seed_directory_holding_another_seed_is_refused(
+    runs: dict[str, Path], tmp_path: Path
+) -> None:
+    parent = _copy(runs["seeds"], tmp_path)
+    shutil.rmtree(parent / "seed-001")
+    shutil.copytree(runs["seeds"] / "seed-000", parent / "seed-001")
+    _refused_quickly("eval", parent, "--episodes", 1, named=("seed-001", "seed is 0 in seed-001"))
+
+
+def test_a_seed_extended_on_its_own_still_belongs(runs: dict[str, Path], tmp_path: Path) -> None:
+    parent = _copy(runs["seeds"], tmp_path)
+    config = parent / "seed-001" / "config.yaml"
+    config.write_text(config.read_text().replace("episodes: 30", "episodes: 40", 1))
+    result = invoke("eval", parent, "--episodes", 1)
+    assert result.exit_code == 0, result.output
+
+
 # -- item 9: an env.id that imports modules ----------------------------------------------------------
 
 PROBE = "hostile_probe_29"

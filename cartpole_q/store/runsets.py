@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cartpole_q.config import Config, Schedule
+from cartpole_q.config import Config, Schedule, config_differences, shown_value
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.store import rundir, sweepdir
@@ -103,7 +103,9 @@ def _multi_seed(parent: Path) -> RunSet:
         elif summary.interrupted:
             unfinished.append(child.name)
         else:
-            runs.append(rundir.load_run(child))
+            run = rundir.load_run(child)
+            check_seed_config(parent, child, config.for_seed(seed), run.config)
+            runs.append(run)
     note = _left_out(parent, len(seeds), missing, unfinished)
     if not runs:
         raise RunError(f"{parent}: none of its seed runs has finished; {note}")
@@ -129,6 +131,45 @@ def check_tables(run_set: RunSet) -> EnvInfo:
         where = str(file) if file.is_file() else f"{run.path}: its Q-table"
         check_q_table_shape(run.q_table.shape, info.state_shape, info.n_actions, where)
     return info
+
+
+NEUTRAL_KEYS = frozenset(
+    {"name", "engine", "train.episodes", "train.checkpoint_every", "train.tensorboard"}
+)
+"""config keys in which a multi-seed run's seeds may differ: the run name, the engine
+(bit-identical results), how often checkpoints and TensorBoard files are written, and
+``train.episodes`` (one seed may be extended with ``train --resume seed-NNN --episodes N``)"""
+
+
+def check_seed_config(parent: Path, child: Path, expected: Config, found: Config) -> None:
+    """Refuse a seed directory whose run is not the multi-seed run's config with its seed.
+
+    A directory copied in from another run (another environment, algorithm, or seed)
+    would otherwise be averaged with the others as if it were one of them.
+
+    Raises:
+        RunError: naming the seed directory and each key that differs, with both values.
+    """
+    differences = [
+        (key, old, new)
+        for key, old, new in config_differences(expected, found)
+        if key not in NEUTRAL_KEYS
+    ]
+    if not differences:
+        return
+    differences.sort(key=lambda difference: difference[0] != "env.id")  # the telling one first
+    shown = "; ".join(
+        f"{key} is {shown_value(new)} in {child.name} but {shown_value(old)} in "
+        f"{parent / rundir.CONFIG_FILE}"
+        for key, old, new in differences[:3]
+    )
+    more = f" (and {len(differences) - 3} more keys)" if len(differences) > 3 else ""
+    raise RunError(
+        f"{child}: is not a seed of the multi-seed run {parent}: its config differs in what "
+        f"changes results: {shown}{more}. A multi-seed run's seeds share one config but "
+        f"their seed, so that their figures can be put together; move {child.name} out of "
+        f"{parent} (it is then named as missing), or use it as a run of its own."
+    )
 
 
 def _left_out(parent: Path, total: int, missing: list[str], unfinished: list[str]) -> str:
