@@ -16,6 +16,7 @@ import time
 import zipfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -349,6 +350,26 @@ def test_a_module_in_the_users_own_config_is_imported_by_design(in_tmp: Path, pr
         named=(f"importing '{PROBE}' registered no environment 'Foo-v0'",),
     )  # fmt: skip
     assert probe.exists()
+
+
+# -- item 10: a robustness grid is checked before it is played ----------------------------------
+
+
+def test_robustness_checks_every_value_before_playing_any(
+    runs: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from cartpole_q.experiments import robustness
+
+    def never(*args: Any, **kwargs: Any) -> None:
+        raise AssertionError("a grid point was played before the grid was checked")
+
+    monkeypatch.setattr(robustness, "make_engine", never)
+    out = tmp_path / "r.png"
+    _refused_quickly(
+        "robustness", runs["one"], "--vary", "length=1:0:5", "--out", out,
+        named=("--vary: env.physics.length: must be in (0, 100], got 0.0",),
+    )  # fmt: skip
+    assert not out.exists() and not out.with_suffix(".csv").exists()
 
 
 # -- item 11: messages that named the wrong cause ----------------------------------------------------
