@@ -149,22 +149,40 @@ def check_q_table(
     """
     if q_table.dtype != np.float64:
         raise RunError(f"{source}: must hold float64 values, found {q_table.dtype}.")
-    if bins is None:
-        if q_table.ndim < 2:
-            raise RunError(f"{source}: has shape {q_table.shape}; expected (*states, n_actions).")
-        bins = tuple(q_table.shape[:-1])
-    expected = f"(*bins, n_actions) = ({', '.join(map(str, bins))}, {n_actions or 'n_actions'})"
-    if q_table.ndim != len(bins) + 1 or tuple(q_table.shape[:-1]) != tuple(bins):
-        raise RunError(
-            f"{source}: has shape {q_table.shape}, which does not match its config: expected {expected}."
-        )
-    if n_actions is not None and q_table.shape[-1] != n_actions:
-        raise RunError(
-            f"{source}: has {q_table.shape[-1]} actions per state but the environment has "
-            f"{n_actions}: expected {expected}."
-        )
+    check_q_table_shape(q_table.shape, bins, n_actions, source)
     if not np.isfinite(q_table).all():
         raise RunError(f"{source}: holds NaN or infinite values.")
+
+
+def check_q_table_shape(
+    shape: tuple[int, ...], bins: tuple[int, ...] | None, n_actions: int | None, source: str
+) -> None:
+    """Check a Q-table's shape alone (as :func:`check_q_table` does), e.g. a file's header.
+
+    >>> check_q_table_shape((1, 1, 2, 10, 2), (1, 1, 2, 10), 2, "q.npy")
+    >>> check_q_table_shape((16, 4), (1, 1, 2, 10), None, "q.npy")
+    Traceback (most recent call last):
+    ...
+    cartpole_q.errors.RunError: q.npy: has shape (16, 4), which does not match its config: expected (*bins, n_actions) = (1, 1, 2, 10, n_actions).
+
+    Raises:
+        RunError: the shape is not ``(*bins, n_actions)``.
+    """
+    shape = tuple(shape)
+    if bins is None:
+        if len(shape) < 2:
+            raise RunError(f"{source}: has shape {shape}; expected (*states, n_actions).")
+        bins = shape[:-1]
+    expected = f"(*bins, n_actions) = ({', '.join(map(str, bins))}, {n_actions or 'n_actions'})"
+    if len(shape) != len(bins) + 1 or shape[:-1] != tuple(bins):
+        raise RunError(
+            f"{source}: has shape {shape}, which does not match its config: expected {expected}."
+        )
+    if n_actions is not None and shape[-1] != n_actions:
+        raise RunError(
+            f"{source}: has {shape[-1]} actions per state but the environment has "
+            f"{n_actions}: expected {expected}."
+        )
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ Strings live only in :mod:`cartpole_q.store`, where CSV is written and read; JSO
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from types import MappingProxyType
@@ -22,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from cartpole_q.config import shown
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
 from cartpole_q.statistics import PointStatistics, summarize_point
@@ -594,7 +596,11 @@ class MultiSeedSummary:
             if statistics is None
             else PointStatistics(
                 statistics.integer("seeds"),
-                *(statistics.optional_number(name) for name in PointStatistics.columns()[1:]),
+                # a statistic of no finished seed is NaN: written so, read back so
+                *(
+                    statistics.optional_number(name, finite=False)
+                    for name in PointStatistics.columns()[1:]
+                ),
             ),
             wall_seconds=reader.optional_number("wall_seconds") or 0.0,
             per_seed=MappingProxyType(
@@ -662,21 +668,28 @@ class _Reader:
         return {key: value for key, value in self._data.items() if key not in known}
 
     def _wrong(self, key: str, kind: str) -> RunError:
-        return RunError(f"{self._where}: {key}: must be {kind}, got {self._data.get(key)!r}.")
+        return RunError(f"{self._where}: {key}: must be {kind}, got {shown(self._data.get(key))}.")
 
     def _required(self, key: str) -> object:
         if key not in self._data:
             raise RunError(f"{self._where}: misses the key {key}.")
         return self._data[key]
 
-    def number(self, key: str) -> float:
+    def number(self, key: str, *, finite: bool = True) -> float:
+        """A number; NaN and infinities (JSON's ``NaN``, ``Infinity``) only when not ``finite``.
+
+        A run's figures are finite: a NaN would pass every comparison silently (and make
+        statistics fail far from the file that holds it).
+        """
         value = self._required(key)
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self._wrong(key, "a number")
+        if finite and not math.isfinite(value):
+            raise self._wrong(key, "a finite number")
         return float(value)
 
-    def optional_number(self, key: str) -> float | None:
-        return None if self._data.get(key) is None else self.number(key)
+    def optional_number(self, key: str, *, finite: bool = True) -> float | None:
+        return None if self._data.get(key) is None else self.number(key, finite=finite)
 
     def integer(self, key: str) -> int:
         value = self._required(key)

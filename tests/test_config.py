@@ -223,9 +223,15 @@ def test_missing_file_and_directory_are_config_errors(tmp_path: Path) -> None:
         load_config(binary)
 
 
-def test_override_errors_name_the_command_line() -> None:
-    with pytest.raises(ConfigError, match=r"^command line: train\.seeds"):
+def test_override_errors_name_the_overrides_argument() -> None:
+    # The Python API has no command line: its overrides are the `overrides` argument
+    # (issue 29); the command line names itself.
+    with pytest.raises(ConfigError, match=r"^overrides: train\.seeds"):
         load_config(overrides={"train.seeds": "x-y"})
+    with pytest.raises(ConfigError, match=r"^overrides: agent\.alpha: must be in"):
+        load_config("blog", {"agent.alpha": 2})
+    with pytest.raises(ConfigError, match=r"^command line: train\.seeds"):
+        load_config(overrides={"train.seeds": "x-y"}, override_source="command line")
 
 
 # -- overrides merge exactly as a file does (issue 8, bug 8) ---------------------------
@@ -275,7 +281,7 @@ def test_overrides_and_files_merge_the_same_way(tmp_path: Path) -> None:
     [
         (
             {"agent.alpah": 0.1},
-            "command line: unknown key 'agent.alpah'; did you mean 'agent.alpha'?",
+            "overrides: unknown key 'agent.alpah'; did you mean 'agent.alpha'?",
         ),
         ({"agent": {"alpah": 0.1}}, "unknown key 'agent.alpah'; did you mean 'agent.alpha'?"),
         ({"agnet.alpha": 0.1}, "unknown key 'agnet'; did you mean 'agent'?"),
@@ -283,11 +289,11 @@ def test_overrides_and_files_merge_the_same_way(tmp_path: Path) -> None:
             {"agent.epsilon.kk": 5},
             "unknown key 'agent.epsilon.kk'; did you mean 'agent.epsilon.k'?",
         ),
-        ({"agent.epsilon.k": 0}, "command line: agent.epsilon.k: must be in (0, inf)"),
-        ({"agent.alpha.k": 5}, "command line: agent.alpha: a schedule mapping needs 'type'"),
-        ({"agent.gamma.x": 1}, "command line: agent.gamma: must be a number"),
+        ({"agent.epsilon.k": 0}, "overrides: agent.epsilon.k: must be in (0, inf)"),
+        ({"agent.alpha.k": 5}, "overrides: agent.alpha: a schedule mapping needs 'type'"),
+        ({"agent.gamma.x": 1}, "overrides: agent.gamma: must be a number"),
         ({"agent..gamma": 1}, "'agent..gamma' is not a config key"),
-        ({"train": 5}, "command line: train: must be a mapping"),
+        ({"train": 5}, "overrides: train: must be a mapping"),
     ],
 )
 def test_bad_overrides_raise_config_error_naming_the_key(overrides: dict, named: str) -> None:
@@ -296,11 +302,11 @@ def test_bad_overrides_raise_config_error_naming_the_key(overrides: dict, named:
     assert named in str(caught.value)
 
 
-def test_errors_blame_the_file_or_the_command_line_for_each_key(tmp_path: Path) -> None:
+def test_errors_blame_the_file_or_the_overrides_for_each_key(tmp_path: Path) -> None:
     path = write_yaml(tmp_path / "c.yaml", {"agent": {"gamma": 2}})
     with pytest.raises(ConfigError, match=f"^{re.escape(str(path))}: agent.gamma"):
         load_config(path, {"agent.alpha": 0.5})
-    with pytest.raises(ConfigError, match=r"^command line: agent\.alpha"):
+    with pytest.raises(ConfigError, match=r"^overrides: agent\.alpha"):
         load_config(tmp_path / "c.yaml", {"agent": {"alpha": 2, "gamma": 0.5}})
 
 

@@ -113,6 +113,6 @@ def test_schedule_forms_cover_every_schedule_kind() -> None:
 
 
 def test_an_entry_of_an_overridden_list_blames_the_override() -> None:
-    where = Provenance("c.yaml", ("discretization.low",))
+    where = Provenance("c.yaml", ("discretization.low",), "command line")
     assert where.of("discretization.low[2]") == "command line"
     assert where.of("discretization.lower[2]") == "c.yaml"

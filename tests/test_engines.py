@@ -72,12 +72,14 @@ def test_twin_refuses_what_it_cannot_reproduce() -> None:
     assert "no compiled twin" in twin_settings("LunarLander-v3", {}, 1000)  # type: ignore[operator]
     assert "'render_mode'" in twin_settings("CartPole-v1", {"render_mode": "human"}, 500)  # type: ignore[operator]
     assert "positive integer" in twin_settings("CartPole-v1", {"max_episode_steps": 0}, 500)  # type: ignore[operator]
-    config = load_config(overrides={"engine": "numba", "env.kwargs": {"render_mode": "rgb_array"}})
+    unsupported = {"disable_env_checker": True}
+    config = load_config(overrides={"engine": "numba", "env.kwargs": unsupported})
     with pytest.raises(
-        ConfigError, match=r"engine: numba cannot run this config: env\.kwargs key 'render_mode'"
+        ConfigError,
+        match=r"engine: numba cannot run this config: env\.kwargs key 'disable_env_checker'",
     ):
         resolve_engine(config, inspect_env(config))
-    auto = load_config(overrides={"env.kwargs": {"render_mode": "rgb_array"}})
+    auto = load_config(overrides={"env.kwargs": unsupported})
     assert resolve_engine(auto, inspect_env(auto)) == "gymnasium"
     assert resolve_engine(load_config(), inspect_env(load_config())) == "numba"
 

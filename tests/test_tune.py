@@ -489,7 +489,7 @@ def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path:
 ENV_CHOICES = [
     pytest.param(
         {"env.id": {"choices": ["CartPole-v1", "CartPol-v1"]}},
-        "space.env.id (CartPol-v1): env.id: cannot make 'CartPol-v1'",
+        "space.env.id (CartPol-v1): env.id: 'CartPol-v1' is not a registered Gymnasium environment",
         id="env id typo",
     ),
     pytest.param(

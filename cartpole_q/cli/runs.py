@@ -78,10 +78,11 @@ def eval_command(
         from cartpole_q.cli.report import eval_line, eval_seeds_text
         from cartpole_q.config import parse_assignment
         from cartpole_q.experiments.evaluate_runs import evaluate_run, evaluate_seeds
-        from cartpole_q.store.runsets import load_run_set
+        from cartpole_q.store.runsets import check_tables, load_run_set
 
         changed = dict(parse_assignment(text, "--physics") for text in physics or [])
         run_set = load_run_set(run_dir)
+        check_tables(run_set)  # each table fits its world, the file named if not
         for text in run_set.notes:
             note(text)
         if run_set.kind != "run":

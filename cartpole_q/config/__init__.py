@@ -17,7 +17,9 @@ This package imports neither numba nor gymnasium, so that the command line start
 
 from cartpole_q.config.diff import NOT_SET, config_differences, mapping_differences, shown_value
 from cartpole_q.config.loading import load_config
+from cartpole_q.config.messages import QUOTE_LIMIT, shorten, shown
 from cartpole_q.config.overrides import (
+    COMMAND_LINE,
     OVERRIDE_SOURCE,
     Provenance,
     blame,
@@ -41,8 +43,10 @@ from cartpole_q.config.schema import (
 )
 from cartpole_q.config.validation import parse_seeds
 from cartpole_q.config.yaml_io import (
+    MAX_YAML_BYTES,
     default_raw,
     default_yaml_text,
+    load_yaml_text,
     read_yaml_mapping,
     resolve_config_path,
     shipped_configs,
@@ -51,12 +55,15 @@ from cartpole_q.errors import ConfigError
 from cartpole_q.rl.schedules import SCHEDULE_KINDS
 
 __all__ = [
+    "COMMAND_LINE",
     "ENGINES",
     "MAX_EPISODES",
     "MAX_SEED",
     "MAX_SEEDS",
+    "MAX_YAML_BYTES",
     "NOT_SET",
     "OVERRIDE_SOURCE",
+    "QUOTE_LIMIT",
     "SCHEDULE_KINDS",
     "AgentConfig",
     "Config",
@@ -75,11 +82,14 @@ __all__ = [
     "default_yaml_text",
     "format_seeds",
     "load_config",
+    "load_yaml_text",
     "mapping_differences",
     "parse_assignment",
     "parse_seeds",
     "read_yaml_mapping",
     "resolve_config_path",
     "shipped_configs",
+    "shorten",
+    "shown",
     "shown_value",
 ]

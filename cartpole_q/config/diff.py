@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from typing import Any
 
+from cartpole_q.config.messages import shorten
 from cartpole_q.config.schema import Config
 
 NOT_SET = "(not set)"
@@ -36,12 +38,33 @@ def mapping_differences(old: Any, new: Any) -> list[tuple[str, Any, Any]]:
 def shown_value(value: Any) -> str:
     """A config value as a message shows it: 0.995, [1, 1, 2, 10], "CartPole-v1", null.
 
+    As YAML and JSON write it, cut like every quoted value
+    (:func:`~cartpole_q.config.messages.shorten`), and as cheap for a huge value.
+
     >>> shown_value([1, 2]), shown_value("sarsa"), shown_value(None), shown_value(NOT_SET)
     ('[1, 2]', '"sarsa"', 'null', '(not set)')
+    >>> shown_value(list(range(10**6)))
+    '[0, 1, 2, 3, 4, 5, 6, 7, 8, ...]'
     """
     if value is NOT_SET:
         return str(value)
-    return json.dumps(value, default=str)
+    return shorten(json.dumps(_first_parts(value), default=str).replace('"..."', "..."))
+
+
+def _first_parts(value: Any, depth: int = 3, entries: int = 9) -> Any:
+    """``value`` with only the entries and levels a short quote can show (``"..."`` for the rest)."""
+    if isinstance(value, str):
+        return value[:80]
+    if not isinstance(value, list | tuple | dict):
+        return value
+    if depth == 0:
+        return "..."
+    if isinstance(value, dict):
+        items = list(itertools.islice(value.items(), entries))
+        shown = {str(key)[:80]: _first_parts(item, depth - 1) for key, item in items}
+        return shown if len(value) <= entries else {**shown, "...": "..."}
+    parts = [_first_parts(item, depth - 1) for item in value[:entries]]
+    return parts if len(value) <= entries else [*parts, "..."]
 
 
 def _differences(old: Any, new: Any, prefix: str) -> list[tuple[str, Any, Any]]:

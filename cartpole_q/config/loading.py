@@ -63,11 +63,12 @@ def load_config(
             :func:`shipped_configs`), or a mapping laid out like a config file; ``None``
             loads the embedded default alone.
         overrides: dotted keys (``"train.episodes"``, ``"env.kwargs.max_episode_steps"``)
-            or section names with mappings, and the values that replace the file's, as
-            given on the command line; applied in order.
+            or section names with mappings, and the values that replace the file's (as
+            ``--set`` gives them on the command line); applied in order.
         source: how errors name ``path`` (default: the file, or "config mapping").
-        override_source: how errors name the overrides (default: "command line"; a
-            sweep names its file and point).
+        override_source: how errors name the overrides (default: "overrides", this
+            argument; the command line passes "command line", a sweep names its file and
+            point).
 
     Returns:
         The validated, frozen config.

@@ -17,12 +17,15 @@ import yaml
 
 from cartpole_q.config.messages import shown, type_name, unknown_key
 from cartpole_q.config.schema import Config, key_of, sections
-from cartpole_q.config.yaml_io import UniqueKeyLoader
+from cartpole_q.config.yaml_io import YamlLimitError, load_yaml_text
 from cartpole_q.errors import ConfigError
 from cartpole_q.rl.algorithms import algorithms
 
-OVERRIDE_SOURCE = "command line"
-"""how errors name the source of an override (``--set``, ``--seed`` and the like)"""
+OVERRIDE_SOURCE = "overrides"
+"""how errors name overrides by default: the ``overrides`` argument of the Python API's
+:func:`~cartpole_q.config.load_config` (the command line passes :data:`COMMAND_LINE`)"""
+COMMAND_LINE = "command line"
+"""how errors name the command line's overrides (``--set``, ``--seed`` and the like)"""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,7 +35,7 @@ class Provenance:
     Checks made after loading (against the environment, say) name a field; the field's
     value came from the file, or from an override (``--set env.id=...``).
 
-    >>> where = Provenance("blog.yaml", ("env.id", "agent.alpha"))
+    >>> where = Provenance("blog.yaml", ("env.id", "agent.alpha"), COMMAND_LINE)
     >>> where.of("env.id"), where.of("discretization.bins"), where.of("agent"), str(where)
     ('command line', 'blog.yaml', 'command line', 'blog.yaml')
     """
@@ -64,7 +67,7 @@ def blame(source: str | Provenance, field: str) -> str:
     A plain label as it is; a :class:`Provenance`, the file or the overrides that gave it.
 
     >>> blame("a.yaml", "env.id"), blame(Provenance("a.yaml", ("env.id",)), "env.id")
-    ('a.yaml', 'command line')
+    ('a.yaml', 'overrides')
     """
     return source.of(field) if isinstance(source, Provenance) else str(source)
 
@@ -88,15 +91,17 @@ def parse_assignment(text: str, option: str = "--set") -> tuple[str, Any]:
     key = key.strip()
     if not equals or not key:
         raise ConfigError(
-            f"{option} {text!r}: expected KEY=VALUE, e.g. {_ASSIGNMENT_EXAMPLES.get(option, option)}."
+            f"{option} {shown(text)}: expected KEY=VALUE, e.g. {_ASSIGNMENT_EXAMPLES.get(option, option)}."
         )
     try:
-        parsed = yaml.load(value, Loader=UniqueKeyLoader) if value.strip() else None
+        parsed = load_yaml_text(value) if value.strip() else None
+    except YamlLimitError as error:
+        raise ConfigError(f"{option} {shown(text)}: the value {error}.") from None
     except yaml.YAMLError as error:
         problem = getattr(error, "problem", None) or "invalid syntax"
         raise ConfigError(
-            f"{option} {text!r}: the value is not plain YAML ({problem}); quote strings that "
-            "contain ':', '#', '[' or '{'."
+            f"{option} {shown(text)}: the value is not plain YAML ({problem}); quote strings "
+            "that contain ':', '#', '[' or '{'."
         ) from None
     return key, parsed
 

@@ -185,7 +185,11 @@ class EnvConfig:
             "str",
             "any Gymnasium environment with `Discrete` actions and a 1-D `Box` observation "
             "(binned), a `Discrete` or a `Tuple` of `Discrete` observations (the Q-table's "
-            "index)",
+            "index); a registered id with its version (`CartPole-v1`, not `CartPole`), checked "
+            "before anything is made. `package:Name-v0` (Gymnasium's syntax) imports `package`, "
+            "which registers `Name-v0`: importing runs that package's code, so it is done for "
+            "a config you give (`train`, `sweep`, `tune`), never for one read back from a run "
+            "or sweep directory (`eval`, `plot`, `compare`, `robustness` refuse it)",
         )
     )
     kwargs: Mapping[str, Any] = field(
@@ -193,7 +197,8 @@ class EnvConfig:
             "kwargs",
             "passed to `gymnasium.make`, e.g. `sutton_barto_reward: true`, "
             "`max_episode_steps: 200` (a positive whole number); whatever the environment "
-            "refuses is an error naming the key",
+            "refuses is an error naming the key. `render_mode` is refused: training never "
+            "renders (`eval --render`, `eval --video FILE.gif`, `train --watch N` draw)",
         )
     )
     physics: Mapping[str, float | str] = field(

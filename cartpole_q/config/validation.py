@@ -186,7 +186,7 @@ def _physics_mapping(
         raise reader.error(
             field,
             f"applies to environments with physics to set ({', '.join(with_physics)}), but "
-            f"env.id is {env_id!r}.",
+            f"env.id is {shown(env_id)}.",
         )
     keys = physics.keys if kind == "physics" else physics.randomizable
     for key in value:
@@ -348,19 +348,21 @@ class _Reader:
     def integer(
         self, field: str, value: Any, minimum: float | None, maximum: float | None = None
     ) -> int:
+        # Written as digits (10), as a float (10.0, 1e3) or as a string YAML left (5e3):
+        # the same integer, within the same range. No field's range reaches 2^53, so a
+        # float inside it is an integer exactly, and one outside it is refused the same
+        # way, however large, as the integer it would stand for.
+        highest = EXACT_INTEGER - 1 if maximum is None else min(int(maximum), EXACT_INTEGER - 1)
         number = _as_number(value)
         if number is None or not math.isfinite(number) or number != int(number):
             raise self.error(field, f"must be an integer, got {shown(value)}.")
-        if not isinstance(value, int) and abs(number) >= EXACT_INTEGER:
+        if minimum is not None and number < minimum:
+            raise self.error(field, f"must be at least {int(minimum)}, got {shown(value)}.")
+        if (value if isinstance(value, int) else number) > highest:
             raise self.error(
-                field, f"must be an integer written out in digits, got {shown(value)}."
+                field, f"must be an integer no larger than {highest}, got {shown(value)}."
             )
-        integer = int(value) if isinstance(value, int) else int(number)
-        if minimum is not None and integer < minimum:
-            raise self.error(field, f"must be at least {int(minimum)}, got {integer}.")
-        if maximum is not None and integer > maximum:
-            raise self.error(field, f"must be at most {int(maximum)}, got {integer}.")
-        return integer
+        return int(value) if isinstance(value, int) else int(number)
 
     def boolean(self, field: str, value: Any) -> bool:
         if not isinstance(value, bool):
@@ -468,6 +470,16 @@ class _Reader:
         if not isinstance(value, dict) or not all(isinstance(key, str) for key in value):
             raise self.error(
                 field, f"must be a mapping of argument names to values, got {shown(value)}."
+            )
+        if "render_mode" in value:
+            # Training never draws, and a window opened with no display fails only after
+            # the environment is made; the commands that draw set the mode themselves.
+            raise self.error(
+                f"{field}.render_mode",
+                "cannot be set in a config: training never renders, and cartpole-q sets the "
+                "render mode itself where it draws. Watch a policy with `cartpole-q eval RUN "
+                "--render` (needs a display), record it with `cartpole-q eval RUN --video "
+                "FILE.gif`, or use `train --watch N` or `--video-every N` while training.",
             )
         steps = value.get("max_episode_steps")
         if "max_episode_steps" in value and (

@@ -1,7 +1,14 @@
-"""Reading YAML safely: unique keys, plain values only, and the configs the package ships.
+"""Reading YAML safely: unique keys, plain values only, bounded, and the configs the package ships.
 
 Nothing here constructs Python objects from YAML tags: a tag other than YAML's plain ones
 is an error, and so is a key given twice (YAML would keep the last silently).
+
+Every YAML text is bounded before it is used: a file larger than :data:`MAX_YAML_BYTES` is
+not read, and a document is refused when it holds more than :data:`MAX_YAML_VALUES` values
+once its aliases (``*name``) are expanded, nests deeper than :data:`MAX_YAML_DEPTH`, or
+refers to itself. Aliases stay usable (a sweep file may repeat a schedule with ``*name``);
+a few hundred bytes of nested aliases ("a billion laughs") may not become millions of
+values that every later step (merging, validation, an error message) would walk.
 """
 
 from __future__ import annotations
@@ -16,15 +23,102 @@ from typing import Any
 
 import yaml
 
-from cartpole_q.config.messages import type_name
+from cartpole_q.config.messages import shown, type_name
 from cartpole_q.errors import ConfigError
 
 # libyaml's parser when PyYAML has it (ten times faster), the same safe constructors.
 _SafeLoader: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
+MAX_YAML_BYTES = 256 * 1024
+"""the largest config, sweep or tune file read (the shipped ones are under 4 KiB)"""
+MAX_YAML_VALUES = 100_000
+"""the most values (scalars, lists and mappings) a YAML document may hold, aliases expanded"""
+MAX_YAML_DEPTH = 64
+"""the deepest a YAML document may nest lists and mappings (a config nests four levels)"""
+
+
+class YamlLimitError(yaml.YAMLError):
+    """A YAML document beyond the bounds above; its message says which one."""
+
 
 class UniqueKeyLoader(_SafeLoader):  # type: ignore[misc]
-    """A safe loader that refuses duplicate mapping keys instead of keeping the last."""
+    """A safe loader that refuses duplicate mapping keys, and documents beyond the bounds.
+
+    The bounds are checked on the composed node graph, before any value is constructed:
+    PyYAML shares an anchored node between its aliases, so counting each node once per
+    path that reaches it (memoised per node) measures the expansion without making it.
+    """
+
+    def get_single_data(self) -> Any:
+        """The document's value, once its node graph is known to be within the bounds."""
+        node = self.get_single_node()
+        if node is None:
+            return None
+        check_yaml_bounds(node)
+        return self.construct_document(node)
+
+
+def check_yaml_bounds(root: yaml.Node) -> None:
+    """Refuse a node graph that expands beyond :data:`MAX_YAML_VALUES` or nests too deep.
+
+    Iterative, so that the check itself cannot run out of stack on what it refuses.
+
+    Raises:
+        YamlLimitError: too many values once aliases are expanded, too deep, or an alias
+            inside the value it names (a document that contains itself).
+    """
+    expanded: dict[int, int] = {}  # id(node) -> values in its expansion, once finished
+    open_nodes: set[int] = set()  # the nodes whose expansion is in progress: the path
+    stack: list[tuple[yaml.Node, int, bool]] = [(root, 1, False)]
+    while stack:
+        node, depth, finished = stack.pop()
+        children = _children(node)
+        if finished:
+            open_nodes.discard(id(node))
+            total = 1 + sum(expanded[id(child)] for child in children)
+            if total > MAX_YAML_VALUES:
+                raise YamlLimitError(
+                    f"holds more than {MAX_YAML_VALUES:,} values once its aliases (*name) are "
+                    f"expanded{_yaml_mark(node.start_mark)}; write the values out, or use fewer "
+                    "nested aliases"
+                    if len(expanded) < MAX_YAML_VALUES
+                    else f"holds more than {MAX_YAML_VALUES:,} values; a config needs far fewer"
+                )
+            expanded[id(node)] = total
+            continue
+        if id(node) in expanded:
+            continue
+        if id(node) in open_nodes:
+            raise YamlLimitError(
+                f"has an alias inside the value it names{_yaml_mark(node.start_mark)}, so the "
+                "value would contain itself"
+            )
+        if depth > MAX_YAML_DEPTH:
+            raise YamlLimitError(
+                f"nests lists and mappings more than {MAX_YAML_DEPTH} levels "
+                f"deep{_yaml_mark(node.start_mark)}"
+            )
+        open_nodes.add(id(node))
+        stack.append((node, depth, True))
+        stack.extend((child, depth + 1, False) for child in children)
+
+
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    if isinstance(node, yaml.MappingNode):
+        return [part for pair in node.value for part in pair]
+    return []
+
+
+def load_yaml_text(text: str) -> Any:
+    """Parse YAML text with the safe, bounded loader (the one parser of every YAML input).
+
+    Raises:
+        yaml.YAMLError: not YAML, a tag that would construct an object, a duplicate key,
+            or beyond the bounds (:class:`YamlLimitError`).
+    """
+    return yaml.load(text, Loader=UniqueKeyLoader)
 
 
 def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode) -> dict[Any, Any]:
@@ -37,7 +131,7 @@ def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode) -
             )
         if key in seen:
             raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {key!r}", key_node.start_mark
+                None, None, f"duplicate key {shown(key)}", key_node.start_mark
             )
         seen.add(key)
     return loader.construct_mapping(node)
@@ -55,11 +149,21 @@ def read_yaml_mapping(path: Path, what: str = "config file") -> dict[str, Any]:
     kind of file in messages ("config file", "sweep file", "tune file").
 
     Raises:
-        ConfigError: the file is missing, unreadable, not YAML, not a mapping, or uses a
-            tag that would construct a Python object.
+        ConfigError: the file is missing, unreadable, larger than :data:`MAX_YAML_BYTES`,
+            not YAML, not a mapping, beyond the bounds on values and nesting, or uses a tag
+            that would construct a Python object.
     """
     try:
-        text = path.read_text(encoding="utf-8")
+        with path.open("rb") as stream:
+            # At most one byte more than the limit: a huge file (or an endless one, such
+            # as a device) is refused without reading it whole.
+            content = stream.read(MAX_YAML_BYTES + 1)
+        if len(content) > MAX_YAML_BYTES:
+            raise ConfigError(
+                f"{path}: is larger than {MAX_YAML_BYTES // 1024} KiB, the most a {what} may "
+                "be (the shipped ones are a few KiB); is this the file you meant?"
+            )
+        text = content.decode("utf-8")
     except FileNotFoundError:
         if what != "config file":
             raise ConfigError(f"{path}: {what} not found.") from None
@@ -75,7 +179,9 @@ def read_yaml_mapping(path: Path, what: str = "config file") -> dict[str, Any]:
     except OSError as error:
         raise ConfigError(f"{path}: cannot be read ({error.strerror}).") from None
     try:
-        data = yaml.load(text, Loader=UniqueKeyLoader)
+        data = load_yaml_text(text)
+    except YamlLimitError as error:
+        raise ConfigError(f"{path}: {error}.") from None
     except yaml.constructor.ConstructorError as error:
         where = _yaml_mark(error.problem_mark)
         if error.problem and "could not determine a constructor" in error.problem:
@@ -161,6 +267,6 @@ def default_raw() -> dict[str, Any]:
 @functools.cache
 def _parsed_default() -> dict[str, Any]:
     # Parsed once per process: a sweep or a multi-seed run loads many configs.
-    data = yaml.load(default_yaml_text(), Loader=UniqueKeyLoader)
+    data = load_yaml_text(default_yaml_text())
     assert isinstance(data, dict)  # the packaged file is ours; tests check it loads
     return data

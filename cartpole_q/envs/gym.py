@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame
+from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame, shorten, shown
 from cartpole_q.errors import RunError
 from cartpole_q.profiles import profile_for
 
@@ -65,6 +65,7 @@ def make_env(
     """
     import gymnasium
 
+    check_env_id(env.id, source)
     kwargs = dict(env.kwargs)
     if render_mode is not None:
         kwargs["render_mode"] = render_mode
@@ -83,17 +84,126 @@ def make_env(
     except gymnasium.error.DependencyNotInstalled as error:
         raise ConfigError(
             f"{blame(source, 'env.id')}: env.id: {env.id!r} needs a package that is not "
-            f"installed ({error})."
+            f"installed ({shorten(str(error), 200)})."
         ) from None
     except gymnasium.error.Error as error:
+        imported, name = env_module(env.id), env.id.rpartition(":")[2]
+        detail = shorten(str(error), 200)
+        if imported is not None and name not in gymnasium.registry:
+            detail = f"importing {imported!r} registered no environment {name!r}"
         raise ConfigError(
-            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: {error}"
+            f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: {detail.rstrip('.')}."
         ) from None
     except Exception as error:  # whatever the environment raises for arguments it refuses
         raise kwargs_error(env, error, source) from None
     if env.physics:
         set_physics(made, env.physics)
     return made
+
+
+def check_env_id(env_id: str, source: str | Provenance = "config") -> None:
+    """Refuse an ``env.id`` Gymnasium cannot make, before anything it names is imported.
+
+    A plain id must be registered (an id without its version is refused with the
+    version to give: Gymnasium would pick its latest silently, and the run would not say
+    which). ``module:Name-vN`` is Gymnasium's way to make an environment another package
+    registers: making it imports ``module``, which runs that module's code, by design, as
+    ``python -m module`` would; so the module is checked to exist first (without running
+    it), and a config read back from a run or sweep directory may not name one
+    (:func:`check_recorded_env_id`).
+
+    >>> check_env_id("CartPole-v1")
+    >>> check_env_id("CartPole")
+    Traceback (most recent call last):
+    ...
+    cartpole_q.errors.ConfigError: config: env.id: 'CartPole' gives no version; write 'CartPole-v1' (the latest version Gymnasium has), so that the run records which environment it trained on.
+
+    Raises:
+        ConfigError: naming ``env.id``: a malformed id, an unknown one (with the closest
+            registered id), an id without its version, or a module that does not exist.
+    """
+    import difflib
+    import importlib.util
+
+    from gymnasium import error as gym_error
+    from gymnasium.envs.registration import (
+        find_highest_version,
+        get_env_id,
+        parse_env_id,
+        registry,
+    )
+
+    where = f"{blame(source, 'env.id')}: env.id: {shown(env_id)}"
+    module, colon, name = env_id.partition(":")
+    if not colon:
+        module, name = "", env_id
+    if ":" in name or (colon and not module):
+        raise ConfigError(
+            f"{where} is not an environment id such as 'CartPole-v1' or 'module:Name-v0'."
+        )
+    try:
+        namespace, base, version = parse_env_id(name)
+    except gym_error.Error:
+        raise ConfigError(
+            f"{where} is not an environment id such as 'CartPole-v1' ([namespace/]name-vN)."
+        ) from None
+    if module:
+        parts = module.split(".")
+        if not all(part.isidentifier() for part in parts):
+            raise ConfigError(f"{where}: {shown(module)} before ':' is not a module name.")
+        if module not in sys.modules and importlib.util.find_spec(parts[0]) is None:
+            raise ConfigError(
+                f"{where}: the module {shown(parts[0])} cannot be imported (no module of that "
+                "name is installed); install it, or check the part of env.id before ':'."
+            )
+        return  # the module registers it when gymnasium.make imports it
+    if name in registry:
+        return
+    latest = find_highest_version(namespace, base) if version is None else None
+    if latest is not None:
+        versioned = get_env_id(namespace, base, latest)
+        raise ConfigError(
+            f"{where} gives no version; write {versioned!r} (the latest version Gymnasium "
+            "has), so that the run records which environment it trained on."
+        )
+    close = difflib.get_close_matches(name, list(registry), n=1, cutoff=0.6)
+    hint = f"; did you mean {close[0]!r}?" if close else "."
+    raise ConfigError(
+        f"{where} is not a registered Gymnasium environment{hint} An environment another "
+        "package registers is made as 'package:Name-v0' (which imports that package)."
+    )
+
+
+def env_module(env_id: str) -> str | None:
+    """The module ``env.id`` asks Gymnasium to import (``module:Name-v0``), if any.
+
+    >>> env_module("mygame.envs:Maze-v0"), env_module("CartPole-v1")
+    ('mygame.envs', None)
+    """
+    module, colon, _ = env_id.partition(":")
+    return module if colon and module else None
+
+
+def check_recorded_env_id(env_id: str, where: str) -> None:
+    """Refuse a config read back from a directory whose ``env.id`` would import a module.
+
+    Importing runs the module's code. cartpole-q imports what ``env.id`` names only
+    from a config the user gives (``train``, ``sweep``, ``tune``, ``load_config``), never
+    from one it reads back to evaluate, plot or compare (a run directory may come from
+    anyone), unless that module is imported already: from Python, import it first.
+
+    Raises:
+        RunError: naming ``where`` (the config file) and the module.
+    """
+    module = env_module(env_id)
+    if module is None or module in sys.modules:
+        return
+    raise RunError(
+        f"{where}: env.id: {shown(env_id)} would import the module {shown(module)}, which "
+        "runs its code; cartpole-q imports a module named by env.id only from a config you "
+        "give it (train, sweep, tune), never from a run or sweep directory it reads. To use "
+        f"this run, import {module} yourself and call the Python API (cartpole_q.load_run)."
+    )
 
 
 def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> ConfigError:
@@ -114,15 +224,16 @@ def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> 
         named = [key for key, value in kwargs.items() if value == error.args[0]]
     if not named and len(kwargs) == 1:
         named = list(kwargs)
-    field = f"env.kwargs.{named[0]}" if len(named) == 1 else "env.kwargs"
-    shown = (
-        f"{named[0]}={kwargs[named[0]]!r}"
+    field = f"env.kwargs.{shorten(named[0])}" if len(named) == 1 else "env.kwargs"
+    given = (
+        f"{shorten(named[0])}={shown(kwargs[named[0]])}"
         if len(named) == 1
-        else ", ".join(f"{key}={value!r}" for key, value in kwargs.items())
+        else shorten(", ".join(f"{key}={shown(value)}" for key, value in kwargs.items()))
     )
-    detail = f"{type(error).__name__}: {text}" if text else type(error).__name__
+    # The environment's message may quote the whole value it refused: cut it too.
+    detail = shorten(f"{type(error).__name__}: {text}" if text else type(error).__name__, 200)
     return ConfigError(
-        f"{blame(source, field)}: {field}: {env.id!r} cannot be made with {shown or 'no arguments'} "
+        f"{blame(source, field)}: {field}: {shown(env.id)} cannot be made with {given or 'no arguments'} "
         f"({detail}); check the value against the environment's documentation."
     )
 
@@ -162,7 +273,7 @@ def info_value(info: Mapping[str, Any], key: str, env_id: str) -> float:
         return float(value)
     raise RunError(
         f"train.info_metric: {key}: {env_id} reports a {type(value).__name__} there "
-        f"({value!r}); only a bool or a number can be summed per episode."
+        f"({shown(value)}); only a bool or a number can be summed per episode."
     )
 
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import load_config
+from cartpole_q.config import COMMAND_LINE, load_config
 from cartpole_q.envs.models import GridLayout, grid_layout
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import EvalReport, ExactReport, evaluate, exact_report, under_conditions
@@ -275,7 +275,7 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
         if key != "env" and not key.startswith("env."):
             raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
         overrides[key] = value
-    config = load_config(overrides=overrides)
+    config = load_config(overrides=overrides, override_source=COMMAND_LINE)
     inspect_env(config)  # an unknown id or argument: a config error naming it
     exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
     if isinstance(exact, str):

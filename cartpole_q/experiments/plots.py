@@ -45,7 +45,7 @@ from cartpole_q.profiles import profile_for
 from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
 from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
-from cartpole_q.store.runsets import load_run_set
+from cartpole_q.store.runsets import check_tables, load_run_set
 
 
 def plot_rewards(
@@ -290,6 +290,7 @@ def plot_policy(
         WriteError: ``out`` cannot be written (checked before the figure is drawn).
     """
     run_set = load_run_set(run_dir)
+    check_tables(run_set)  # a table drawn as another world's would be a wrong picture
     for note in run_set.notes:
         if on_note is not None:
             on_note(note)

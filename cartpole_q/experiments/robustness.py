@@ -26,7 +26,7 @@ from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, robustness_figure
 from cartpole_q.profiles import Physics, profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, check_output_file
-from cartpole_q.store.runsets import RunSet, load_run_set
+from cartpole_q.store.runsets import RunSet, check_tables, load_run_set
 
 PRESETS = {
     "rl-generalization": {"force_mag": (5.0, 15.0), "length": (0.25, 0.75), "masspole": (0.05, 0.5)},
@@ -104,7 +104,7 @@ def measure(
     max_steps: int | None = None,
     progress: SweepProgress | None = None,
 ) -> tuple[np.ndarray, list[float], float | None]:
-    """Each seed's greedy mean return at each grid point.
+    """Each seed's greedy mean return at each grid point (its values checked: :func:`check_values`).
 
     Returns:
         ``(means, trained, threshold)``: means of shape ``(seeds, *grid)``; each key's
@@ -114,7 +114,7 @@ def measure(
     runs = run_set.runs
     config = run_set.config
     spec = varied_physics(run_set, axes)
-    info = inspect_env(config)
+    info = check_tables(run_set)
     grid = list(itertools.product(*(axis.values for axis in axes)))
     shape = (len(runs), *(len(axis.values) for axis in axes))
     means = np.empty((len(runs), len(grid)))
@@ -133,6 +133,21 @@ def measure(
     trained = [float(config.env.physics.get(axis.key, spec.defaults[axis.key])) for axis in axes]
     threshold = inspect_env(under_conditions(config, None, max_steps)).reward_threshold
     return means.reshape(shape), trained, threshold
+
+
+def check_values(run_set: RunSet, axes: list[Axis], max_steps: int | None) -> None:
+    """Check every value of every axis before any point is played.
+
+    A value out of range at the end of the grid is refused at once, not after the points
+    before it have been played. Each physics key's range is its own (no key's bounds
+    depend on another's), so checking each axis's values alone checks every point.
+
+    Raises:
+        ConfigError: a value is not one the physics key accepts (naming ``--vary``).
+    """
+    for axis in axes:
+        for value in dict.fromkeys(axis.values.tolist()):
+            under_conditions(run_set.config, {axis.key: value}, max_steps, source="--vary")
 
 
 def varied_physics(run_set: RunSet, axes: list[Axis]) -> Physics:
@@ -193,6 +208,7 @@ def robustness(
         raise UserError("--vary: give one key (a curve) or two different keys (a heatmap).")
     run_set = load_run_set(run_dir)
     varied_physics(run_set, axes)
+    check_values(run_set, axes, max_steps)  # every value, before any file or episode
     check_size(run_set, axes, episodes, yes)
     suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
     table_path = out.with_suffix(".csv")

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import (
+    COMMAND_LINE,
     Config,
     ConfigError,
     Provenance,
@@ -155,9 +156,9 @@ def prepare_new(
         overrides["train.episodes"] = episodes
     if engine is not None:
         overrides["engine"] = engine
-    loaded = load_config(config_file, overrides)
+    loaded = load_config(config_file, overrides, override_source=COMMAND_LINE)
     file = str(resolve_config_path(config_file)) if config_file else "default config"
-    return prepare(loaded, Provenance(file, tuple(overrides)))
+    return prepare(loaded, Provenance(file, tuple(overrides), COMMAND_LINE))
 
 
 @contextlib.contextmanager
@@ -299,7 +300,7 @@ def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
     if not config_path.is_file():
         raise RunError(f"{run_dir}: is not a run directory (it has no {rundir.CONFIG_FILE}).")
     overrides = None if episodes is None else {"train.episodes": episodes}
-    config = load_config(config_path, overrides)
+    config = load_config(config_path, overrides, override_source=COMMAND_LINE)
     multi_seed = config.train.seeds is not None
     if multi_seed and episodes is not None:
         raise RunError(

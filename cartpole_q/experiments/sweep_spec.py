@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import difflib
 import itertools
-import json
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -26,6 +25,8 @@ from cartpole_q.config import (
     load_config,
     parse_seeds,
     read_yaml_mapping,
+    shown,
+    shown_value,
 )
 from cartpole_q.store import sweepdir
 from cartpole_q.store.sweepdir import axis_cell
@@ -184,7 +185,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     if not isinstance(curves, bool):
         raise ConfigError(
             f"{where}: curves: must be true (keep every run's learning curve) or false, got "
-            f"{json.dumps(curves, default=str)}."
+            f"{shown_value(curves)}."
         )
     try:
         seeds = parse_seeds(raw.get("seeds", base.seed))
@@ -219,7 +220,7 @@ def _check_against(key: str, axes: Mapping[str, list[Any]], where: str) -> None:
     """``figure.against`` names an axis of numbers."""
     if key not in axes:
         raise ConfigError(
-            f"{where}: figure.against: {key!r} is not an axis of this sweep "
+            f"{where}: figure.against: {shown(key)} is not an axis of this sweep "
             f"({', '.join(axes) or 'it has none'})."
         )
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axes[key]):
@@ -239,7 +240,7 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
         if point.config.train.info_metric != key:
             recorded = point.config.train.info_metric
             raise ConfigError(
-                f"{where}: figure.metric: info:{key} draws each episode's sum of info[{key!r}], "
+                f"{where}: figure.metric: info:{key} draws each episode's sum of info[{shown(key)}], "
                 f"but point {point.index} sets train.info_metric: {recorded or 'null'}; put "
                 f"train: {{info_metric: {key}}} in the base."
             )
@@ -254,7 +255,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     if not isinstance(raw, Mapping):
         raise ConfigError(
             f"{where}: figure: must be a mapping such as {{metric: length, x: episode}}, got "
-            f"{json.dumps(raw, default=str)}."
+            f"{shown_value(raw)}."
         )
     check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
     if not curves:
@@ -271,12 +272,11 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     metric = values["metric"]
     problem = check_metric(metric) if isinstance(metric, str) else "not a string"
     if problem is not None:
-        shown = json.dumps(metric, default=str)
-        raise ConfigError(f"{where}: figure.metric: {shown} is {problem}.")
+        raise ConfigError(f"{where}: figure.metric: {shown_value(metric)} is {problem}.")
     for key, allowed in choices.items():
         if key in values and values[key] not in allowed:
             raise ConfigError(
-                f"{where}: figure.{key}: {json.dumps(values[key], default=str)} is not one of "
+                f"{where}: figure.{key}: {shown_value(values[key])} is not one of "
                 f"{', '.join(allowed)}."
             )
     kinds: dict[str, tuple[type, ...]] = {
@@ -290,7 +290,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         wrong_bool = isinstance(value, bool) and bool not in kind
         if value is not None and (not isinstance(value, kind) or wrong_bool):
             raise ConfigError(
-                f"{where}: figure.{key}: {json.dumps(value, default=str)} is not a "
+                f"{where}: figure.{key}: {shown_value(value)} is not a "
                 f"{' or '.join(k.__name__ for k in kind)}."
             )
     if values.get("smooth", 1) < 1:
@@ -298,7 +298,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     file = values.get("file", "figure.png")
     if "/" in file or Path(file).suffix.lower() not in (".png", ".svg", ".pdf"):
         raise ConfigError(
-            f"{where}: figure.file: {file!r} must be a file name in the sweep directory "
+            f"{where}: figure.file: {shown(file)} must be a file name in the sweep directory "
             "ending in .png, .svg or .pdf."
         )
     if values.get("first") is not None and values["first"] < 1:
@@ -326,7 +326,7 @@ def check_top_keys(raw: Mapping[str, Any], valid: tuple[str, ...], where: str) -
             hint = (
                 f"; did you mean {close[0]!r}?" if close else f"; valid keys: {', '.join(valid)}."
             )
-            raise ConfigError(f"{where}: unknown key {key!r}{hint}")
+            raise ConfigError(f"{where}: unknown key {shown(key)}{hint}")
 
 
 def checked_name(raw: Mapping[str, Any], default: str, where: str) -> str:
@@ -339,7 +339,7 @@ def checked_name(raw: Mapping[str, Any], default: str, where: str) -> str:
     if not isinstance(name, str) or not _NAME.fullmatch(name):
         raise ConfigError(
             f"{where}: name: must be letters, digits, '-' or '_' (it names the directory), "
-            f"got {json.dumps(name, default=str)}."
+            f"got {shown_value(name)}."
         )
     return name
 
@@ -388,7 +388,7 @@ def load_base(base: Any, where: str, base_dir: Path) -> Config:
     else:
         raise ConfigError(
             f"{where}: base: must be a config file (relative to the sweep file), the name of "
-            f"a shipped config, or a mapping of config keys; got {json.dumps(base, default=str)}."
+            f"a shipped config, or a mapping of config keys; got {shown_value(base)}."
         )
     # The sweep's own seeds say which seeds every point runs.
     return config.for_seed(config.seed)
@@ -406,7 +406,7 @@ def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
     checked: dict[str, list[Any]] = {}
     for key, values in axes.items():
         if not isinstance(key, str) or not key:
-            raise ConfigError(f"{where}: {section}: {key!r} is not a dotted config key.")
+            raise ConfigError(f"{where}: {section}: {shown(key)} is not a dotted config key.")
         if key in FORBIDDEN_AXES or key.startswith("train.seeds."):
             raise ConfigError(
                 f"{where}: {section}.{key}: cannot be an axis; the sweep's `seeds` say which "
@@ -415,7 +415,7 @@ def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
         if not isinstance(values, list):
             raise ConfigError(
                 f"{where}: {section}.{key}: must be a list of the values to try, got "
-                f"{json.dumps(values, default=str)}."
+                f"{shown_value(values)}."
             )
         if not values:
             raise ConfigError(

@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import io
+import json
 import math
 import os
 import socket
@@ -31,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, mapping_differences, shown_value
+from cartpole_q.config import ConfigError, mapping_differences, shorten, shown_value
 from cartpole_q.errors import RunError, WriteError
 from cartpole_q.experiments.sweep import (
     MAX_RUNS_PER_TASK,
@@ -99,12 +100,71 @@ def storage_for(directory: Path, url: str | None) -> Any:
 
         path = directory / tunedir.JOURNAL_FILE if url is None else Path(url)
         with storage_errors(path):
+            check_journal(path, given=url is not None)  # before anything is cut or added
             repair_journal(path)
-            return JournalStorage(JournalFileBackend(str(path)))
+            try:
+                return JournalStorage(JournalFileBackend(str(path)))
+            except (ValueError, KeyError, TypeError, AssertionError) as error:
+                # records of the right form that Optuna cannot replay
+                reason = shorten(
+                    f"Optuna cannot replay its records: {type(error).__name__}: {error}"
+                )
+                raise _not_a_journal(path, url is not None, reason) from None
     try:
         return optuna.storages.get_storage(url)
     except Exception as error:  # Optuna raises many kinds for a bad URL
         raise ConfigError(f"--storage {url}: cannot open this Optuna storage ({error}).") from None
+
+
+MAX_JOURNAL_RECORD = 16 * 2**20
+"""the longest journal line read as a record"""
+JOURNAL_RECORD_START = b'{"op_code":'
+"""how every record Optuna writes to a journal begins (``json.dumps`` with ``op_code`` first)"""
+
+
+def check_journal(path: Path, *, given: bool) -> None:
+    """Refuse a file that is not an Optuna journal before anything reads, cuts or appends to it.
+
+    Every line of a journal is one JSON object with an ``op_code``; only the last may be
+    cut short (a kill mid-write, which :func:`repair_journal` then removes). Optuna skips a
+    last line it cannot read and would append its records after it, turning a file that
+    was never a journal into one no reader accepts; and cutting a "half-written record"
+    from a file that is not a journal would destroy its end.
+
+    Args:
+        path: the journal file (it may not exist yet).
+        given: it is ``--storage`` (a refusal names the option), not the tune directory's.
+
+    Raises:
+        ConfigError: ``--storage`` names a file that is not a journal.
+        RunError: a tune directory's own journal is damaged.
+    """
+    if not path.is_file():
+        return  # a new journal: Optuna creates it
+    with path.open("rb") as journal:
+        # A record is a few kilobytes; a "line" of many megabytes is no record (and is not
+        # read whole).
+        lines = iter(lambda: journal.readline(MAX_JOURNAL_RECORD), b"")
+        for number, line in enumerate(lines, start=1):
+            cut_short = not line.endswith(b"\n") and len(line) < MAX_JOURNAL_RECORD
+            if cut_short and line.startswith(JOURNAL_RECORD_START):
+                return  # a record cut short, the last line: repair_journal removes it
+            try:
+                record = json.loads(line)
+            except (ValueError, RecursionError):  # not UTF-8 or not JSON
+                record = None
+            if not isinstance(record, dict) or not isinstance(record.get("op_code"), int):
+                raise _not_a_journal(path, given, f"line {number} is not one of its records")
+
+
+def _not_a_journal(path: Path, given: bool, reason: str) -> ConfigError | RunError:
+    if given:
+        return ConfigError(
+            f"--storage {path}: is not an Optuna journal file ({reason}); nothing was written "
+            "to it. Give a new file name (the journal is created), a journal an earlier "
+            "`cartpole-q tune` wrote, or a storage URL such as sqlite:///study.db."
+        )
+    return RunError(f"{path}: the study's journal is damaged ({reason}); it cannot be read.")
 
 
 def repair_journal(path: Path) -> bool:

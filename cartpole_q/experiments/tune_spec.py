@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import contextlib
 import difflib
-import json
 import math
 import re
 from collections.abc import Mapping
@@ -24,6 +23,8 @@ from cartpole_q.config import (
     load_config,
     parse_seeds,
     read_yaml_mapping,
+    shown,
+    shown_value,
 )
 from cartpole_q.experiments.sweep_spec import (
     FORBIDDEN_AXES,
@@ -134,12 +135,12 @@ def load_tune(source: Path | Mapping[str, Any], *, label: str | None = None) -> 
     trials = raw.get("trials", 100)
     if isinstance(trials, bool) or not isinstance(trials, int) or not 1 <= trials <= MAX_TRIALS:
         raise ConfigError(
-            f"{where}: trials: must be an integer from 1 to {MAX_TRIALS:,}, got {json.dumps(trials, default=str)}."
+            f"{where}: trials: must be an integer from 1 to {MAX_TRIALS:,}, got {shown_value(trials)}."
         )
     objective = raw.get("objective", "success_rate")
     if objective not in OBJECTIVES:
         raise ConfigError(
-            f"{where}: objective: must be one of {', '.join(OBJECTIVES)}, got {json.dumps(objective, default=str)}."
+            f"{where}: objective: must be one of {', '.join(OBJECTIVES)}, got {shown_value(objective)}."
         )
     sampler = _sampler(raw.get("sampler"), where)
     pruner = raw.get("pruner", False)
@@ -163,16 +164,18 @@ def _sampler(value: Any, where: str) -> dict[str, Any]:
         raise ConfigError(f"{where}: sampler: must be a mapping like {{type: tpe, seed: 0}}.")
     for key in value:
         if key not in ("type", "seed"):
-            raise ConfigError(f"{where}: sampler: unknown key {key!r}; valid keys: type, seed.")
+            raise ConfigError(
+                f"{where}: sampler: unknown key {shown(key)}; valid keys: type, seed."
+            )
     kind = value.get("type", "tpe")
     if kind not in SAMPLERS:
         raise ConfigError(
-            f"{where}: sampler.type: must be one of {', '.join(SAMPLERS)}, got {json.dumps(kind, default=str)}."
+            f"{where}: sampler.type: must be one of {', '.join(SAMPLERS)}, got {shown_value(kind)}."
         )
     seed = value.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise ConfigError(
-            f"{where}: sampler.seed: must be a non-negative integer, got {json.dumps(seed, default=str)}."
+            f"{where}: sampler.seed: must be a non-negative integer, got {shown_value(seed)}."
         )
     return {"type": kind, "seed": seed}
 
@@ -245,7 +248,7 @@ def _range(key: str, spec: Mapping[str, Any], label: str) -> Dimension:
         if name not in RANGE_KEYS:
             close = difflib.get_close_matches(str(name), (*RANGE_KEYS, "choices"), n=1)
             hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise ConfigError(f"{label}: unknown key {name!r}{hint}")
+            raise ConfigError(f"{label}: unknown key {shown(name)}{hint}")
     if "low" not in spec or "high" not in spec:
         raise ConfigError(f"{label}: a range needs both low and high.")
     low, high = _number(spec["low"], f"{label}.low"), _number(spec["high"], f"{label}.high")
@@ -286,5 +289,5 @@ def _number(value: Any, label: str) -> float:
         with contextlib.suppress(ValueError):
             value = float(value)  # YAML reads 5e-4 as a string
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise ConfigError(f"{label}: must be a number, got {json.dumps(value, default=str)}.")
+        raise ConfigError(f"{label}: must be a number, got {shown_value(value)}.")
     return float(value)

@@ -70,16 +70,17 @@ def profile_for(env_id: str) -> EnvProfile:
 
 
 def _entry_point(env_id: str) -> str | None:
-    """The entry point ``env_id`` is registered with (``module:Class``), if it is."""
+    """The entry point ``env_id`` is registered with (``module:Class``), if it is.
+
+    A look in the registry only: nothing is imported (``module:Name-v0`` is looked up as
+    ``Name-v0``, found once the module that registers it has been imported).
+    """
     try:
-        import gymnasium
+        from gymnasium.envs.registration import registry
     except ImportError:  # pragma: no cover - gymnasium is a dependency
         return None
-    try:
-        spec = gymnasium.spec(env_id)
-    except Exception:  # an unknown or malformed id: no entry point to match
-        return None
-    entry_point = spec.entry_point
+    spec = registry.get(env_id.rpartition(":")[2])
+    entry_point = None if spec is None else spec.entry_point
     return entry_point if isinstance(entry_point, str) else None
 
 

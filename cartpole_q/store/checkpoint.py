@@ -13,20 +13,23 @@ from __future__ import annotations
 
 import io
 import json
-import zipfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
-from cartpole_q.config import Config, ConfigError, load_config
+from cartpole_q.config import Config, load_config, load_yaml_text, shorten
 from cartpole_q.engines.base import EpisodeMetrics, Tables
 from cartpole_q.errors import RunError
 from cartpole_q.store.atomic import atomic_write_bytes
+from cartpole_q.store.reading import load_npz
 from cartpole_q.training import Checkpoint
 
 CHECKPOINT_FILE = "checkpoint.npz"
+MAX_META_CHARS = 16 * 2**20
+"""the longest meta record read (a checkpoint's is a few kilobytes, its config included)"""
 MEMORY_PREFIX = "memory_"
 """the keys of the algorithm's memory arrays: ``memory_0``, ``memory_1``, ..."""
 INFO_ARRAY = "info"
@@ -99,41 +102,56 @@ def checkpoint_from_bytes(content: bytes, where: str) -> Checkpoint:
         RunError: the bytes are not a checkpoint.
     """
     try:
-        with np.load(io.BytesIO(content), allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-            return Checkpoint(
-                engine=meta["engine"],
-                episode=int(meta["episode"]),
-                env_steps=int(meta["env_steps"]),
-                tables=Tables(q=data["q"], visits=data["visits"], memory=_memory(data)),
-                metrics=EpisodeMetrics(*(data[name] for name in EpisodeMetrics._fields)),
-                agent_rng_state=meta["agent_rng_state"],
-                env_rng_state=meta["env_rng_state"],
-                # checkpoints older than env.randomize have none (nothing was drawn)
-                physics_rng_state=meta.get("physics_rng_state"),
-                solved_episode=meta["solved_episode"],
-                solved_q=data["solved_q"] if "solved_q" in data.files else None,
-                evaluations=meta["evaluations"],
-                train_seconds=float(meta["train_seconds"]),
-                wall_seconds=float(meta["wall_seconds"]),
-                config=_checkpoint_config(meta.get("config")),
-                info=data[INFO_ARRAY] if INFO_ARRAY in data.files else None,
-                errors=data[ERRORS_ARRAY] if ERRORS_ARRAY in data.files else None,
-            )
-    except (
-        OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, ConfigError
-    ) as error:  # fmt: skip
-        raise RunError(
-            f"{where}: the checkpoint is damaged and cannot be resumed ({error})."
-        ) from None
+        data = load_npz(content, where)
+        meta = _meta(data)
+        return Checkpoint(
+            engine=meta["engine"],
+            episode=int(meta["episode"]),
+            env_steps=int(meta["env_steps"]),
+            tables=Tables(q=data["q"], visits=data["visits"], memory=_memory(data)),
+            metrics=EpisodeMetrics(*(data[name] for name in EpisodeMetrics._fields)),
+            agent_rng_state=meta["agent_rng_state"],
+            env_rng_state=meta["env_rng_state"],
+            # checkpoints older than env.randomize have none (nothing was drawn)
+            physics_rng_state=meta.get("physics_rng_state"),
+            solved_episode=meta["solved_episode"],
+            solved_q=data.get("solved_q"),
+            evaluations=meta["evaluations"],
+            train_seconds=float(meta["train_seconds"]),
+            wall_seconds=float(meta["wall_seconds"]),
+            config=_checkpoint_config(meta.get("config")),
+            info=data.get(INFO_ARRAY),
+            errors=data.get(ERRORS_ARRAY),
+        )
+    except (ValueError, KeyError, TypeError, RecursionError) as error:
+        # RunError (a damaged archive) and ConfigError (its recorded config) are ValueErrors
+        raise _damaged(where, error) from None
 
 
-def _memory(data: Any) -> tuple[np.ndarray, ...]:
+def _damaged(where: str, error: BaseException) -> RunError:
+    detail = str(error).removeprefix(f"{where}: ")
+    return RunError(
+        f"{where}: the checkpoint is damaged and cannot be resumed ({shorten(detail, 200)})."
+    )
+
+
+def _meta(data: Mapping[str, np.ndarray]) -> dict[str, Any]:
+    """The checkpoint's JSON record (its generator states, config, counters)."""
+    text = str(data["meta"])
+    if len(text) > MAX_META_CHARS:
+        raise ValueError("its meta record is larger than any checkpoint writes")
+    meta = json.loads(text)
+    if not isinstance(meta, dict):
+        raise ValueError("its meta is not a JSON object")
+    return meta
+
+
+def _memory(data: Mapping[str, np.ndarray]) -> tuple[np.ndarray, ...]:
     """The algorithm's memory arrays, in order (an old checkpoint's ``q_b`` as the first)."""
-    count = sum(1 for name in data.files if name.startswith(MEMORY_PREFIX))
+    count = sum(1 for name in data if name.startswith(MEMORY_PREFIX))
     if count:
         return tuple(data[f"{MEMORY_PREFIX}{index}"] for index in range(count))
-    if "q_b" in data.files and data["q_b"].size:
+    if "q_b" in data and data["q_b"].size:
         return (data["q_b"],)
     return ()
 
@@ -142,7 +160,10 @@ def _checkpoint_config(text: Any) -> Config | None:
     """The config a checkpoint recorded (``None`` for checkpoints older than that)."""
     if text is None:
         return None
-    data = yaml.safe_load(text)
+    try:
+        data = load_yaml_text(text)
+    except yaml.YAMLError:
+        raise ValueError("its recorded config is not valid YAML") from None
     if not isinstance(data, dict):
         raise ValueError("its recorded config is not a mapping")
     return load_config(data)
@@ -161,12 +182,6 @@ def read_checkpoint_meta(run_dir: Path) -> dict[str, Any] | None:
     if not path.is_file():
         return None
     try:
-        with np.load(path, allow_pickle=False) as data:
-            meta = json.loads(str(data["meta"]))
-        if not isinstance(meta, dict):
-            raise ValueError("its meta is not a JSON object")
-        return meta
-    except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile) as error:
-        raise RunError(
-            f"{path}: the checkpoint is damaged and cannot be resumed ({error})."
-        ) from None
+        return _meta(load_npz(path, str(path)))
+    except (ValueError, KeyError, TypeError, RecursionError) as error:
+        raise _damaged(str(path), error) from None

@@ -24,7 +24,6 @@ import csv
 import dataclasses
 import functools
 import io
-import json
 import platform
 import shutil
 import time
@@ -39,7 +38,7 @@ import numpy as np
 from cartpole_q.config import Config, ConfigError, load_config
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError, WriteError
-from cartpole_q.evaluation import check_q_table
+from cartpole_q.evaluation import check_q_table, check_q_table_shape
 from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.store import lock
@@ -52,6 +51,7 @@ from cartpole_q.store.atomic import (
     write_json,
 )
 from cartpole_q.store.checkpoint import CHECKPOINT_FILE
+from cartpole_q.store.reading import ShapeCheck, load_npy, read_json
 from cartpole_q.training import TrainResult
 
 CONFIG_FILE = "config.yaml"
@@ -69,8 +69,6 @@ ERRORS_COLUMN = "rms_error"
 INFO_COLUMN_PREFIX = "info_"
 """``metrics.csv``'s last column with ``train.info_metric: KEY`` is ``info_KEY``"""
 EVALUATIONS_HEADER = ("episode", "env_steps", "mean", "std", "min", "max")
-NPY_MAGIC = b"\x93NUMPY"
-"""the first bytes of every ``.npy`` file"""
 
 
 # -- creating a run directory ---------------------------------------------------------
@@ -444,19 +442,23 @@ def load_run(path: str | Path) -> Run:
         raise RunError(f"{path}: training did not finish (no {SUMMARY_FILE}){hint}.")
     grid = config.discretization
     predicts = get_algorithm(config.agent.algorithm).predicts
-    table_file = V_TABLE_FILE if predicts else Q_TABLE_FILE
-    table = load_array(path / table_file, np.float64)
-    if predicts:  # V as the one-column table the algorithms learnt it as
+    states = None if grid is None else grid.table_shape
+    if predicts:  # V: the states' values, as the one-column table the algorithms learnt
+        table_file = V_TABLE_FILE
+        table = load_array(path / table_file, np.float64, _values_check(states))
         table = table.reshape(*table.shape, 1)
-    check_q_table(table, None if grid is None else grid.table_shape, None, str(path / table_file))
+    else:
+        table_file = Q_TABLE_FILE
+        table = load_array(path / table_file, np.float64, table_check(states))
+    check_q_table(table, states, None, str(path / table_file))
     visits = None
     if (path / VISITS_FILE).is_file():
-        visits = load_array(path / VISITS_FILE, np.int64)
-        if visits.shape[:-1] != table.shape[:-1] or (not predicts and visits.shape != table.shape):
-            raise RunError(
-                f"{path / VISITS_FILE}: has shape {visits.shape}, but {table_file}'s is "
-                f"{table.shape[:-1] if predicts else table.shape}."
-            )
+        whose = f"{table_file}'s states" if predicts else "the Q-table's"
+        visits = load_array(
+            path / VISITS_FILE,
+            np.int64,
+            _same_shape(table.shape[:-1] if predicts else table.shape, whose, predicts),
+        )
     metrics, info, errors = read_metric_columns(
         path / METRICS_FILE, config.train.info_metric, errors=predicts
     )
@@ -490,40 +492,50 @@ def config_threshold(config: Config) -> float | None:
     return inspect_env(config).reward_threshold
 
 
-def load_array(path: Path, dtype: type) -> np.ndarray:
-    """Load an ``.npy`` file without pickle and check its dtype.
+def load_array(path: Path, dtype: type, check: ShapeCheck | None = None) -> np.ndarray:
+    """Load an ``.npy`` file without pickle, checking its dtype (and shape) before allocating it.
 
     Raises:
-        RunError: the file is missing, truncated, an object array, or of another dtype.
+        RunError: the file is missing, truncated, an object array, of another dtype, or
+            refused by ``check`` (see :func:`~cartpole_q.store.reading.load_npy`).
     """
-    if not path.exists():
-        raise RunError(f"{path}: is missing.")
-    if not path.is_file():
-        kind = "a directory" if path.is_dir() else "not a regular file"
-        raise RunError(f"{path}: is {kind}, but a .npy array file is expected here.")
-    try:
-        with open(path, "rb") as stream:
-            magic = stream.read(len(NPY_MAGIC))
-    except OSError as error:
-        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
-    if magic != NPY_MAGIC:
-        raise RunError(
-            f"{path}: is not a NumPy array file (.npy); it was not written by cartpole-q."
-        )
-    try:
-        array = np.load(path, allow_pickle=False)
-    except ValueError as error:
-        if "allow_pickle" in str(error):
+    return load_npy(path, dtype, check)
+
+
+def table_check(states: tuple[int, ...] | None) -> ShapeCheck:
+    """The check of a Q-table's header: float64, ``(*states, n_actions)`` (any states when ``None``)."""
+
+    def check(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+        if dtype != np.float64:
+            raise RunError(f"{where}: must hold float64 values, found {dtype}.")
+        check_q_table_shape(shape, states, None, where)
+
+    return check
+
+
+def _values_check(states: tuple[int, ...] | None) -> ShapeCheck:
+    """The check of ``v_table.npy``'s header: float64, ``states`` (any shape when ``None``)."""
+
+    def check(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+        if dtype != np.float64:
+            raise RunError(f"{where}: must hold float64 values, found {dtype}.")
+        if states is not None and tuple(shape) != tuple(states):
             raise RunError(
-                f"{path}: holds Python objects; only numeric arrays are accepted."
-            ) from None
-        raise RunError(f"{path}: is not a valid .npy array ({error}).") from None
-    except (OSError, EOFError) as error:
-        raise RunError(f"{path}: cannot be read as a .npy array ({error}).") from None
-    if not isinstance(array, np.ndarray) or array.dtype != np.dtype(dtype):
-        found = getattr(array, "dtype", type(array).__name__)
-        raise RunError(f"{path}: must hold {np.dtype(dtype).name} values, found {found}.")
-    return array
+                f"{where}: has shape {tuple(shape)}, but the config's states are {states}."
+            )
+
+    return check
+
+
+def _same_shape(expected: tuple[int, ...], whose: str, leading: bool = False) -> ShapeCheck:
+    """The check of an array's header against a shape (``leading``: all but its last axis)."""
+
+    def check(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+        found = tuple(shape)[:-1] if leading else tuple(shape)
+        if found != tuple(expected):
+            raise RunError(f"{where}: has shape {tuple(shape)}, but {whose} is {tuple(expected)}.")
+
+    return check
 
 
 def read_metrics(path: Path) -> EpisodeMetrics:
@@ -598,7 +610,7 @@ def read_summary(run_dir: Path) -> RunSummary | None:
         RunError: the file exists but is not a run's summary (naming the file and key).
     """
     path = run_dir / SUMMARY_FILE
-    data = _read_json(path)
+    data = read_json(path)
     return None if data is None else RunSummary.from_json(data, str(path))
 
 
@@ -609,29 +621,28 @@ def read_multi_seed_summary(parent: Path) -> MultiSeedSummary | None:
         RunError: the file exists but is not a multi-seed summary.
     """
     path = parent / SUMMARY_FILE
-    data = _read_json(path)
+    data = read_json(path)
     return None if data is None else MultiSeedSummary.from_json(data, str(path))
 
 
-def _read_json(path: Path) -> object:
-    try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        return None
-    except NotADirectoryError:
-        raise RunError(
-            f"{path.parent}: is a file, but a run directory was expected here."
-        ) from None
-    except IsADirectoryError:
-        raise RunError(f"{path}: is a directory, not a JSON file.") from None
-    except OSError as error:
-        raise RunError(f"{path}: cannot be read ({error.strerror}).") from None
-    except (UnicodeDecodeError, json.JSONDecodeError) as error:
-        raise RunError(f"{path}: is not valid JSON ({error}).") from None
-
-
 def _config_of(path: Path) -> Config:
+    return read_config_file(path / CONFIG_FILE)
+
+
+def read_config_file(path: Path) -> Config:
+    """The ``config.yaml`` of a directory cartpole-q wrote (a run, a multi-seed run, a sweep point).
+
+    Read as data: an ``env.id`` that would import a module is refused
+    (:func:`~cartpole_q.envs.gym.check_recorded_env_id`).
+
+    Raises:
+        RunError: the file is not a valid config, or its ``env.id`` names a module to import.
+    """
+    from cartpole_q.envs.gym import check_recorded_env_id
+
     try:
-        return load_config(path / CONFIG_FILE)
+        config = load_config(path)
     except ConfigError as error:
-        raise RunError(f"{path}: its {CONFIG_FILE} is not a valid config. {error}") from None
+        raise RunError(f"{path.parent}: its {path.name} is not a valid config. {error}") from None
+    check_recorded_env_id(config.env.id, str(path))
+    return config

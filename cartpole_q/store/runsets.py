@@ -13,13 +13,17 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, Schedule, load_config
+from cartpole_q.config import Config, Schedule, config_differences, shown_value
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
 from cartpole_q.store import rundir, sweepdir
+
+if TYPE_CHECKING:
+    from cartpole_q.envs.gym import EnvInfo
 
 
 def seed_dir(parent: Path, seed: int, seeds: tuple[int, ...]) -> Path:
@@ -85,7 +89,7 @@ def load_run_set(path: Path) -> RunSet:
 
 def _multi_seed(parent: Path) -> RunSet:
     """A multi-seed run's finished seeds; interrupted and missing ones are named, left out."""
-    config = load_config(parent / rundir.CONFIG_FILE)
+    config = rundir.read_config_file(parent / rundir.CONFIG_FILE)
     seeds = config.train.seeds
     assert seeds is not None
     runs: list[rundir.Run] = []
@@ -99,11 +103,73 @@ def _multi_seed(parent: Path) -> RunSet:
         elif summary.interrupted:
             unfinished.append(child.name)
         else:
-            runs.append(rundir.load_run(child))
+            run = rundir.load_run(child)
+            check_seed_config(parent, child, config.for_seed(seed), run.config)
+            runs.append(run)
     note = _left_out(parent, len(seeds), missing, unfinished)
     if not runs:
         raise RunError(f"{parent}: none of its seed runs has finished; {note}")
     return RunSet(parent, "multi-seed run", runs, [note] if note else [], missing, unfinished)
+
+
+def check_tables(run_set: RunSet) -> EnvInfo:
+    """The environment's facts, once every seed's Q-table is checked to fit them.
+
+    A run's ``config.yaml`` replaced by another world's would otherwise have its table
+    drawn (or played) as that world's: its states and actions must be the environment's.
+
+    Raises:
+        ConfigError: the environment cannot be made.
+        RunError: a table's shape is not ``(*states, n_actions)`` of the environment.
+    """
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.evaluation import check_q_table_shape
+
+    info = inspect_env(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
+    for run in run_set.runs:
+        file = run.path / rundir.Q_TABLE_FILE  # a sweep point's seeds have none of their own
+        where = str(file) if file.is_file() else f"{run.path}: its Q-table"
+        check_q_table_shape(run.q_table.shape, info.state_shape, info.n_actions, where)
+    return info
+
+
+NEUTRAL_KEYS = frozenset(
+    {"name", "engine", "train.episodes", "train.checkpoint_every", "train.tensorboard"}
+)
+"""config keys in which a multi-seed run's seeds may differ: the run name, the engine
+(bit-identical results), how often checkpoints and TensorBoard files are written, and
+``train.episodes`` (one seed may be extended with ``train --resume seed-NNN --episodes N``)"""
+
+
+def check_seed_config(parent: Path, child: Path, expected: Config, found: Config) -> None:
+    """Refuse a seed directory whose run is not the multi-seed run's config with its seed.
+
+    A directory copied in from another run (another environment, algorithm, or seed)
+    would otherwise be averaged with the others as if it were one of them.
+
+    Raises:
+        RunError: naming the seed directory and each key that differs, with both values.
+    """
+    differences = [
+        (key, old, new)
+        for key, old, new in config_differences(expected, found)
+        if key not in NEUTRAL_KEYS
+    ]
+    if not differences:
+        return
+    differences.sort(key=lambda difference: difference[0] != "env.id")  # the telling one first
+    shown = "; ".join(
+        f"{key} is {shown_value(new)} in {child.name} but {shown_value(old)} in "
+        f"{parent / rundir.CONFIG_FILE}"
+        for key, old, new in differences[:3]
+    )
+    more = f" (and {len(differences) - 3} more keys)" if len(differences) > 3 else ""
+    raise RunError(
+        f"{child}: is not a seed of the multi-seed run {parent}: its config differs in what "
+        f"changes results: {shown}{more}. A multi-seed run's seeds share one config but "
+        f"their seed, so that their figures can be put together; move {child.name} out of "
+        f"{parent} (it is then named as missing), or use it as a run of its own."
+    )
 
 
 def _left_out(parent: Path, total: int, missing: list[str], unfinished: list[str]) -> str:
@@ -130,13 +196,11 @@ def _names(names: list[str], limit: int = 8) -> str:
 def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
     """A sweep point's seeds as runs: rows, tables and (when kept) learning curves."""
     sweep = point_dir.parent.parent
-    try:
-        config = load_config(point_dir / rundir.CONFIG_FILE)
-    except ConfigError as error:
-        raise RunError(
-            f"{point_dir}: its {rundir.CONFIG_FILE} is not a valid config ({error})."
-        ) from None
-    tables = sweepdir.read_tables(sweep, point_dir.name)
+    config = rundir.read_config_file(point_dir / rundir.CONFIG_FILE)
+    grid = config.discretization
+    tables = sweepdir.read_tables(
+        sweep, point_dir.name, rundir.table_check(None if grid is None else grid.table_shape)
+    )
     curves = sweepdir.read_curves(sweep, point_dir.name)
     info_key = config.train.info_metric
     infos = {} if info_key is None else sweepdir.read_info_curves(sweep, point_dir.name, info_key)

@@ -13,7 +13,7 @@ import contextlib
 import csv
 import io
 import json
-import zipfile
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from cartpole_q.config import parse_seeds, read_yaml_mapping
+from cartpole_q.config import MAX_EPISODES, parse_seeds, read_yaml_mapping, shown
 from cartpole_q.errors import RunError
 from cartpole_q.results import SeedResult
 from cartpole_q.statistics import PointStatistics
@@ -32,6 +32,7 @@ from cartpole_q.store.atomic import (
     make_directory,
     remove_stale_temporaries,
 )
+from cartpole_q.store.reading import ShapeCheck, load_npz
 from cartpole_q.store.rundir import CONFIG_FILE, NewDirectory, new_directory, write_config
 
 SWEEP_FILE = "sweep.yaml"
@@ -190,16 +191,24 @@ def parse_row(cells: Mapping[str, str], axes: Sequence[str], where: Path) -> Res
                 solved_episode=_integer(cells["solved_episode"]),
                 env_steps_to_solve=_integer(cells["env_steps_to_solve"]),
                 first_greedy_success_env_steps=_integer(cells["first_greedy_success_env_steps"]),
-                eval_mean=float(cells["eval_mean"]) if cells["eval_mean"] else None,
+                eval_mean=_finite(cells["eval_mean"]) if cells["eval_mean"] else None,
                 success=_flag(cells["success"]),
-                train_seconds=float(cells["train_seconds"] or 0.0),
+                train_seconds=_finite(cells["train_seconds"] or "0"),
             ),
         )
-    except (KeyError, ValueError, TypeError):
+    except (KeyError, ValueError, TypeError, OverflowError):
         raise RunError(
-            f"{where}: has a damaged row ({dict(cells)}); the sweep directory was changed by "
-            "hand. Start a new sweep."
+            f"{where}: has a damaged row ({shown(dict(cells))}); the sweep directory was "
+            "changed by hand. Start a new sweep."
         ) from None
+
+
+def _finite(text: str) -> float:
+    """A finite number: NaN or an infinity is no figure a run produced."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(text)
+    return value
 
 
 def _integer(text: str) -> int | None:
@@ -308,15 +317,21 @@ def read_curves(directory: Path, point_id: str) -> dict[str, tuple[np.ndarray, n
     path = curves_path(directory, point_id)
     if not path.is_file():
         return {}
+    archive = load_npz(path, str(path), check=_one_dimensional)
+    keys = sorted({name.rpartition(".")[0] for name in archive})
     try:
-        with np.load(path, allow_pickle=False) as archive:
-            names = archive.files
-            keys = sorted({name.rpartition(".")[0] for name in names})
-            return {key: (archive[f"{key}.returns"], archive[f"{key}.lengths"]) for key in keys}
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as error:
+        return {key: (archive[f"{key}.returns"], archive[f"{key}.lengths"]) for key in keys}
+    except KeyError as error:
+        raise RunError(f"{path}: has no array {error}; the sweep directory is damaged.") from None
+
+
+def _one_dimensional(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -> None:
+    """A learning curve's header: one value per episode, at most the most episodes a run has."""
+    if len(shape) != 1 or shape[0] > MAX_EPISODES:
         raise RunError(
-            f"{path}: cannot be read ({error}); the sweep directory is damaged."
-        ) from None
+            f"{where}: has shape {shape}, not one value per episode; the sweep directory is "
+            "damaged."
+        )
 
 
 def read_info_curves(directory: Path, point_id: str, info_key: str) -> dict[str, np.ndarray]:
@@ -329,17 +344,10 @@ def read_info_curves(directory: Path, point_id: str, info_key: str) -> dict[str,
     if not path.is_file():
         return {}
     suffix = f".info_{info_key}"
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            return {
-                name.removesuffix(suffix): archive[name]
-                for name in archive.files
-                if name.endswith(suffix)
-            }
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as error:
-        raise RunError(
-            f"{path}: cannot be read ({error}); the sweep directory is damaged."
-        ) from None
+    archive = load_npz(path, str(path), check=_one_dimensional)
+    return {
+        name.removesuffix(suffix): array for name, array in archive.items() if name.endswith(suffix)
+    }
 
 
 def tables_path(directory: Path, point_id: str) -> Path:
@@ -355,22 +363,24 @@ def write_tables(directory: Path, point_id: str, tables: Mapping[str, np.ndarray
     atomic_write_bytes(tables_path(directory, point_id), buffer.getvalue())
 
 
-def read_tables(directory: Path, point_id: str) -> dict[str, np.ndarray]:
+def read_tables(
+    directory: Path, point_id: str, check: ShapeCheck | None = None
+) -> dict[str, np.ndarray]:
     """A point's saved tables by key (none if it has no file yet).
 
+    Args:
+        directory: the sweep directory.
+        point_id: the point (``p000``).
+        check: each table's header check (the shape its config implies), before it is
+            allocated.
+
     Raises:
-        RunError: the file is damaged.
+        RunError: the file is damaged, or a table is refused by ``check``.
     """
     path = tables_path(directory, point_id)
     if not path.is_file():
         return {}
-    try:
-        with np.load(path, allow_pickle=False) as archive:
-            return {key: archive[key] for key in archive.files}
-    except (OSError, ValueError, zipfile.BadZipFile) as error:
-        raise RunError(
-            f"{path}: cannot be read ({error}); the sweep directory is damaged."
-        ) from None
+    return load_npz(path, str(path), check=check)
 
 
 @dataclass(frozen=True)
