@@ -54,7 +54,7 @@ def eval_command(
         typer.Option(
             metavar="FILE",
             help="Record the first episodes (see --video-episodes) as FILE.gif, or FILE.mp4 "
-            'with the video extra (`pip install "cartpole-q[video]"`); any environment with '
+            'with the video extra (`pip install "cartpole-q\\[video]"`); any environment with '
             "a renderer; checked before any episode is played.",
         ),
     ] = None,
