@@ -75,12 +75,20 @@ def under_conditions(
     Checked like a config: an unknown key, a bad value, or physics on an environment that
     is not CartPole is a ``ConfigError`` naming it and ``source`` (the option that gave
     the physics: ``eval --physics``, ``robustness --vary``; the horizon is ``--max-steps``).
+
+    Another horizon also judges success by the environment's own threshold for it
+    (``train.reward_threshold`` becomes null: CartPole's 475 of 500 steps scales, 9,500 at
+    10,000 steps): a threshold the run was trained with is a stopping rule for its own
+    horizon (``robust``'s 1995 of 2000 steps), no yardstick at another one.
     """
     overrides: dict[str, Any] = {}
     if physics:
         overrides["env.physics"] = {**config.env.physics, **physics}
     if max_steps is not None:
         overrides["env.kwargs.max_episode_steps"] = max_steps
+        explicit = config.train.reward_threshold is not None
+        if explicit and max_steps != inspect_env(config).max_episode_steps:
+            overrides["train.reward_threshold"] = None
     if not overrides:
         return config
     label = source if physics else "--max-steps"
