@@ -28,10 +28,11 @@ def _rows_single(run_dir: Path, summary: RunSummary) -> list[tuple[str, str]]:
         ),
     ]
     if evaluation is not None:
+        cut = ", cut short by the stop" if evaluation.interrupted else ""
         rows.append((
             "greedy eval",
             f"mean {evaluation.mean:.1f} +/- {evaluation.std:.1f} over {evaluation.episodes} "
-            f"episodes (min {evaluation.min:g}, max {evaluation.max:g})",
+            f"episodes (min {evaluation.min:g}, max {evaluation.max:g}{cut})",
         ))  # fmt: skip
     if greedy is not None:
         rows.append((

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import os
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
 
-from cartpole_q.engines.base import AgentParams, TrainingState
+from cartpole_q.engines.base import AgentParams, TrainingState, played_until_stopped
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
@@ -141,13 +141,24 @@ class NumbaEngine:
             np.zeros(observation_size, dtype=twin.observation_dtype),
         )  # fmt: skip
 
-    def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
+    def evaluate(
+        self,
+        q: np.ndarray,
+        episodes: int,
+        seed: int,
+        should_stop: Callable[[], bool] | None = None,
+    ) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
         env_rng = seeding.np_random(seed)[0]
-        returns: np.ndarray = self._greedy_returns(
-            self._params.hook_table(q), self._params.grid, env_rng, self._greedy_env, episodes
-        )
-        return returns
+        table, grid, env = self._params.hook_table(q), self._params.grid, self._greedy_env
+
+        def play(count: int) -> np.ndarray:
+            returns: np.ndarray = self._greedy_returns(table, grid, env_rng, env, count)
+            return returns
+
+        if should_stop is None:
+            return play(episodes)
+        return played_until_stopped(play, episodes, should_stop)
 
     def env_rng_state(self) -> dict[str, Any]:
         """Return the twin environment's generator state."""
