@@ -7,6 +7,7 @@ Q-table and metrics are byte-identical to it; about two hundred times faster.
 from __future__ import annotations
 
 import os
+import signal
 import threading
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -19,6 +20,7 @@ from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
 from cartpole_q.numba_cache import is_cached
+from cartpole_q.processes import leave_signals_to_parent
 from cartpole_q.profiles import profile_for
 
 NO_TIME_LIMIT = 2**63 - 1
@@ -110,13 +112,19 @@ class NumbaEngine:
         greedy play is the smaller compilation: it goes with the exploring loop, which
         compiles faster than the greedy one.) Where a process cannot fork (or has threads,
         where forking is unsafe), everything is compiled here, one after another.
+
+        The child leaves signals to this process (a Ctrl-C to the terminal reaches both: the
+        command answers it once) and dies with it; if this process stops compiling (a second
+        Ctrl-C), the child is killed, not waited for.
         """
         if not hasattr(os, "fork") or threading.active_count() > 1:
             return
+        parent = os.getpid()
         child = os.fork()
         if child == 0:  # the child: the greedy episode loop, then exit without clean-up
             code = 1
             try:
+                leave_signals_to_parent(parent)
                 self._scratch_episode(state, self._kernel.greedy_episode, 0.0)
                 code = 0
             finally:
@@ -124,6 +132,9 @@ class NumbaEngine:
         try:
             self._scratch_episode(state, self._kernel.exploring_episode, 0.5)
             self.evaluate(state.tables.q.copy(), 0, 0)
+        except BaseException:
+            os.kill(child, signal.SIGKILL)  # its half-compiled loop is worth nothing
+            raise
         finally:
             os.waitpid(child, 0)
 
