@@ -4,7 +4,8 @@
 proof): the first episode's reset is seeded with the evaluation seed, later resets continue
 that environment's random stream. ``--engine numba`` plays the same episodes on the
 environment's compiled twin, which gives exactly the same returns (the twins are
-bit-identical to Gymnasium, a test compares them) about a hundred times faster.
+bit-identical to Gymnasium, a test compares them) some thirty times faster (a hundred
+seeds' tables of CartPole, 100 episodes each).
 """
 
 from __future__ import annotations

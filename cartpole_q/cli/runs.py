@@ -75,7 +75,7 @@ def eval_command(
         PlayChoice,
         typer.Option(
             help="Where to play: gymnasium.make (the proof), or numba: the environment's "
-            "compiled twin, the same returns exactly and about a hundred times faster "
+            "compiled twin, the same returns exactly and some thirty times faster "
             "(environments with a twin; no --video or --render). The output says which.",
         ),
     ] = PlayChoice.gymnasium,
