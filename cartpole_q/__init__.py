@@ -41,25 +41,44 @@ if TYPE_CHECKING:
 
 
 def train(
-    config: Config | str | PathLike[str] | Mapping[str, Any] | None = None, **options: Any
+    config: Config | str | PathLike[str] | Mapping[str, Any] | None = None,
+    *,
+    quiet: bool = False,
+    **options: Any,
 ) -> TrainResult:
     """Train a config; see :func:`cartpole_q.training.train` for ``options``.
+
+    A run whose training loop is not in numba's cache yet (the first on a machine, or the
+    first of an algorithm of your own) compiles it first, for seconds up to a minute; it
+    says so on stderr, as ``cartpole-q train`` does.
 
     Args:
         config: a loaded config, or what :func:`load_config` takes: a YAML file
             (``"configs/blog.yaml"``), a shipped config's name, a mapping merged onto the
             default (``{"seed": 3}``), or ``None`` for the embedded default.
+        quiet: print nothing, not even that the loop is being compiled.
         **options: passed on (``on_progress``, ``should_stop``, ...).
 
     Raises:
         ConfigError: the config is invalid or does not fit its environment.
     """
+    import sys
+
     from cartpole_q.config import Config, load_config
+    from cartpole_q.engines import compile_notice, resolve_engine
+    from cartpole_q.envs.gym import inspect_env
     from cartpole_q.training import train as train_config
 
     if not isinstance(config, Config):
         config = load_config(config)
-    return train_config(config, **options)
+    env_info = options.pop("env_info", None) or inspect_env(config)
+    if not quiet:
+        resume = options.get("resume")
+        engine = resume.engine if resume is not None else resolve_engine(config, env_info)
+        notice = compile_notice(config, env_info, engine)
+        if notice is not None:
+            print(notice, file=sys.stderr, flush=True)
+    return train_config(config, env_info=env_info, **options)
 
 
 # Every use of the package (the command line imports it too) can make the worlds' ids.

@@ -143,14 +143,19 @@ class EvalFigures:
     seed: int
     played_in: str | None = None
     """``twin`` (the numba engine's compiled environment) or ``gymnasium``"""
+    interrupted: bool = False
+    """a stop cut the evaluation short: ``episodes`` counts those played (written only
+    when true, so files without the key read as whole evaluations)"""
 
     @classmethod
-    def of_report(cls, report: EvalReport, played_in: str | None = None) -> EvalFigures:
+    def of_report(
+        cls, report: EvalReport, played_in: str | None = None, interrupted: bool = False
+    ) -> EvalFigures:
         """The figures of an evaluation's returns."""
         data = report.to_dict()
         return cls(
             data["mean"], data["std"], data["min"], data["max"], data["episodes"],
-            data["seed"], played_in,
+            data["seed"], played_in, interrupted,
         )  # fmt: skip
 
     def to_json(self) -> JsonObject:
@@ -161,6 +166,8 @@ class EvalFigures:
         }  # fmt: skip
         if self.played_in is not None:
             data["played_in"] = self.played_in
+        if self.interrupted:
+            data["interrupted"] = True
         return data
 
     @classmethod
@@ -172,7 +179,7 @@ class EvalFigures:
         return cls(
             reader.number("mean"), reader.number("std"), reader.number("min"),
             reader.number("max"), reader.integer("episodes"), reader.integer("seed"),
-            reader.optional_text("played_in"),
+            reader.optional_text("played_in"), reader.flag("interrupted", default=False),
         )  # fmt: skip
 
 
@@ -264,7 +271,9 @@ class RunSummary:
             reward_threshold=result.reward_threshold,
             kept_episode=result.kept_episode,
             kept_from="solve point" if result.solved_episode is not None else "last episode",
-            eval=None if report is None else EvalFigures.of_report(report, played_in),
+            eval=None
+            if report is None
+            else EvalFigures.of_report(report, played_in, result.eval_interrupted),
             first_greedy_success=None
             if greedy is None
             else GreedySuccess(greedy["episode"], greedy["env_steps"], played_in),

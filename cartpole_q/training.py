@@ -134,9 +134,14 @@ class TrainResult:
     wall_seconds: float
     """seconds of the whole training loop, periodic evaluations included"""
     interrupted: bool = False
+    """a stop request cut the run short: training stopped before its end, or an evaluation
+    was cut (``train --resume`` finishes it)"""
     info: np.ndarray | None = None
     """each training episode's sum of ``info[config.train.info_metric]`` over its steps
     (``None`` without ``train.info_metric``)"""
+    eval_interrupted: bool = False
+    """the final evaluation was cut short by a stop request: ``eval`` holds the episodes it
+    played (``None`` if none)"""
     errors: np.ndarray | None = None
     """a prediction run's RMS error of ``V`` against the true values after each episode
     (``None`` for control, or when the world has no model to know them by)"""
@@ -217,8 +222,12 @@ def train(
         env_info: the checked environment, if the caller already inspected it.
         resume: a checkpoint to continue from; the result is then byte-identical to an
             uninterrupted run.
-        should_stop: polled between chunks; when it returns true, training ends at the
-            last finished episode and the result is marked ``interrupted``.
+        should_stop: polled between chunks of episodes, and between chunks of greedy
+            episodes in evaluations; when it returns true, training ends at the last
+            finished episode, a periodic evaluation being played is dropped (a resumed run
+            plays it again), the final evaluation ends after its first chunk (of
+            :data:`~cartpole_q.engines.base.EVAL_CHUNK_EPISODES` episodes) or where it is,
+            and the result is marked ``interrupted``.
         on_progress: called after every chunk.
         on_checkpoint: called every ``train.checkpoint_every`` episodes, and on interruption.
         final_eval: run the final greedy evaluation of the kept table.
@@ -307,10 +316,25 @@ def _run(
             errors=None if state.errors is None else state.errors[:episode],
         )
 
+    def periodic_evaluation() -> bool:
+        """Record the periodic evaluation of this episode; False if a stop cut it short."""
+        returns = engine.evaluate(
+            state.policy_table(), settings.eval_episodes, config.eval.seed, should_stop
+        )
+        if len(returns) < settings.eval_episodes:
+            return False  # not recorded: a resumed run plays it again, whole
+        periodic = EvalReport.from_returns(returns, config.eval.seed)
+        state.evaluations.append(
+            {"episode": state.episode, "env_steps": state.env_steps, **periodic.to_dict()}
+        )
+        return True
+
     finished = state.episode >= total or (
         state.solved_episode is not None and settings.stop_when_solved
     )
-    while not finished:
+    if resume is not None and _evaluation_missing(state, settings.eval_every):
+        interrupted = not periodic_evaluation()  # the one a stop cut short
+    while not finished and not interrupted:
         stop = min(
             total,
             state.episode + engine.chunk_episodes,
@@ -325,14 +349,9 @@ def _run(
             state.solved_episode = solved + 1
             if not settings.stop_when_solved:
                 state.solved_q = state.policy_table().copy()
+        evaluated = True
         if evaluate_every and state.episode % evaluate_every == 0:
-            periodic = EvalReport.from_returns(
-                engine.evaluate(state.policy_table(), settings.eval_episodes, config.eval.seed),
-                config.eval.seed,
-            )
-            state.evaluations.append(
-                {"episode": state.episode, "env_steps": state.env_steps, **periodic.to_dict()}
-            )
+            evaluated = periodic_evaluation()
         finished = state.episode >= total or (solved is not None and settings.stop_when_solved)
         if on_snapshot is not None and snapshot_every and state.episode % snapshot_every == 0:
             on_snapshot(state.episode, state.policy_table().reshape(table_shape).copy())
@@ -341,16 +360,18 @@ def _run(
             and settings.checkpoint_every
             and state.episode % settings.checkpoint_every == 0
             and not finished
+            and evaluated
         ):
             on_checkpoint(snapshot())
         if on_progress is not None:
             on_progress(_progress(state, total, time.perf_counter() - started, train_seconds))
-        if not finished and should_stop is not None and should_stop():
+        if not evaluated or (not finished and should_stop is not None and should_stop()):
             interrupted = True
             break
 
     stopped_when_solved = state.solved_episode is not None and settings.stop_when_solved
-    if on_checkpoint is not None and (interrupted or not stopped_when_solved):
+    checkpointed = on_checkpoint is not None and (interrupted or not stopped_when_solved)
+    if checkpointed and on_checkpoint is not None:
         # Interrupted: for --resume. Reached train.episodes: to extend the run later.
         on_checkpoint(snapshot())
     wall_seconds = wall_before + time.perf_counter() - started
@@ -361,10 +382,14 @@ def _run(
     else:
         kept, kept_episode = state.policy_table(), state.episode
     report: EvalReport | None = None
+    eval_interrupted = False
     if final_eval and not predicts:
-        report = EvalReport.from_returns(
-            engine.evaluate(kept, config.eval.episodes, config.eval.seed), config.eval.seed
-        )
+        returns = engine.evaluate(kept, config.eval.episodes, config.eval.seed, should_stop)
+        eval_interrupted = len(returns) < config.eval.episodes
+        report = EvalReport.from_returns(returns, config.eval.seed) if len(returns) else None
+    if eval_interrupted and not checkpointed and on_checkpoint is not None:
+        # Trained to its end, its evaluation cut short: --resume only evaluates again.
+        on_checkpoint(snapshot())
     episode = state.episode
     return TrainResult(
         config=config,
@@ -380,9 +405,10 @@ def _run(
         eval=report,
         train_seconds=train_seconds,
         wall_seconds=wall_seconds,
-        interrupted=interrupted,
+        interrupted=interrupted or eval_interrupted,
         info=None if state.info is None else state.info[:episode].copy(),
         errors=None if state.errors is None else state.errors[:episode].copy(),
+        eval_interrupted=eval_interrupted,
     )
 
 
@@ -421,6 +447,18 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     state.solved_episode = checkpoint.solved_episode
     state.solved_q = None if checkpoint.solved_q is None else checkpoint.solved_q.copy()
     state.evaluations = list(checkpoint.evaluations)
+
+
+def _evaluation_missing(state: TrainingState, eval_every: int) -> bool:
+    """Whether the periodic evaluation due at ``state.episode`` has no record.
+
+    Only a stop can leave it out (it cuts the evaluation short, and the checkpoint is
+    written after it): a resumed run plays it first, so its evaluations are those of an
+    uninterrupted run.
+    """
+    if not eval_every or state.episode == 0 or state.episode % eval_every:
+        return False
+    return not state.evaluations or state.evaluations[-1]["episode"] != state.episode
 
 
 def _next_multiple(episode: int, every: int) -> int:

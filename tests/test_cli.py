@@ -78,8 +78,9 @@ def test_default_run_solves_and_evaluates_above_475(trained_run: Path) -> None:
     result = invoke("eval", trained_run, "--json")
     assert result.exit_code == 0, result.output
     report = json.loads(result.stdout)
-    assert set(report) == {"mean", "std", "min", "max", "episodes", "seed"}
+    assert set(report) == {"mean", "std", "min", "max", "episodes", "seed", "played_in"}
     assert report["episodes"] == 100 and report["seed"] == 1000000
+    assert report["played_in"] == "gymnasium"
     assert report["mean"] >= 475
     # the evaluation in summary.json ran on the twin and must equal Gymnasium's exactly
     assert {**report, "played_in": "twin"} == summary["eval"]

@@ -304,6 +304,7 @@ def test_the_cli_reference_documents_every_command_and_option() -> None:
     for command in typer.main.get_command(app).commands:
         assert f"### `cartpole-q {command}`" in page
     assert "* `--set KEY=VALUE`:" in page and "* `--max-steps N`:" in page
+    assert '`pip install "cartpole-q[video]"`' in page and "\\[" not in page
     assert hook.on_page_markdown("no marker", page=None) == "no marker"
 
 

@@ -207,3 +207,32 @@ def test_robustness_refuses_bad_axes(solved_run, tmp_path, args, named: str) -> 
     from tests.test_cli import assert_refused
 
     assert_refused(invoke("robustness", solved_run, *args, "--out", tmp_path / "r.png"), named)
+
+
+def test_another_horizon_judges_success_by_the_environment_threshold_for_it(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    """--max-steps 10000 counts success at 9,500, also for a run trained with its own threshold.
+
+    A run's ``train.reward_threshold`` (``robust``'s 1995 of 2000 steps) stops its training;
+    at its own horizon it stays the yardstick, at another one CartPole's scaled default is.
+    """
+    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.evaluation import under_conditions
+    from tests.conftest import invoke
+
+    overrides = {
+        "env.kwargs.max_episode_steps": 2000, "train.reward_threshold": 1995,
+        "train.episodes": 3, "eval.episodes": 1,
+    }  # fmt: skip
+    config = load_config(overrides=overrides)
+    for max_steps, threshold in ((None, 1995), (2000, 1995), (10_000, 9500), (500, 475)):
+        assert inspect_env(under_conditions(config, None, max_steps)).reward_threshold == threshold
+    default = load_config(overrides={"train.episodes": 3})
+    assert inspect_env(under_conditions(default, None, 10_000)).reward_threshold == 9500
+
+    run = tmp_path / "run"
+    args = [f"{key}={value}" for key, value in overrides.items()]
+    assert invoke("train", *(f"--set={arg}" for arg in args), "--out", run, "-q").exit_code == 0
+    for options, shown in (([], ">= 1995"), (["--max-steps", "10000"], ">= 9500")):
+        result = invoke("eval", run, "--episodes", "1", *options)
+        assert result.exit_code == 0, result.output
+        assert f"[{shown}: no]" in result.stdout, result.stdout

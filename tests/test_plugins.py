@@ -79,6 +79,34 @@ def test_the_reserved_keys_are_the_agent_section_s_fields() -> None:
     assert {field.name for field in dataclasses.fields(AgentConfig)} == RESERVED_KEYS
 
 
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_its_first_run_says_it_is_compiling(
+    engine: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The Python API says so on stderr, as the command line does, naming the module."""
+    import cartpole_q
+    import cartpole_q.numba_cache
+    from cartpole_q.engines import loop_names
+    from cartpole_q.envs.gym import inspect_env
+
+    config = load_config(overrides={**SETTINGS, "engine": engine, "train.episodes": 3})
+    cartpole_q.train(config, final_eval=False)  # compiled now, if it was not
+    names = loop_names(config, inspect_env(config), engine)
+    assert all(cartpole_q.numba_cache.is_cached(name) for name in names)
+    capsys.readouterr()
+    cartpole_q.train(config, final_eval=False)
+    assert capsys.readouterr().err == ""  # cached: nothing to say
+
+    monkeypatch.setattr(cartpole_q.numba_cache, "is_cached", lambda name: False)
+    cartpole_q.train(config, final_eval=False)
+    assert capsys.readouterr().err == (
+        f"compiling the training loop for {NAME} on CartPole-v1 ({engine} engine): once per "
+        f"version of its module {plugin_algorithm.__name__}, up to a minute...\n"
+    )
+    cartpole_q.train(config, final_eval=False, quiet=True)
+    assert capsys.readouterr().err == ""
+
+
 def test_the_command_line_trains_it(tmp_path: Path) -> None:
     config = write_yaml(
         tmp_path / "plugin.yaml",

@@ -273,6 +273,118 @@ def test_train_takes_a_path_a_name_or_a_mapping(tmp_path: Path) -> None:
     assert cartpole_q.train("sutton_barto", final_eval=False).config.name == "sutton-barto"
 
 
+# -- a real signal while an evaluation plays ----------------------------------------------
+
+
+def _signal_in_evaluation(monkeypatch: pytest.MonkeyPatch, which: int) -> list[int]:
+    """A real SIGINT to this process inside the ``which``-th evaluation a stop may cut (1-based).
+
+    It is sent when that evaluation first asks whether to stop (after its first chunk of
+    greedy episodes), and the question is answered only once the command's own handler has
+    seen it. Returns the list the evaluations' episode counts are appended to.
+    """
+    import cartpole_q.training as training
+
+    make_engine = training.make_engine
+    asked: list[int] = []
+
+    def with_signal(should_stop):  # type: ignore[no-untyped-def]
+        sent = False
+
+        def look() -> bool:
+            nonlocal sent
+            if not sent:
+                sent = True
+                os.kill(os.getpid(), signal.SIGINT)
+                deadline = time.monotonic() + 10
+                while not should_stop() and time.monotonic() < deadline:
+                    time.sleep(0.001)  # until the handler has run
+            return bool(should_stop())
+
+        return look
+
+    def engine(*args, **kwargs):  # type: ignore[no-untyped-def]
+        made = make_engine(*args, **kwargs)
+        evaluate = made.evaluate
+
+        def evaluate_with_signal(q, episodes, seed, should_stop=None):  # type: ignore[no-untyped-def]
+            if should_stop is not None:
+                asked.append(episodes)
+                if len(asked) == which:
+                    should_stop = with_signal(should_stop)
+            return evaluate(q, episodes, seed, should_stop)
+
+        made.evaluate = evaluate_with_signal
+        return made
+
+    monkeypatch.setattr(training, "make_engine", engine)
+    return asked
+
+
+def _train_args(overrides: dict, out: Path) -> list[str]:
+    return ["train", *(f"--set={key}={value}" for key, value in overrides.items()), "--out",
+            str(out), "-q"]  # fmt: skip
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_a_signal_in_the_final_evaluation_stops_it_and_resume_finishes_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, engine: str
+) -> None:
+    # Solves (about episode 170) and stops there: no checkpoint is due before the evaluation.
+    overrides = {"engine": engine, "seed": 1, "train.eval_every": 0, "eval.episodes": 250}
+    reference = _reference(tmp_path, overrides)
+    run = tmp_path / "run"
+    asked = _signal_in_evaluation(monkeypatch, which=1)
+    result = CliRunner().invoke(app, _train_args(overrides, run), catch_exceptions=False)
+
+    assert asked == [250]
+    assert result.exit_code == 130, result.output
+    assert f"interrupted: resume with `cartpole-q train --resume {run}`" in result.stderr
+    summary = json.loads((run / "summary.json").read_text())
+    expected = json.loads((reference / "summary.json").read_text())
+    assert (
+        summary["interrupted"] is True and summary["solved_episode"] == expected["solved_episode"]
+    )
+    assert summary["eval"]["interrupted"] is True and summary["eval"]["episodes"] == 100
+    for name in RESULT_FILES:  # what training had finished is all there
+        assert (run / name).read_bytes() == (reference / name).read_bytes(), name
+    assert (run / rundir.CHECKPOINT_FILE).is_file()
+
+    monkeypatch.undo()
+    resumed = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
+    assert resumed.exit_code == 0, resumed.output
+    _assert_same_results(run, reference)
+    assert "interrupted" not in json.loads((run / "summary.json").read_text())["eval"]
+
+
+def test_a_signal_in_a_periodic_evaluation_drops_it_and_resume_plays_it_again(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    overrides = {
+        "seed": 2, "train.episodes": 40, "train.stop_when_solved": False,
+        "train.eval_every": 10, "train.eval_episodes": 250, "train.checkpoint_every": 0,
+        "eval.episodes": 150,
+    }  # fmt: skip
+    reference = _reference(tmp_path, overrides)
+    run = tmp_path / "run"
+    asked = _signal_in_evaluation(monkeypatch, which=2)  # the evaluation after episode 20
+    result = CliRunner().invoke(app, _train_args(overrides, run), catch_exceptions=False)
+
+    assert asked == [250, 250, 150]  # two periodic evaluations, then the final one
+    assert result.exit_code == 130, result.output
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["episodes"] == 20
+    assert summary["eval"]["episodes"] == 100 and summary["eval"]["interrupted"] is True
+    assert [row.split(",")[0] for row in (run / "evaluations.csv").read_text().split()[1:]] == [
+        "10"
+    ]
+
+    monkeypatch.undo()
+    resumed = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
+    assert resumed.exit_code == 0, resumed.output
+    _assert_same_results(run, reference)
+
+
 # -- real signals, in a subprocess ---------------------------------------------------------
 
 # Long enough that a signal sent at the first checkpoint lands in training on a fast machine.
@@ -355,6 +467,43 @@ def test_sigint_or_sigterm_completes_the_run_directory_and_exits_130(
     )
     assert resumed.returncode == 0, resumed.stderr
     _assert_same_results(run, _reference_of(config, tmp_path))
+
+
+@pytest.mark.slow
+def test_sigint_in_a_long_final_evaluation_ends_it_within_seconds(tmp_path: Path) -> None:
+    """Two million greedy episodes (tens of seconds): a SIGINT ends them, the run is kept."""
+    config = write_yaml(
+        tmp_path / "long-eval.yaml",
+        {
+            # The run's only checkpoint is written as training ends, right before the evaluation.
+            "train": {"episodes": 200, "stop_when_solved": False, "checkpoint_every": 200,
+                      "eval_every": 0},
+            "eval": {"episodes": 2_000_000},
+        },
+    )  # fmt: skip
+    run = tmp_path / "run"
+    process = subprocess.Popen(_command("train", "-c", config, "--out", run, "-q"),
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)  # fmt: skip
+    _wait_for(run / rundir.CHECKPOINT_FILE)
+    time.sleep(0.5)  # into the evaluation
+    os.killpg(process.pid, signal.SIGINT)  # as Ctrl-C does
+    sent = time.monotonic()
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == 130, stderr
+    assert time.monotonic() - sent < 10, "the evaluation should end within seconds"
+    assert "Traceback" not in stderr and stderr.count("SIGINT: stopping") == 1, stderr
+    summary = json.loads((run / "summary.json").read_text())
+    assert summary["interrupted"] is True and summary["episodes"] == 200
+    assert summary["eval"]["interrupted"] is True
+    assert 100 <= summary["eval"]["episodes"] < 2_000_000
+    reference = tmp_path / "reference"
+    quick = write_yaml(
+        tmp_path / "quick.yaml", {**yaml.safe_load(config.read_text()), "eval": {"episodes": 1}}
+    )
+    assert subprocess.run(_command("train", "-c", quick, "--out", reference, "-q")).returncode == 0
+    for name in ("q_table.npy", "visits.npy", "metrics.csv"):
+        assert (run / name).read_bytes() == (reference / name).read_bytes(), name
 
 
 def _reference_of(config: Path, tmp_path: Path) -> Path:

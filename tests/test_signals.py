@@ -8,6 +8,7 @@ they have been orphaned.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -54,13 +55,18 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return parent
 
 
-def _start(tmp_path: Path, *args: object) -> subprocess.Popen[bytes]:
-    """Start ``cartpole-q ARGS`` in a new session; its output goes to files in ``tmp_path``."""
+def _start(
+    tmp_path: Path, *args: object, env: dict[str, str] | None = None
+) -> subprocess.Popen[bytes]:
+    """Start ``cartpole-q ARGS`` in a new session; its output goes to files in ``tmp_path``.
+
+    ``env`` replaces the environment (default: this one, so the numba cache stays warm).
+    """
     with (tmp_path / "stdout").open("wb") as out, (tmp_path / "stderr").open("wb") as err:
         return subprocess.Popen(
             [sys.executable, "-m", "cartpole_q", *map(str, args)],
             stdout=out, stderr=err, start_new_session=True, cwd=tmp_path,
-            env={**os.environ},  # the current numba cache (XDG_CACHE_HOME) stays warm
+            env=env if env is not None else {**os.environ},
         )  # fmt: skip
 
 
@@ -194,6 +200,40 @@ def test_multi_seed_eval_ends_on_signals(
     time.sleep(0.5)  # into their imports or their episodes
     _signal(process, signum, count, group)
     _assert_ends_cleanly(process, tmp_path)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    "algorithms", [["q_learning"], ["q_learning", "sarsa"]], ids=["one-loop", "two-loops"]
+)
+def test_a_signal_while_a_sweep_compiles_ends_it_within_a_second_or_two(
+    tmp_path: Path, algorithms: list[str]
+) -> None:
+    """On an empty numba cache a sweep compiles its loops first, for tens of seconds.
+
+    A Ctrl-C then abandons them: the command answers once, exits 130 at once, and no
+    process it started (workers, the child compiling beside one) survives it.
+    """
+    sweep = write_yaml(
+        tmp_path / "s.yaml",
+        {"base": {"train": {"episodes": 5}}, "grid": {"agent.algorithm": algorithms},
+         "seeds": "0-1"},
+    )  # fmt: skip
+    cold = {key: value for key, value in os.environ.items() if key != "NUMBA_CACHE_DIR"}
+    cold["XDG_CACHE_HOME"] = str(tmp_path / "empty-cache")
+    process = _start(tmp_path, "sweep", sweep, "--out", "out", "--workers", 2, env=cold)
+    stderr = tmp_path / "stderr"
+    _wait_until(lambda: "compiling" in stderr.read_text(), "the compile notice")
+    time.sleep(1.0)  # into the compilation, which takes several seconds at least
+    _signal(process, signal.SIGINT, 1, group=True)
+    sent = time.monotonic()
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        process.wait(timeout=30)
+    took = time.monotonic() - sent
+    text = _assert_ends_cleanly(process, tmp_path)
+    assert took < 5, f"it took {took:.1f} s to stop"
+    assert text.count("SIGINT: stopping") == 1, text
+    assert "cartpole-q sweep --resume out" in text
 
 
 # -- an interrupted multi-seed run: what its summary and its evaluation say ---------------

@@ -138,6 +138,13 @@ class EngineChoice(StrEnum):
     gymnasium = "gymnasium"
 
 
+class PlayChoice(StrEnum):
+    """The ``eval --engine`` values: where the greedy episodes are played."""
+
+    gymnasium = "gymnasium"
+    numba = "numba"
+
+
 class BackendChoice(StrEnum):
     """The ``--backend`` values."""
 

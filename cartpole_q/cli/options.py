@@ -33,7 +33,7 @@ SetValues = Annotated[
         "--set",
         metavar="KEY=VALUE",
         help="Set any config key by its dotted path, the value read as YAML, e.g. "
-        "--set agent.alpha=5e-4 --set discretization.bins=[1,1,6,12]. Repeatable.",
+        "--set agent.alpha=5e-4 --set 'discretization.bins=[1, 1, 6, 12]'. Repeatable.",
     ),
 ]
 Workers = Annotated[

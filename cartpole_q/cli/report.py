@@ -28,10 +28,11 @@ def _rows_single(run_dir: Path, summary: RunSummary) -> list[tuple[str, str]]:
         ),
     ]
     if evaluation is not None:
+        cut = ", cut short by the stop" if evaluation.interrupted else ""
         rows.append((
             "greedy eval",
             f"mean {evaluation.mean:.1f} +/- {evaluation.std:.1f} over {evaluation.episodes} "
-            f"episodes (min {evaluation.min:g}, max {evaluation.max:g})",
+            f"episodes (min {evaluation.min:g}, max {evaluation.max:g}{cut})",
         ))  # fmt: skip
     if greedy is not None:
         rows.append((
@@ -152,17 +153,18 @@ def eval_line(
     ...     "episodes": 100, "seed": 7}, 475.0)
     'runs/a: greedy mean 500.00 +/- 0.00 (min 500, max 500) over 100 episodes from seed 7 [>= 475: yes]'
     >>> eval_line(Path("a"), {"mean": 9.0, "std": 0.0, "min": 9, "max": 9, "episodes": 1,
-    ...     "seed": 0}, None, {"physics": {"length": 0.75}, "max_steps": 1000})
-    'a: greedy mean 9.00 +/- 0.00 (min 9, max 9) over 1 episodes from seed 0, under physics length=0.75, time limit 1000'
+    ...     "seed": 0, "played_in": "twin"}, None, {"physics": {"length": 0.75}, "max_steps": 1000})
+    'a: greedy mean 9.00 +/- 0.00 (min 9, max 9) over 1 episodes from seed 0 on the compiled twin, under physics length=0.75, time limit 1000'
     """
     verdict = ""
     if threshold is not None:
         reached = is_success(report["mean"], threshold)
         verdict = f" [>= {threshold:g}: {'yes' if reached else 'no'}]"
+    where = " on the compiled twin" if report.get("played_in") == "twin" else ""
     return (
         f"{run_dir}: greedy mean {report['mean']:.2f} +/- {report['std']:.2f} "
         f"(min {report['min']:g}, max {report['max']:g}) over {report['episodes']} episodes "
-        f"from seed {report['seed']}{conditions_text(conditions)}{verdict}"
+        f"from seed {report['seed']}{where}{conditions_text(conditions)}{verdict}"
     )
 
 
@@ -180,6 +182,10 @@ def conditions_text(conditions: dict[str, Any] | None) -> str:
     return ", under " + ", ".join(parts)
 
 
+PLACES = {"gymnasium": "in gymnasium.make", "twin": "on the compiled twin"}
+"""where greedy episodes were played (``played_in``), in words"""
+
+
 def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
     """Lines reporting the greedy evaluation of every seed of a multi-seed run or sweep point.
 
@@ -190,6 +196,7 @@ def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
         f"seed {run['run_seed']}: mean {run['mean']:.2f} +/- {run['std']:.2f} (min {run['min']:g}, max {run['max']:g})"
         for run in result["runs"]
     ]
+    where = result.get("played_in") or "gymnasium"
     finished = "finished " if result.get("note") else ""
     count = len(result["runs"])
     threshold = result["reward_threshold"]
@@ -204,7 +211,7 @@ def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
     else:
         reached = f"{count} {finished}seeds (no reward threshold)"
     lines.append(
-        f"{parent}: {reached} over {result['episodes']} episodes each in gymnasium.make"
+        f"{parent}: {reached} over {result['episodes']} episodes each {PLACES[where]}"
         f"{conditions_text(result.get('conditions'))}; mean of means {result['mean']:.2f}, "
         f"lowest {result['min']:.2f}"
     )

@@ -64,7 +64,7 @@ def train(
         typer.Option(
             metavar="DIR",
             help="Run directory to create; it must not exist or be empty.",
-            show_default="runs/<name>-<YYYYmmdd-HHMMSS>",
+            show_default="runs/<name>-<date>-<time>",
         ),
     ] = None,
     resume: Annotated[
@@ -110,7 +110,7 @@ def train(
         typer.Option(
             "--tensorboard",
             help="Also write TensorBoard event files into RUN/tensorboard/ (sets "
-            '`train.tensorboard`; needs `pip install "cartpole-q[tensorboard]"`).',
+            '`train.tensorboard`; needs `pip install "cartpole-q\\[tensorboard]"`).',
         ),
     ] = False,
 ) -> None:

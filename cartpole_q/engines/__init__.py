@@ -123,15 +123,23 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
 
     Returns:
         A sentence (the first run on a machine compiles for several seconds), or ``None``
-        when the loop is cached.
+        when the loop is cached. An algorithm registered from outside the package (a
+        plug-in) compiles once per version of its module, for longer: nothing of it is
+        cached with the package's loops.
     """
     from cartpole_q.numba_cache import is_cached
+    from cartpole_q.rl.algorithms import get as get_algorithm
 
     if all(is_cached(name) for name in loop_names(config, env_info, engine)):
         return None
+    module = get_algorithm(config.agent.algorithm).step.__module__
+    if module.partition(".")[0] != __name__.partition(".")[0]:
+        when = f"once per version of its module {module}, up to a minute"
+    else:
+        when = "once per machine and version, a few seconds"
     return (
         f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "
-        f"({engine} engine): once per machine and version, a few seconds..."
+        f"({engine} engine): {when}..."
     )
 
 

@@ -9,6 +9,7 @@ compiled loops are built per algorithm (see :mod:`cartpole_q.engines.kernel`).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple, Protocol
 
@@ -359,6 +360,41 @@ class TrainingState:
         return self.algorithm.policy(self.tables.q, self.tables.memory)
 
 
+EVAL_CHUNK_EPISODES = 100
+"""greedy episodes an evaluation plays between looks at a stop request (the first chunk is
+always played, so that even a stopped run has an evaluation of its table)"""
+
+
+def played_until_stopped(
+    play: Callable[[int], np.ndarray],
+    episodes: int,
+    should_stop: Callable[[], bool] | None,
+    chunk: int = EVAL_CHUNK_EPISODES,
+) -> np.ndarray:
+    """The returns of ``episodes`` greedy episodes, played ``chunk`` at a time.
+
+    After each chunk, ``should_stop`` is asked; once it says so, the returns of the episodes
+    played so far are returned. ``play(n)`` plays the next ``n`` episodes, continuing the
+    environment's random stream, so the chunks give exactly the returns of one long call.
+
+    >>> stream = iter(range(1000))
+    >>> play = lambda n: np.array([next(stream) for _ in range(n)], dtype=float)
+    >>> played_until_stopped(play, 250, lambda: True).size
+    100
+    >>> played_until_stopped(play, 250, None)[:3].tolist()
+    [100.0, 101.0, 102.0]
+    """
+    parts: list[np.ndarray] = []
+    played = 0
+    while played < episodes:
+        count = min(chunk, episodes - played)
+        parts.append(play(count))
+        played += count
+        if should_stop is not None and played < episodes and should_stop():
+            break
+    return np.concatenate(parts) if parts else np.zeros(0, dtype=np.float64)
+
+
 class Engine(Protocol):
     """Drives an environment around the shared compiled step functions."""
 
@@ -375,8 +411,18 @@ class Engine(Protocol):
         """
         ...
 
-    def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
-        """Return the greedy policy's returns over ``episodes`` episodes from ``seed``."""
+    def evaluate(
+        self,
+        q: np.ndarray,
+        episodes: int,
+        seed: int,
+        should_stop: Callable[[], bool] | None = None,
+    ) -> np.ndarray:
+        """Return the greedy policy's returns over ``episodes`` episodes from ``seed``.
+
+        With ``should_stop``, fewer when it asks to stop: the episodes played before
+        (see :func:`played_until_stopped`).
+        """
         ...
 
     def warm_up(self, state: TrainingState) -> None:

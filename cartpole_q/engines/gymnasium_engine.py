@@ -7,6 +7,7 @@ loop (see :mod:`cartpole_q.engines.kernel`).
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -225,14 +226,21 @@ class GymnasiumEngine:
         if self._has_end:
             self._end(scratch, 0.0, 0.0)
 
-    def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
+    def evaluate(
+        self,
+        q: np.ndarray,
+        episodes: int,
+        seed: int,
+        should_stop: Callable[[], bool] | None = None,
+    ) -> np.ndarray:
         """Play the greedy policy in a fresh ``gymnasium.make`` environment."""
         env = make_env(self._config.env)
         try:
             p = self._params
             return play_greedy(
-                env, q, p.grid, episodes, seed, step_cap=self._step_cap, tilings=p.tilings
-            )
+                env, q, p.grid, episodes, seed, step_cap=self._step_cap, tilings=p.tilings,
+                should_stop=should_stop,
+            )  # fmt: skip
         finally:
             env.close()
 

@@ -7,18 +7,25 @@ Q-table and metrics are byte-identical to it; about two hundred times faster.
 from __future__ import annotations
 
 import os
+import signal
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
 
-from cartpole_q.engines.base import AgentParams, TrainingState, loops_played
+from cartpole_q.engines.base import (
+    AgentParams,
+    TrainingState,
+    loops_played,
+    played_until_stopped,
+)
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
 from cartpole_q.numba_cache import is_cached
+from cartpole_q.processes import leave_signals_to_parent
 from cartpole_q.profiles import profile_for
 
 _NO_ERRORS = np.zeros(0, dtype=np.float64)
@@ -149,13 +156,19 @@ class NumbaEngine:
         cache and exits; this process then loads the child's code from there. Where a
         process cannot fork (or has threads, where forking is unsafe), everything is
         compiled here, one after another.
+
+        The child leaves signals to this process (a Ctrl-C to the terminal reaches both: the
+        command answers it once) and dies with it; if this process stops compiling (a second
+        Ctrl-C), the child is killed, not waited for.
         """
         if not hasattr(os, "fork") or threading.active_count() > 1 or not needed:
             return
+        parent = os.getpid()
         child = os.fork()
         if child == 0:  # the child: compile into the cache, then exit without clean-up
             code = 1
             try:
+                leave_signals_to_parent(parent)
                 for greedy in needed[1:]:
                     self._load(state, greedy)
                 self.evaluate(state.tables.q.copy(), 0, 0)
@@ -164,16 +177,30 @@ class NumbaEngine:
                 os._exit(code)
         try:
             self._load(state, needed[0])
+        except BaseException:
+            os.kill(child, signal.SIGKILL)  # its half-compiled loop is worth nothing
+            raise
         finally:
             os.waitpid(child, 0)
 
-    def evaluate(self, q: np.ndarray, episodes: int, seed: int) -> np.ndarray:
+    def evaluate(
+        self,
+        q: np.ndarray,
+        episodes: int,
+        seed: int,
+        should_stop: Callable[[], bool] | None = None,
+    ) -> np.ndarray:
         """Play the greedy policy on the twin, seeded like ``reset(seed=seed)``."""
         env_rng = seeding.np_random(seed)[0]
-        returns: np.ndarray = self._greedy_returns(
-            self._params.hook_table(q), self._params.grid, env_rng, self._greedy_env, episodes
-        )
-        return returns
+        table, grid, env = self._params.hook_table(q), self._params.grid, self._greedy_env
+
+        def play(count: int) -> np.ndarray:
+            returns: np.ndarray = self._greedy_returns(table, grid, env_rng, env, count)
+            return returns
+
+        if should_stop is None:
+            return play(episodes)
+        return played_until_stopped(play, episodes, should_stop)
 
     def env_rng_state(self) -> dict[str, Any]:
         """Return the twin environment's generator state."""

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.engines.base import Grid
+from cartpole_q.engines.base import EVAL_CHUNK_EPISODES, Grid
 from cartpole_q.rl.binning import discrete_index, state_index
 from cartpole_q.rl.tiles import active_tiles, greedy_tile_action
 
@@ -28,6 +28,7 @@ def play_greedy(
     on_frame: FrameCallback | None = None,
     step_cap: int | None = None,
     tilings: int = 1,
+    should_stop: Callable[[], bool] | None = None,
 ) -> np.ndarray:
     """Play the greedy policy of a 2-D ``(n_states, n_actions)`` Q-table.
 
@@ -42,9 +43,11 @@ def play_greedy(
             limit, see :data:`GREEDY_STEP_CAP`); ``None``: only the environment ends it.
         tilings: tile coding's tilings: ``q`` is then the weights ``(T * tiles, n_actions)``
             and the action the argmax of the tiles' sum (see :mod:`cartpole_q.rl.tiles`).
+        should_stop: asked after every :data:`EVAL_CHUNK_EPISODES` episodes; when it says
+            so, play ends there (as :func:`~cartpole_q.engines.base.played_until_stopped`).
 
     Returns:
-        The return of each episode.
+        The return of each episode played.
     """
     # Plain Python lists make the uncompiled binning rule about twice as fast per step.
     low, high, bins = grid.low.tolist(), grid.high.tolist(), grid.bins.tolist()
@@ -73,4 +76,8 @@ def play_greedy(
                 on_frame(env, episode, step)
             if terminated or truncated or (step_cap is not None and step >= step_cap):
                 break
+        played = episode + 1
+        chunk_ended = played % EVAL_CHUNK_EPISODES == 0 and played < episodes
+        if chunk_ended and should_stop is not None and should_stop():
+            return returns[:played]
     return returns

@@ -100,9 +100,11 @@ def compile_all(
         if on_done is not None and line:
             on_done(line)
 
+    # A stop abandons the loops being compiled (compiled in part, they are worth nothing);
+    # the finished ones are in the cache.
     execute(
         _compile, [(job, mapping) for job in jobs], on_item,
-        workers=workers or default_workers(len(jobs)), should_stop=should_stop,
+        workers=workers or default_workers(len(jobs)), should_stop=should_stop, abandon=True,
     )  # fmt: skip
     return done, time.perf_counter() - started
 
@@ -115,14 +117,15 @@ def compile_ahead(
 ) -> int:
     """Compile the distinct loops ``configs`` will run that numba's cache lacks, once each.
 
-    One loop is compiled in this process (worker processes forked later inherit it); several
-    are compiled side by side on up to ``workers`` processes (the runs' workers then load
-    them from the cache).
+    The loops are compiled side by side on up to ``workers`` worker processes (also a single
+    loop: this process stays free to answer a stop); the runs' workers then load them from
+    the cache.
 
     Args:
         configs: the configs of the runs about to start (validated).
         workers: the worker processes the runs will use.
-        should_stop: polled between loops (a loop being compiled is finished first).
+        should_stop: polled about ten times a second; once true, the loops being compiled
+            are abandoned (their processes killed) and this returns at once.
         on_start: told how many loops are about to be compiled (not called for none).
 
     Returns:
@@ -157,7 +160,7 @@ def compile_ahead(
         on_start(len(counted))
     execute(
         _compile_loop, jobs, lambda index, item: None,
-        workers=min(workers, len(jobs)), should_stop=should_stop,
+        workers=min(workers, len(jobs)), should_stop=should_stop, abandon=True,
     )  # fmt: skip
     return len(counted)
 

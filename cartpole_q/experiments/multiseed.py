@@ -111,7 +111,7 @@ def run_seeds(
         items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
         size = chunk_size(len(items), workers)
         chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
-        if len(chunks) > 1:  # compiled once here, not once per worker
+        if len(chunks) > 1:  # compiled once before the workers start, not once per worker
             compile_ahead([config], workers, should_stop)
         execute(
             _train_seeds, chunks, on_item,

@@ -39,6 +39,7 @@ from multiprocessing.process import BaseProcess
 from typing import Any, Protocol
 
 from cartpole_q.errors import ConfigError, UserError
+from cartpole_q.processes import STOP_SIGNALS, leave_signals_to_parent
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.training import Progress
 
@@ -93,6 +94,7 @@ def execute(
     address: str | None = None,
     should_stop: Callable[[], bool] | None = None,
     reporter: Reporter | None = None,
+    abandon: bool = False,
 ) -> bool:
     """Run every job, handing each item to ``on_item(job_index, item)`` as it arrives.
 
@@ -109,6 +111,11 @@ def execute(
         should_stop: polled about ten times a second; once true no job starts any more
             and running local jobs are asked to stop (Ray jobs are cancelled).
         reporter: receives the jobs' progress.
+        abandon: for jobs whose unfinished work is worth nothing (compiling a loop): once
+            ``should_stop`` is true, running local jobs are killed at once instead of asked
+            to stop, and they run in worker processes even with one worker, so that this
+            process answers a stop within a tenth of a second. Items already made are
+            handed on first.
 
     Returns:
         Whether every job started and no stop was requested.
@@ -120,7 +127,7 @@ def execute(
     reporter = reporter or NullReporter()
     if backend == "ray":
         return _execute_ray(function, jobs, on_item, workers, address, should_stop)
-    if workers <= 1:
+    if workers <= 1 and not abandon:
         handle = InProcess(should_stop, reporter)
         for index, job in enumerate(jobs):
             if handle.should_stop():
@@ -128,7 +135,7 @@ def execute(
             for item in items_of(function(handle, *job)):
                 on_item(index, item)
         return not handle.should_stop()
-    started = _run_local(function, jobs, workers, reporter, should_stop, on_item)
+    started = _run_local(function, jobs, max(1, workers), reporter, should_stop, on_item, abandon)
     return started and not (should_stop is not None and should_stop())
 
 
@@ -161,11 +168,15 @@ class InProcess:
 
 _STOP = "stop"
 _JOIN_SECONDS = 5.0
-_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_SIGNALS = STOP_SIGNALS
 
 
 class WorkerError(RuntimeError):
     """A worker process failed in a way that cannot be passed on as its own exception."""
+
+
+class _Abandoned(Exception):
+    """A stop asked to abandon the running jobs (see ``execute(..., abandon=True)``)."""
 
 
 def _run_local(
@@ -175,6 +186,7 @@ def _run_local(
     reporter: Reporter,
     should_stop: Callable[[], bool] | None,
     on_item: Callable[[int, Any], None],
+    abandon: bool = False,
 ) -> bool:
     """Run the jobs in worker processes; return whether every job started."""
     if not jobs:
@@ -200,7 +212,12 @@ def _run_local(
                 conns.append(parent_end)
                 process.start()
                 child_end.close()
-        started = _dispatch(function, jobs, conns, processes, reporter, should_stop, on_item)
+        started = _dispatch(
+            function, jobs, conns, processes, reporter, should_stop, on_item, abandon
+        )
+    except _Abandoned:
+        _end_workers(processes, conns, kill=True)
+        return False
     except BaseException:
         _end_workers(processes, conns, kill=True)
         raise
@@ -230,8 +247,14 @@ def _dispatch(
     reporter: Reporter,
     should_stop: Callable[[], bool] | None,
     on_item: Callable[[int, Any], None],
+    abandon: bool = False,
 ) -> bool:
-    """Hand out the jobs to idle workers and pass their messages on until none is busy."""
+    """Hand out the jobs to idle workers and pass their messages on until none is busy.
+
+    Raises:
+        _Abandoned: ``abandon`` and a stop was asked for (the items that arrived are handed
+            on first).
+    """
     idle = list(range(len(conns)))
     busy: dict[int, int] = {}  # worker -> job
     arrived: list[tuple[int, Any]] = []  # items on_item has not seen yet
@@ -240,6 +263,10 @@ def _dispatch(
     while True:
         if not stopping and should_stop is not None and should_stop():
             stopping = True
+            if abandon:
+                for job, item in arrived:
+                    on_item(job, item)
+                raise _Abandoned
             for worker in busy:
                 _send(conns[worker], _STOP)
         while idle and not stopping and next_job < len(jobs):
@@ -354,11 +381,7 @@ def _signals_ignored() -> Iterator[None]:
 
 def _worker_main(conn: Connection, parent_pid: int) -> None:
     """A worker's life: ignore signals, die with the parent, run jobs until told to end."""
-    for signum in _SIGNALS:
-        signal.signal(signum, signal.SIG_IGN)  # also discards one that arrived while blocked
-    if hasattr(signal, "pthread_sigmask"):
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(_SIGNALS))
-    _die_with_parent(parent_pid)
+    leave_signals_to_parent(parent_pid)
     while True:
         try:
             message = conn.recv()
@@ -387,20 +410,6 @@ def _worker_main(conn: Connection, parent_pid: int) -> None:
             conn.send(reply)
         except OSError:
             return
-
-
-def _die_with_parent(parent_pid: int) -> None:
-    """On Linux, ask the kernel to SIGKILL this process when its parent dies."""
-    if not sys.platform.startswith("linux"):
-        return
-    try:
-        import ctypes
-
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() != parent_pid:
-        os._exit(1)  # the parent died before the request took effect
 
 
 class Worker:

@@ -31,7 +31,9 @@ def cli_reference() -> str:
     # The page's own title is the only "#" heading: start the app's section one level down.
     with typer.Context(command, info_name="cartpole-q") as context:
         text = get_docs_for_click(obj=command, ctx=context, name="cartpole-q", indent=1)
-    return text.strip() + "\n"
+    # A literal bracket in a help text is written `\[` for rich (`cartpole-q\[video]`);
+    # Typer's Markdown keeps the backslash, which a code span would show.
+    return text.replace("\\[", "[").strip() + "\n"
 
 
 def on_page_markdown(markdown: str, page: Any, **kwargs: Any) -> str:
