@@ -90,7 +90,7 @@ def test_an_algorithms_own_keys_get_rows_from_its_params() -> None:
         "| `agent.behaviour` | `0.2` | the fixed exploration rate it acts with ([0, 1]; "
         "`fixed_behaviour_expected_sarsa` only) |"
     ) in table
-    assert "`off_policy_monte_carlo` or `fixed_behaviour_expected_sarsa`" in table
+    assert "`true_online_td_lambda` or `fixed_behaviour_expected_sarsa`" in table  # the last
     # the same Param checks the value
     with pytest.raises(ConfigError, match=r"agent\.behaviour: must be in \[0, 1\], got 2\.$"):
         load_config(
