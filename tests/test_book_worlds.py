@@ -36,6 +36,7 @@ IDS = [world.id for world in WORLDS]
 DETERMINISTIC = [
     "cartpole_q/WindyGridworld-v0", "cartpole_q/KingsWindyGridworld-v0", "cartpole_q/DynaMaze-v0",
     "cartpole_q/BlockingMaze-v0", "cartpole_q/ShortcutMaze-v0", "cartpole_q/RandomWalk-v0",
+    "cartpole_q/RandomWalk5-v0",
 ]  # fmt: skip
 
 
@@ -74,6 +75,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/BlockingMaze-v0": (54, 4, 10_000),
         "cartpole_q/ShortcutMaze-v0": (54, 4, 10_000),
         "cartpole_q/MaximizationBias-v0": (3, 10, None),
+        "cartpole_q/RandomWalk5-v0": (7, 2, 1_000),
         "cartpole_q/RandomWalk-v0": (21, 2, 1_000),
     }
     assert set(expected) == set(IDS)
@@ -277,6 +279,16 @@ def test_the_random_walk_is_the_books() -> None:
     assert world.reset(seed=0)[0] == 10
     assert world.P[1][0] == [(1.0, 0, -1.0, True)] and world.P[19][1] == [(1.0, 20, 1.0, True)]
     assert world.P[10][0] == [(1.0, 9, 0.0, False)] and world.P[10][1] == [(1.0, 11, 0.0, False)]
+
+
+def test_the_five_state_walk_is_example_6_2s() -> None:
+    """States A-E are 1-5, started in C; the left end pays 0, the right end +1."""
+    world = _make("cartpole_q/RandomWalk5-v0").unwrapped
+    assert world.reset(seed=0)[0] == 3
+    assert world.P[1][0] == [(1.0, 0, 0.0, True)] and world.P[5][1] == [(1.0, 6, 1.0, True)]
+    assert world.P[3][0] == [(1.0, 2, 0.0, False)] and world.P[0][1] == [(1.0, 0, 0.0, True)]
+    with pytest.raises(ValueError, match="odd number of states"):
+        _make("cartpole_q/RandomWalk5-v0", states=4)
 
 
 # -- the tool: maps, training, resuming -----------------------------------------------------------

@@ -249,5 +249,5 @@ def test_metrics_csv_must_have_the_column_its_config_names(tmp_path: Path) -> No
         "must start with the header episode,return,length,epsilon,alpha,info_left_from_a "
         "(its config's train.info_metric is left_from_a)" in " ".join(result.output.split())
     )
-    metrics, info = rundir.read_metric_columns(run / "metrics.csv", None)
-    assert info is None and metrics.returns.size == 60
+    metrics, info, errors = rundir.read_metric_columns(run / "metrics.csv", None)
+    assert info is None and errors is None and metrics.returns.size == 60

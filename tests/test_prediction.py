@@ -78,6 +78,22 @@ def test_a_prediction_run_writes_v_and_its_errors(tmp_path: Path, engine: str) -
     assert run.q_table[..., 0].tobytes() == values.tobytes()
 
 
+def test_a_prediction_run_has_no_policy_to_play_but_its_curves_plot(tmp_path: Path) -> None:
+    out = tmp_path / "run"
+    trained = invoke(
+        "train", "--set", f"env.id={WALK5['env.id']}", "--set", "discretization=null",
+        "--set", "agent.algorithm=td", "--episodes", "20", "--out", str(out), "-q",
+    )  # fmt: skip
+    assert trained.exit_code == 0, trained.output
+    for args in (("eval", out), ("plot", out, "--policy")):
+        refused = invoke(*args)
+        assert refused.exit_code == 2, refused.output
+        assert "is a prediction run (td)" in refused.stderr and "Traceback" not in refused.output
+    plotted = invoke("plot", out, "--out", tmp_path / "curves.png")
+    assert plotted.exit_code == 0, plotted.output
+    assert (tmp_path / "curves.png").stat().st_size > 0
+
+
 @pytest.mark.parametrize("engine", ["numba", "gymnasium"])
 def test_an_interrupted_prediction_run_resumes_byte_identically(
     tmp_path: Path, engine: str

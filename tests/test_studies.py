@@ -310,7 +310,8 @@ def test_is_cached_finds_the_compiled_loop() -> None:
     train(load_config(overrides={"train.episodes": 1}))  # compiles or loads it
     twin = twin_for("CartPole-v1")
     assert twin is not None
-    assert is_cached(f"train_episodes__{get('q_learning').key}__{twin.key}")
+    # one exploring episode: the exploring loop (engines.kernel: one loop per kind of episode)
+    assert is_cached(f"train_exploring__{get('q_learning').key}__{twin.key}")
     assert not is_cached("no_such_function_anywhere")
 
 
@@ -416,6 +417,8 @@ def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
     assert "2 training loops compiled or loaded" in result.stdout
     twin = twin_for(load_config().env.id)
     assert twin is not None
-    assert is_cached(f"train_episodes__{get('q_learning').key}__{twin.key}")
+    # the default's epsilon reaches 0 at episode 90: both loops
+    for kind in ("exploring", "greedy"):
+        assert is_cached(f"train_{kind}__{get('q_learning').key}__{twin.key}")
     assert is_cached(f"next_step__{get('q_learning').key}__box")
     assert_refused(invoke("compile", "-c", "default", "--all"), "not both")

@@ -120,11 +120,19 @@ def check_tables(run_set: RunSet) -> EnvInfo:
 
     Raises:
         ConfigError: the environment cannot be made.
-        RunError: a table's shape is not ``(*states, n_actions)`` of the environment.
+        RunError: a table's shape is not ``(*states, n_actions)`` of the environment, or the
+            run is a prediction run (its ``V`` is no policy to play or draw).
     """
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.evaluation import check_q_table_shape
 
+    if any(run.predicts for run in run_set.runs):
+        raise RunError(
+            f"{run_set.path}: is a prediction run ({run_set.config.agent.algorithm}): it "
+            "learnt the state values V of agent.policy (v_table.npy), not a policy, so there "
+            "is no greedy policy to evaluate, map or test. `cartpole-q plot "
+            f"{run_set.path}` draws its curves; metrics.csv holds its rms_error."
+        )
     info = inspect_env(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
     for run in run_set.runs:
         file = run.path / rundir.Q_TABLE_FILE  # a sweep point's seeds have none of their own
