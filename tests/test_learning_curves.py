@@ -177,6 +177,8 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "scale": "x"}, 'figure.scale: "x" is not a int or float'),
         ({"metric": "length", "smooth": 0}, "figure.smooth: must be at least 1"),
         ({"metric": "length", "file": "../f.png"}, "figure.file"),
+        ({"metric": "length", "file": "points.svg"}, "would write points.csv beside it"),
+        ({"metric": "length", "file": "sweep.png"}, "would write sweep.csv beside it"),
         ([1], "figure: must be a mapping"),
         ({"metric": "length", "against": "agent.gamma"}, "figure.against: 'agent.gamma' is not"),
         ({"metric": "length", "y_min": 5, "y_max": 5}, "figure.y_min: must be below figure.y_max"),
