@@ -469,7 +469,8 @@ def policy_figure(
     ):
         image = axes.imshow(data, origin="lower", aspect="auto", extent=extent, cmap=cmap,
                             norm=norm, interpolation="nearest")  # fmt: skip
-        figure.data.panel(name).cells(series, columns, rows, values)
+        if series != "visits" or visits is not None:  # no visits: the panel stays blank
+            figure.data.panel(name).cells(series, columns, rows, values)
         axes.set_title(name)
         axes.set_xlabel(names[d_col])
         axes.set_ylabel(names[d_row])

@@ -186,6 +186,10 @@ def test_a_policy_map_writes_each_cell_at_its_centre() -> None:
     assert column(values, "value")[:5].tolist() == [1.0, 2.0, 5.0, 3.0, 7.0]
     visits_rows = series(rows, "training visits (log scale)")["visits"]
     assert [row["value"] for row in visits_rows] == ["2", "2", "2", "2", "2", ""]
+    # a table without visit counts (tiles) draws a blank visits panel: no rows for it
+    blank = policy_figure(q, None, (2, 3), [0] * 4, [1] * 4, list("abcd"), "t")
+    panels = {row["panel"] for row in csv.DictReader(blank.data.csv_text().splitlines())}
+    assert panels == {"greedy action", "state value max_a Q"}
 
 
 def test_a_figure_that_cannot_be_written_leaves_its_old_data(tmp_path: Path) -> None:
