@@ -240,7 +240,7 @@ def test_a_figure_against_an_axis_draws_each_points_mean_over_its_first_episodes
 
 
 def test_y_limits_end_the_axis_where_the_book_does() -> None:
-    """``figure.y_min``/``y_max``: Fig. 6.3's axis stops at -100 as the book's does."""
+    """``figure.y_min``/``y_max``: Example 6.6's axis stops at -100 as the book's does."""
     from cartpole_q.figures import MetricBand, metric_curve_figure
 
     values = np.array([[-1700.0, -50.0, -25.0], [-1500.0, -40.0, -30.0]])
