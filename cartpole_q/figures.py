@@ -1,14 +1,17 @@
 """Figures, drawn with matplotlib's object API (no pyplot state) on the Agg canvas.
 
-The ``*_figure`` functions take arrays and return a :class:`matplotlib.figure.Figure`;
-:func:`plot_rewards` and :func:`plot_policy` are what ``cartpole-q plot`` runs: they load
-run directories, draw, and write the figure (PNG, SVG or PDF) atomically.
+The ``*_figure`` functions take arrays and return a :class:`DataFigure`: a matplotlib figure
+that carries the numbers it draws (:class:`FigureData`), recorded by the same code that
+draws them, so that every figure file goes out with its data beside it (``<figure>.csv``,
+see :mod:`cartpole_q.store.figure_file`). ``cartpole-q plot`` and the studies load run
+directories, draw with these functions, and write both.
 """
 
 from __future__ import annotations
 
+import csv
 import io
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,6 +33,129 @@ POLICY_SIZE = (13.5, 4.2)
 BOOTSTRAP_RESAMPLES = 1000
 FIGURE_FORMATS = {".png": "png", ".svg": "svg", ".pdf": "pdf"}
 """the extensions ``plot --out`` writes, and matplotlib's format for each"""
+
+
+# -- the numbers a figure draws ------------------------------------------------------------
+
+DATA_COLUMNS = ("panel", "series", "x", "y", "y_low", "y_high", "value")
+"""the columns of a figure's data, ``<figure>.csv``"""
+
+Cell = float | int | str | None
+"""one value of a figure's data: a number, a category (a sweep axis's value), or nothing"""
+
+
+class FigureData:
+    """The numbers a figure draws, in the tidy long format of ``<figure>.csv``.
+
+    One row per plotted point, columns :data:`DATA_COLUMNS`: the ``panel`` (its title; empty
+    on a one-panel figure), the ``series`` (a curve, a band, a line or a map, named as its
+    legend names it), the point's ``x`` and ``y``, the interval drawn around it (``y_low``,
+    ``y_high``, empty where none is drawn); a coloured cell (a heatmap, a policy map) is a
+    row with ``x``, ``y`` and its ``value``. A horizontal reference line is one row with an
+    empty ``x``, a vertical one a row with an empty ``y``. Numbers are written with
+    ``repr``, so they read back as the very floats drawn; a value not drawn (NaN, a masked
+    cell) is an empty cell. Rows keep the order the figure draws them in.
+
+    >>> data = FigureData()
+    >>> data.panel("").line("mean", [1, 2], [0.5, float("nan")], low=[0.25, None], high=[1.0, None])
+    >>> data.panel("").level("threshold", 475.0)
+    >>> print(data.csv_text(), end="")
+    panel,series,x,y,y_low,y_high,value
+    ,mean,1,0.5,0.25,1.0,
+    ,mean,2,,,,
+    ,threshold,,475.0,,,
+    """
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[str, str, Cell, Cell, Cell, Cell, Cell]] = []
+
+    def panel(self, name: str) -> PanelData:
+        """A recorder for the panel titled ``name`` (``""``: the figure's only panel)."""
+        return PanelData(self, name)
+
+    def csv_text(self) -> str:
+        """The rows as CSV text (Unix line ends), the header first."""
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        writer.writerow(DATA_COLUMNS)
+        writer.writerows([_data_cell(value) for value in row] for row in self.rows)
+        return buffer.getvalue()
+
+
+@dataclass(frozen=True)
+class PanelData:
+    """What one panel of a figure draws, recorded into its :class:`FigureData`."""
+
+    data: FigureData
+    name: str
+
+    def line(
+        self,
+        series: str,
+        x: Iterable[Cell],
+        y: Iterable[Cell],
+        low: Iterable[Cell] | None = None,
+        high: Iterable[Cell] | None = None,
+    ) -> None:
+        """Points of a curve (a band's centre with its ``low`` and ``high`` edges), in order."""
+        xs, ys = list(x), list(y)
+        lows = [None] * len(xs) if low is None else list(low)
+        highs = [None] * len(xs) if high is None else list(high)
+        rows = zip(xs, ys, lows, highs, strict=True)
+        self.data.rows.extend((self.name, series, a, b, c, d, None) for a, b, c, d in rows)
+
+    def level(self, series: str, y: float) -> None:
+        """A horizontal line at ``y`` (a threshold, a reference): ``x`` stays empty."""
+        self.data.rows.append((self.name, series, None, y, None, None, None))
+
+    def mark(self, series: str, x: float) -> None:
+        """A vertical line at ``x`` (a solve episode, a trained value): ``y`` stays empty."""
+        self.data.rows.append((self.name, series, x, None, None, None, None))
+
+    def cells(self, series: str, x: Sequence[Cell], y: Sequence[Cell], values: np.ndarray) -> None:
+        """A map: ``values[i, j]`` coloured at ``(x[j], y[i])``, row by row; masked: empty.
+
+        Integer values (actions, counts) stay integers.
+        """
+        shown = np.ma.asarray(values)
+        if shown.dtype.kind == "f":
+            shown = np.ma.masked_invalid(shown)
+        if shown.shape != (len(y), len(x)):
+            raise ValueError(f"cells: values of shape {shown.shape} for {len(y)} x {len(x)}")
+        mask = np.ma.getmaskarray(shown)
+        for i, row_y in enumerate(y):
+            for j, column_x in enumerate(x):
+                value = None if mask[i, j] else shown.data[i, j].item()
+                self.data.rows.append((self.name, series, column_x, row_y, None, None, value))
+
+
+def _data_cell(value: Cell) -> str:
+    """A value as a CSV cell: floats round-trip (``repr``), NaN and ``None`` are empty.
+
+    Text is written as the figure draws it (:func:`drawable`: an undecodable file name's
+    bytes become U+FFFD), so the data is UTF-8 whatever the directory's name.
+
+    >>> _data_cell(0.1), _data_cell(np.float64(2.5)), _data_cell(np.int64(3)), _data_cell(None)
+    ('0.1', '2.5', '3', '')
+    >>> _data_cell(float("nan")), _data_cell("0.5")
+    ('', '0.5')
+    """
+    if value is None:
+        return ""
+    if isinstance(value, str):  # a label naming a directory: as the figure draws it
+        return drawable(value)
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    number = float(value)
+    return "" if np.isnan(number) else repr(number)
+
+
+class DataFigure(Figure):
+    """A matplotlib figure that carries the numbers it draws (``data``), for its ``.csv``."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.data = FigureData()
 
 
 @dataclass(frozen=True)
@@ -56,6 +182,9 @@ class SeedBand:
     """the seeds' reward threshold (``None``: the figure's)"""
     interrupted: int = 0
     """how many of the seeds were stopped before their configured episodes"""
+    seeds: Sequence[int] = ()
+    """the seeds, in the order of ``returns`` (they name the data's series; default: none,
+    the series are numbered ``run 1``, ``run 2``, ...)"""
 
 
 def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
@@ -85,7 +214,7 @@ def bootstrap_band(
 
 def reward_curve_figure(
     curves: Sequence[Curve | SeedBand], threshold: float | None, title: str = "Training reward"
-) -> Figure:
+) -> DataFigure:
     """Training returns: per run, the returns (faint) and their 100-episode moving average.
 
     A :class:`SeedBand` is drawn as its seeds' moving averages (faint), their mean, and a
@@ -94,39 +223,49 @@ def reward_curve_figure(
     without its own); otherwise each run's in its colour. An interrupted run says so in
     its legend entry.
     """
-    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
-    _draw_reward_curves(figure.add_subplot(), curves, threshold, title)
+    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    _draw_reward_curves(figure.add_subplot(), figure.data.panel(""), curves, threshold, title)
     return figure
 
 
 def _draw_reward_curves(
-    axes: Axes, curves: Sequence[Curve | SeedBand], threshold: float | None, title: str
+    axes: Axes,
+    record: PanelData,
+    curves: Sequence[Curve | SeedBand],
+    threshold: float | None,
+    title: str,
 ) -> None:
     colours = _colours(len(curves))
     for item, colour in zip(curves, colours, strict=True):
         if isinstance(item, SeedBand):
-            _draw_band(axes, item, colour)
+            _draw_band(axes, record, item, colour)
             continue
         episodes = np.arange(1, len(item.returns) + 1)
         axes.plot(episodes, item.returns, color=colour, alpha=0.25, linewidth=0.8)
+        record.line(f"{item.label}: return", episodes, item.returns)
         suffix = f" (solved at {item.solved_episode})" if item.solved_episode else ""
         if item.interrupted:
             suffix += f" (interrupted at episode {len(item.returns)})"
-        axes.plot(episodes, moving_average(item.returns), color=colour, linewidth=2.0,
+        average = moving_average(item.returns)
+        axes.plot(episodes, average, color=colour, linewidth=2.0,
                   label=f"{item.label}{suffix}")  # fmt: skip
+        record.line(f"{item.label}: {SOLVE_WINDOW}-episode average", episodes, average)
         if item.solved_episode:
             axes.axvline(item.solved_episode, color=colour, linestyle=":", linewidth=1.0)
+            record.mark(f"{item.label}: solved", item.solved_episode)
     thresholds = [threshold if item.threshold is None else item.threshold for item in curves]
     if len(set(thresholds)) == 1:
         shared = thresholds[0]
         if shared is not None:
             axes.axhline(shared, color="black", linestyle="--", linewidth=1.0,
                          label=f"reward threshold {shared:g}")  # fmt: skip
+            record.level("reward threshold", shared)
     else:
         for item, colour, own in zip(curves, colours, thresholds, strict=True):
             if own is not None:
                 axes.axhline(own, color=colour, linestyle="--", linewidth=1.0,
                              label=f"{item.label}: reward threshold {own:g}")  # fmt: skip
+                record.level(f"{item.label}: reward threshold", own)
     axes.set_xlabel("training episode")
     # A short axis label: a long one (what bold and faint mean) would be cut at the figure's
     # edge, so that goes under the title instead.
@@ -149,6 +288,9 @@ class MetricBand:
     high: np.ndarray
     aggregate: str
     """``mean`` or ``iqm``"""
+    seeds: Sequence[int] = ()
+    """the seeds of ``per_seed``'s rows (they name the data's series; default: none, the
+    series are numbered ``run 1``, ``run 2``, ...)"""
 
 
 def metric_curve_figure(
@@ -159,30 +301,35 @@ def metric_curve_figure(
     log_y: bool = False,
     reference: tuple[float, str] | None = None,
     y_limits: tuple[float | None, float | None] = (None, None),
-) -> Figure:
+) -> DataFigure:
     """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
 
     One run (a single seed) is drawn as its line alone. ``reference`` is a dashed
     horizontal line and its legend label (an optimum, the book's figure); ``y_limits`` the
     y axis's ends (``None``: automatic).
     """
-    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
+    record = figure.data.panel("")
     for band, colour in zip(bands, _colours(len(bands)), strict=True):
         seeds = band.per_seed.shape[0]
         if seeds == 1:
             axes.plot(band.x, band.centre, color=colour, linewidth=1.6, label=band.label)
+            record.line(band.label, band.x, band.centre)
             continue
         if seeds <= 50:  # more faint lines only grey the figure
-            for row in band.per_seed:
+            for name, row in zip(_run_names(band.seeds, seeds), band.per_seed, strict=True):
                 axes.plot(band.x, row, color=colour, alpha=0.12, linewidth=0.6)
+                record.line(f"{band.label}: {name}", band.x, row)
         axes.fill_between(band.x, band.low, band.high, color=colour, alpha=0.3, linewidth=0)
         name = "mean" if band.aggregate == "mean" else "IQM"
         axes.plot(band.x, band.centre, color=colour, linewidth=2.0,
                   label=f"{band.label}: {name} of {seeds} seeds, 95% CI")  # fmt: skip
+        record.line(f"{band.label}: {name}", band.x, band.centre, band.low, band.high)
     if reference is not None:
         axes.axhline(reference[0], color="black", linestyle="--", linewidth=1.0,
                      label=reference[1])  # fmt: skip
+        record.level(reference[1], reference[0])
     if log_y:
         axes.set_yscale("log")
     if y_limits != (None, None):
@@ -201,16 +348,18 @@ def summary_line_figure(
     y_label: str,
     title: str,
     log_y: bool = False,
-) -> Figure:
+) -> DataFigure:
     """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
 
     Each line is ``(label, xs, centre, low, high)``.
     """
-    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
+    record = figure.data.panel("")
     for (label, xs, centre, low, high), colour in zip(lines, _colours(len(lines)), strict=True):
         axes.fill_between(xs, low, high, color=colour, alpha=0.25, linewidth=0)
         axes.plot(xs, centre, color=colour, linewidth=1.8, marker="o", markersize=3, label=label)
+        record.line(label, xs, centre, low, high)
     if log_y:
         axes.set_yscale("log")
     axes.set_xlabel(x_label)
@@ -231,7 +380,7 @@ def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
     return f"return (bold: {average}, of a run or mean of seeds; faint: episodes or seeds)"
 
 
-def _draw_band(axes: object, band: SeedBand, colour: tuple[float, ...]) -> None:
+def _draw_band(axes: Axes, record: PanelData, band: SeedBand, colour: tuple[float, ...]) -> None:
     length = max(len(r) for r in band.returns)
     curves = np.full((len(band.returns), length), np.nan)
     for i, returns in enumerate(band.returns):
@@ -240,18 +389,33 @@ def _draw_band(axes: object, band: SeedBand, colour: tuple[float, ...]) -> None:
         if len(returns):
             curves[i, len(returns) :] = curves[i, len(returns) - 1]
     episodes = np.arange(1, length + 1)
-    for row in curves:
-        axes.plot(episodes, row, color=colour, alpha=0.12, linewidth=0.6)  # type: ignore[attr-defined]
+    for name, row in zip(_run_names(band.seeds, len(curves)), curves, strict=True):
+        axes.plot(episodes, row, color=colour, alpha=0.12, linewidth=0.6)
+        record.line(f"{band.label}: {name}", episodes, row)
     mean, low, high = bootstrap_band(curves, np.random.default_rng(0))
     solved = [s for s in band.solved_episodes if s is not None]
     note = f", median solve {np.median(solved):g}" if solved else ""
     if band.interrupted:
         note += f", {band.interrupted} interrupted"
-    axes.fill_between(episodes, low, high, color=colour, alpha=0.3, linewidth=0)  # type: ignore[attr-defined]
-    axes.plot(episodes, mean, color=colour, linewidth=2.0,  # type: ignore[attr-defined]
+    axes.fill_between(episodes, low, high, color=colour, alpha=0.3, linewidth=0)
+    axes.plot(episodes, mean, color=colour, linewidth=2.0,
               label=f"{band.label}: mean of {len(curves)} seeds, 95% CI{note}")  # fmt: skip
+    record.line(f"{band.label}: mean", episodes, mean, low, high)
     if solved:
-        axes.axvline(float(np.median(solved)), color=colour, linestyle=":", linewidth=1.2)  # type: ignore[attr-defined]
+        median = float(np.median(solved))
+        axes.axvline(median, color=colour, linestyle=":", linewidth=1.2)
+        record.mark(f"{band.label}: median solve episode", median)
+
+
+def _run_names(seeds: Sequence[int], count: int) -> list[str]:
+    """Each seed's series name: ``seed 3`` when the seeds are known, else ``run 1``, ...
+
+    >>> _run_names([3, 7], 2), _run_names([], 2)
+    (['seed 3', 'seed 7'], ['run 1', 'run 2'])
+    """
+    if len(seeds) == count:
+        return [f"seed {seed}" for seed in seeds]
+    return [f"run {number}" for number in range(1, count + 1)]
 
 
 def policy_figure(
@@ -265,7 +429,7 @@ def policy_figure(
     action_names: Sequence[str] | None = None,
     value_name: str = "state value max_a Q",
     rows_down: bool = False,
-) -> Figure:
+) -> DataFigure:
     """Greedy action, state value ``max_a Q`` and visit counts over two binned dimensions.
 
     The other dimensions are averaged out, weighted by how often training visited each
@@ -275,9 +439,10 @@ def policy_figure(
     ``rows_down`` draws the first dimension downwards (a grid world's rows, as Taxi).
     """
     q_map, value_map, visit_map = project_policy(q_table, visits, dims)
-    action_map = np.argmax(q_map, axis=-1).astype(float)
+    actions = np.argmax(q_map, axis=-1)
+    action_map = actions.astype(float)
     unvisited = visit_map == 0 if visits is not None else np.zeros_like(value_map, dtype=bool)
-    figure = Figure(figsize=POLICY_SIZE, dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=POLICY_SIZE, dpi=DPI, layout="constrained")
     panels = figure.subplots(1, 3)
     d_row, d_col = dims
     extent = (low[d_col], high[d_col], low[d_row], high[d_row])
@@ -291,9 +456,21 @@ def policy_figure(
         (value_name, np.ma.masked_where(unvisited, value_map), "viridis", None),
         ("training visits (log scale)", np.ma.masked_where(visit_map == 0, visit_map), "magma", visit_norm),
     )  # fmt: skip
-    for axes, (name, data, cmap, norm) in zip(panels, layers, strict=True):
+    # The data: each cell at its centre; actions and visits as the integers they are.
+    columns = _centres(extent[0], extent[1], action_map.shape[1])
+    rows = _centres(extent[2], extent[3], action_map.shape[0])
+    recorded = (
+        ("action", np.ma.masked_where(unvisited, actions)),
+        ("value", layers[1][1]),
+        ("visits", np.ma.masked_where(visit_map == 0, visit_map.astype(np.int64))),
+    )
+    for axes, (name, data, cmap, norm), (series, values) in zip(
+        panels, layers, recorded, strict=True
+    ):
         image = axes.imshow(data, origin="lower", aspect="auto", extent=extent, cmap=cmap,
                             norm=norm, interpolation="nearest")  # fmt: skip
+        if series != "visits" or visits is not None:  # no visits: the panel stays blank
+            figure.data.panel(name).cells(series, columns, rows, values)
         axes.set_title(name)
         axes.set_xlabel(names[d_col])
         axes.set_ylabel(names[d_row])
@@ -307,6 +484,16 @@ def policy_figure(
             bar.minorticks_off()
     figure.suptitle(title)
     return figure
+
+
+def _centres(low: float, high: float, count: int) -> list[float]:
+    """The centres of ``count`` equal cells from ``low`` to ``high`` (an image's extent).
+
+    >>> _centres(-0.5, 2.5, 3), _centres(0.0, 1.0, 2)
+    ([0.0, 1.0, 2.0], [0.25, 0.75])
+    """
+    width = (high - low) / count
+    return [low + (index + 0.5) * width for index in range(count)]
 
 
 def _action_colours(count: int) -> list[tuple[float, ...]]:
@@ -451,13 +638,20 @@ _CELL_COLOURS = {"H": "#30405a", "C": "#3a3a3a", "G": "#3c9a4a", "#": "#6b6b6b",
 _CELL_NAMES = {"H": "hole", "C": "cliff", "G": "goal", "S": "start", "#": "wall", "E": "end"}
 
 
-def _draw_grid(axes: Axes, grid: GridMap, values: np.ndarray | None = None) -> None:
-    """Cells (holes, cliff and goal coloured and named; others by ``values`` if given)."""
+def _draw_grid(
+    axes: Axes, grid: GridMap, values: np.ndarray | None = None, record: PanelData | None = None
+) -> None:
+    """Cells (holes, cliff and goal coloured and named; others by ``values`` if given).
+
+    ``values`` drawn are recorded into ``record`` as the series ``state value max_a Q``.
+    """
     shape = (grid.rows, grid.columns)
     special = np.array([cell in _CELL_COLOURS for cell in grid.cells]).reshape(shape)
     if values is not None:
         shown = np.ma.masked_where(special | np.isnan(values.reshape(shape)), values.reshape(shape))
         image = axes.imshow(shown, cmap="viridis", origin="upper", interpolation="nearest")
+        if record is not None:
+            record.cells("state value max_a Q", range(grid.columns), range(grid.rows), shown)
         figure: Any = axes.figure
         figure.colorbar(image, ax=axes, shrink=0.8, label="state value max_a Q")
     for state, cell in enumerate(grid.cells):
@@ -487,7 +681,7 @@ def _square(row: int, column: int, colour: str) -> Any:
 
 def grid_policy_figure(
     q_table: np.ndarray, visits: np.ndarray | None, grid: GridMap, title: str
-) -> Figure:
+) -> DataFigure:
     """A grid world's greedy policy: an arrow per cell over the state value ``max_a Q``.
 
     Holes, cliff and goal are coloured and named; cells training never visited get no
@@ -499,13 +693,16 @@ def grid_policy_figure(
     )
     values = np.where(visited, q.max(axis=1), np.nan)
     width = min(14.0, 1.0 + 0.75 * grid.columns + 1.5)
-    figure = Figure(figsize=(width, 1.0 + 0.75 * grid.rows), dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=(width, 1.0 + 0.75 * grid.rows), dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
-    _draw_grid(axes, grid, values)
+    record = figure.data.panel("")
+    _draw_grid(axes, grid, values, record)
+    arrows = np.ma.masked_array(np.zeros((grid.rows, grid.columns), dtype=np.int64), mask=True)
     for state in range(len(q)):
         if not visited[state] or grid.cells[state] in _CELL_COLOURS:
             continue
         row, column = divmod(state, grid.columns)
+        arrows[row, column] = int(np.argmax(q[state]))
         d_row, d_col = grid.moves[int(np.argmax(q[state]))]
         if (d_row, d_col) == (0, 0):  # an arrow of no length would not show: a dot stays
             axes.plot(column, row, marker="o", color="white", markersize=5, zorder=3)
@@ -514,17 +711,29 @@ def grid_policy_figure(
                       xytext=(column - 0.32 * d_col, row - 0.32 * d_row),
                       arrowprops={"arrowstyle": "->", "color": "white", "linewidth": 1.8},
                       zorder=3)  # fmt: skip
+    record.cells("greedy action", range(grid.columns), range(grid.rows), arrows)
     axes.set_xlabel("column")
     axes.set_ylabel("row")
     axes.set_title(f"{title}\ngreedy action per cell (blank: never visited in training)")
     return figure
 
 
-def draw_paths(axes: Axes, grid: GridMap, paths: Sequence[tuple[str, Sequence[int], bool]]) -> None:
-    """Draw greedy paths (lists of states) on a grid; a path that never ends is dashed."""
+def draw_paths(
+    axes: Axes,
+    record: PanelData,
+    grid: GridMap,
+    paths: Sequence[tuple[str, Sequence[int], bool]],
+) -> None:
+    """Draw greedy paths (lists of states) on a grid; a path that never ends is dashed.
+
+    Paths are drawn a little apart, so that paths over the same cells all show; ``record``
+    gets each path's cells themselves (``x`` its columns, ``y`` its rows).
+    """
     _draw_grid(axes, grid)
     colours = _colours(len(paths))
     for index, ((label, states, ends), colour) in enumerate(zip(paths, colours, strict=True)):
+        record.line(label, [state % grid.columns for state in states],
+                    [state // grid.columns for state in states])  # fmt: skip
         offset = 0.12 * (index - (len(paths) - 1) / 2)
         rows = [divmod(state, grid.columns)[0] + offset for state in states]
         columns = [divmod(state, grid.columns)[1] + offset for state in states]
@@ -541,11 +750,11 @@ def reward_and_paths_figure(
     title: str,
     grid: GridMap,
     paths: Sequence[tuple[str, Sequence[int], bool]],
-) -> Figure:
+) -> DataFigure:
     """Reward curves (as :func:`reward_curve_figure`) above each run's greedy path on the grid."""
-    figure = Figure(figsize=(9.0, 8.0), dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=(9.0, 8.0), dpi=DPI, layout="constrained")
     top, bottom = figure.subplots(2, 1, height_ratios=[1.4, 1.0])
-    _draw_reward_curves(top, curves, threshold, title)
+    _draw_reward_curves(top, figure.data.panel("training reward"), curves, threshold, title)
     # The first episodes of a grid world can cost thousands; show the learning after them.
     settled = []
     for item in curves:
@@ -557,12 +766,14 @@ def reward_and_paths_figure(
     if values.size:
         low, high = float(np.percentile(values, 1)), float(np.max(values))
         top.set_ylim(low - 0.1 * (high - low + 1.0), high + 0.1 * (high - low + 1.0))
-    draw_paths(bottom, grid, paths)
+    draw_paths(bottom, figure.data.panel("greedy path"), grid, paths)
     bottom.set_title("greedy path from the start (a multi-seed run's first seed)")
     return figure
 
 
-def blackjack_policy_figure(q_table: np.ndarray, visits: np.ndarray | None, title: str) -> Figure:
+def blackjack_policy_figure(
+    q_table: np.ndarray, visits: np.ndarray | None, title: str
+) -> DataFigure:
     """Blackjack's greedy policy as Sutton & Barto draw it: usable ace or not, hit or stick.
 
     ``q_table`` has shape ``(32, 11, 2, 2)``: player sum, dealer's card, usable ace,
@@ -570,15 +781,18 @@ def blackjack_policy_figure(q_table: np.ndarray, visits: np.ndarray | None, titl
     visited in training are blank.
     """
     sums, dealer = np.arange(12, 22), np.arange(1, 11)
-    figure = Figure(figsize=(10.0, 4.6), dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=(10.0, 4.6), dpi=DPI, layout="constrained")
     panels = figure.subplots(1, 2)
     colours = ListedColormap(["#d9e6f2", "#c0392b"])
     for axes, usable in zip(panels, (1, 0), strict=True):
-        actions = np.argmax(q_table[12:22, 1:11, usable], axis=-1).astype(float)
+        chosen = np.ma.asarray(np.argmax(q_table[12:22, 1:11, usable], axis=-1))
         if visits is not None:
-            actions = np.ma.masked_where(visits[12:22, 1:11, usable].sum(-1) == 0, actions)
+            chosen = np.ma.masked_where(visits[12:22, 1:11, usable].sum(-1) == 0, chosen)
+        actions = chosen.astype(float)
         axes.imshow(actions, origin="lower", cmap=colours, vmin=0, vmax=1, aspect="auto",
                     extent=(0.5, 10.5, 11.5, 21.5), interpolation="nearest")  # fmt: skip
+        panel = figure.data.panel("usable ace" if usable else "no usable ace")
+        panel.cells("action (0 stick / 1 hit)", dealer.tolist(), sums.tolist(), chosen)
         axes.set_xticks(dealer, ["A", *map(str, range(2, 11))])
         axes.set_yticks(sums)
         axes.set_xlabel("dealer showing")
@@ -598,7 +812,7 @@ def robustness_figure(
     trained: Sequence[float],
     threshold: float | None,
     title: str,
-) -> Figure:
+) -> DataFigure:
     """The greedy policy's mean return as one physics value (a curve) or two (a heatmap) vary.
 
     Args:
@@ -609,8 +823,9 @@ def robustness_figure(
         threshold: the solve threshold (a dashed line on a curve), if any.
         title: the figure's title.
     """
-    figure = Figure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
+    record = figure.data.panel("")
     median = np.median(means, axis=0)
     if len(axes_values) == 1:
         key, values = axes_values[0]
@@ -620,13 +835,17 @@ def robustness_figure(
                 values, low, high, alpha=0.25, label=f"interquartile range, {means.shape[0]} seeds"
             )
             axes.plot(values, median, marker="o", label="median across seeds")
+            record.line("median across seeds", values, median, low, high)
         else:
             axes.plot(values, median, marker="o", label="greedy mean return")
+            record.line("greedy mean return", values, median)
         axes.axvline(
             trained[0], color="black", linestyle=":", label=f"trained with {key} = {trained[0]:g}"
         )
+        record.mark(f"trained with {key}", trained[0])
         if threshold is not None:
             axes.axhline(threshold, color="grey", linestyle="--", label=f"threshold {threshold:g}")
+            record.level("threshold", threshold)
         axes.set_xlabel(key)
         axes.set_ylabel("greedy mean return")
         axes.legend(loc="best", fontsize="small")
@@ -634,13 +853,12 @@ def robustness_figure(
     else:
         (key_x, x), (key_y, y) = axes_values
         image = axes.pcolormesh(_edges(x), _edges(y), median.T, shading="flat", cmap="viridis")
-        figure.colorbar(
-            image,
-            ax=axes,
-            label="greedy mean return" + (" (median of seeds)" if means.shape[0] > 1 else ""),
-        )
+        name = "greedy mean return" + (" (median of seeds)" if means.shape[0] > 1 else "")
+        figure.colorbar(image, ax=axes, label=name)
+        record.cells(name, x.tolist(), y.tolist(), median.T)
         axes.plot([trained[0]], [trained[1]], marker="*", markersize=14, color="red",
                   markeredgecolor="white", label="trained with")  # fmt: skip
+        record.line("trained with", [trained[0]], [trained[1]])
         axes.set_xlabel(key_x)
         axes.set_ylabel(key_y)
         axes.legend(loc="upper right", fontsize="small")
@@ -679,7 +897,7 @@ def sweep_figure(
     statistics: Sequence[dict[str, float | int | None]],
     eval_means: Sequence[np.ndarray],
     threshold: float | None,
-) -> Figure:
+) -> DataFigure:
     """``sweep.png``: success rate and median solve episode against the axes, and profiles.
 
     One axis: both statistics against it, with their 95% intervals as error bars. Two
@@ -695,8 +913,8 @@ def sweep_figure(
         eval_means: each point's seeds' eval means.
         threshold: the reward threshold (marked on the profile), if any.
     """
-    figure = Figure(figsize=(SWEEP_PANEL_SIZE[0] * 3, SWEEP_PANEL_SIZE[1]), dpi=DPI,
-                    layout="constrained")  # fmt: skip
+    figure = DataFigure(figsize=(SWEEP_PANEL_SIZE[0] * 3, SWEEP_PANEL_SIZE[1]), dpi=DPI,
+                        layout="constrained")  # fmt: skip
     rate_axes, solve_axes, profile_axes = figure.subplots(1, 3)
     rate = _column(statistics, "success_rate")
     solve = _column(statistics, "median_solved_episode")
@@ -712,16 +930,18 @@ def sweep_figure(
         # Along one axis neighbouring points are neighbours; along the point ids of three or
         # more axes they are not, so no line joins them.
         joined = len(axes) == 1
-        _sweep_errorbars(rate_axes, labels, name, statistics, "success_rate", "success rate",
-                         joined)  # fmt: skip
+        _sweep_errorbars(rate_axes, figure.data.panel("success rate"), labels, name,
+                         statistics, "success_rate", "success rate", joined)  # fmt: skip
         rate_axes.set_ylim(-0.02, 1.02)
-        _sweep_errorbars(solve_axes, labels, name, statistics, "median_solved_episode",
+        _sweep_errorbars(solve_axes, figure.data.panel("median solve episode"), labels, name,
+                         statistics, "median_solved_episode",
                          "median solve episode (solved seeds)", joined)  # fmt: skip
     iqm = _column(statistics, "iqm_eval_return")
     order = [i for i in np.argsort(-np.nan_to_num(iqm, nan=-np.inf), kind="stable")
              if eval_means[i].size][:PROFILE_MAX_POINTS]  # fmt: skip
     draw_profiles(
         profile_axes,
+        figure.data.panel("performance profiles"),
         [eval_means[i] for i in order],
         [f"point {point_ids[i]}" for i in order],
         threshold,
@@ -757,18 +977,24 @@ def profile_thresholds(
 
 def draw_profiles(
     axes: Axes,
+    record: PanelData,
     scores: Sequence[np.ndarray],
     labels: Sequence[str],
     threshold: float | None,
     xlabel: str,
 ) -> None:
-    """Performance profiles: the fraction of seeds scoring at least ``τ``, per run or point."""
+    """Performance profiles: the fraction of seeds scoring at least ``τ``, per run or point.
+
+    Drawn as steps (each value holds until the next ``τ``); ``record`` gets the points.
+    """
     taus = profile_thresholds(scores, threshold)
     for colour, values, label in zip(_colours(len(scores)), scores, labels, strict=True):
         fraction = (np.asarray(values)[:, None] >= taus[None, :]).mean(axis=0)
         axes.step(taus, fraction, where="post", color=colour, label=label)
+        record.line(label, taus, fraction)
     if threshold is not None:
         axes.axvline(threshold, color="grey", linestyle="--", label=f"threshold {threshold:g}")
+        record.mark("threshold", threshold)
     axes.set_ylim(-0.02, 1.02)
     axes.set_xlabel(xlabel)
     axes.set_ylabel("fraction of seeds ≥ τ")
@@ -776,7 +1002,7 @@ def draw_profiles(
     axes.grid(alpha=0.3)
 
 
-def compare_figure(data: dict[str, Any], title: str) -> Figure:
+def compare_figure(data: dict[str, Any], title: str) -> DataFigure:
     """The aggregate picture of several runs, as rliable draws it.
 
     IQM and optimality gap with 95% stratified-bootstrap intervals, and performance
@@ -789,21 +1015,24 @@ def compare_figure(data: dict[str, Any], title: str) -> Figure:
     gaps = [gap for gap in data["gap"] if gap is not None]
     panels = 3 if gaps else 2
     height = max(SWEEP_PANEL_SIZE[1], 1.0 + 0.45 * len(data["labels"]))
-    figure = Figure(figsize=(SWEEP_PANEL_SIZE[0] * panels, height), dpi=DPI,
-                    layout="constrained")  # fmt: skip
+    figure = DataFigure(figsize=(SWEEP_PANEL_SIZE[0] * panels, height), dpi=DPI,
+                        layout="constrained")  # fmt: skip
     axes = figure.subplots(1, panels)
     rows = np.arange(len(data["labels"]))[::-1]
     colours = _colours(len(data["labels"]))
-    _interval_rows(axes[0], rows, data["iqm"], colours, data["labels"])
-    axes[0].set_title(
-        "IQM (higher is better)" if data["higher_is_better"] else "IQM (lower is better)"
-    )
+    iqm_title = "IQM (higher is better)" if data["higher_is_better"] else "IQM (lower is better)"
+    _interval_rows(axes[0], figure.data.panel(iqm_title), rows, data["iqm"], colours,
+                   data["labels"])  # fmt: skip
+    axes[0].set_title(iqm_title)
     axes[0].set_xlabel(data["metric"])
     if gaps:
-        _interval_rows(axes[1], rows, data["gap"], colours, data["labels"])
-        axes[1].set_title(f"optimality gap below {data['target']:g} (lower is better)")
+        gap_title = f"optimality gap below {data['target']:g} (lower is better)"
+        _interval_rows(axes[1], figure.data.panel(gap_title), rows, data["gap"], colours,
+                       data["labels"])  # fmt: skip
+        axes[1].set_title(gap_title)
         axes[1].set_xlabel("mean shortfall per seed")
-    draw_profiles(axes[-1], data["values"], data["labels"], data["target"], data["metric"] + " τ")
+    draw_profiles(axes[-1], figure.data.panel("performance profiles"), data["values"],
+                  data["labels"], data["target"], data["metric"] + " τ")  # fmt: skip
     axes[-1].set_title("performance profiles")
     figure.suptitle(f"{title}: 95% stratified-bootstrap intervals over seeds")
     return figure
@@ -811,16 +1040,22 @@ def compare_figure(data: dict[str, Any], title: str) -> Figure:
 
 def _interval_rows(
     axes: Axes,
+    record: PanelData,
     rows: np.ndarray,
     figures: Sequence[tuple[float, float, float] | None],
     colours: Sequence[tuple[float, ...]],
     labels: Sequence[str],
 ) -> None:
-    """One horizontal interval per run, its point estimate marked."""
-    for row, item, colour in zip(rows, figures, colours, strict=True):
+    """One horizontal interval per run, its point estimate marked.
+
+    Drawn sideways: ``record`` gets, per run, a row whose ``x`` is the run's label and whose
+    ``y``, ``y_low`` and ``y_high`` are its estimate and interval.
+    """
+    for row, item, colour, label in zip(rows, figures, colours, labels, strict=True):
         if item is None or not np.isfinite(item[0]):
             continue
         value, low, high = item
+        record.line(label, [label], [value], [low], [high])
         axes.plot([low, high], [row, row], color=colour, linewidth=6, alpha=0.45,
                   solid_capstyle="butt")  # fmt: skip
         axes.plot([value], [row], marker="|", color="black", markersize=14)
@@ -844,6 +1079,7 @@ def _numeric(labels: Sequence[str]) -> np.ndarray | None:
 
 def _sweep_errorbars(
     axes: Axes,
+    record: PanelData,
     labels: Sequence[str],
     name: str,
     statistics: Sequence[dict[str, float | int | None]],
@@ -859,6 +1095,8 @@ def _sweep_errorbars(
     errors = np.vstack([np.clip(values - low, 0, None), np.clip(high - values, 0, None)])
     axes.errorbar(positions, values, yerr=np.nan_to_num(errors), marker="o", capsize=4,
                   linestyle="-" if joined else "none")  # fmt: skip
+    # x as the axis's values are written in points.csv (a number, or a category's name)
+    record.line(ylabel, labels, values, low, high)
     if numbers is None:
         axes.set_xticks(positions, labels, rotation=30, ha="right", fontsize="small")
     elif np.all(numbers > 0) and numbers.max() / numbers.min() >= 100:
@@ -869,7 +1107,7 @@ def _sweep_errorbars(
 
 
 def _sweep_heatmap(
-    figure: Figure,
+    figure: DataFigure,
     axes: Axes,
     sweep_axes: Sequence[SweepAxis],
     values: np.ndarray,
@@ -882,6 +1120,7 @@ def _sweep_heatmap(
     vmin, vmax = limits if limits is not None else (None, None)
     image = axes.imshow(masked, cmap=cmap, vmin=vmin, vmax=vmax, aspect="auto")
     figure.colorbar(image, ax=axes, label=label)
+    figure.data.panel(label).cells(label, sweep_axes[1].values, sweep_axes[0].values, masked)
     rows, columns = values.shape
     for i in range(rows):
         for j in range(columns):
@@ -905,3 +1144,59 @@ def _outline() -> list[object]:
     from matplotlib import patheffects
 
     return [patheffects.withStroke(linewidth=2, foreground="black")]
+
+
+# -- tune studies --------------------------------------------------------------------------
+
+
+def tune_history_figure(
+    trials: Sequence[int], objectives: Sequence[float], title: str
+) -> DataFigure:
+    """``history.png``: each finished trial's objective, and the best so far (maximised).
+
+    Args:
+        trials: the finished trials' numbers, in order.
+        objectives: their objectives.
+        title: the figure's title.
+    """
+    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    record = figure.data.panel("")
+    best = np.maximum.accumulate(np.asarray(objectives, dtype=np.float64))
+    axes.scatter(trials, objectives, s=16, color="tab:blue", label="objective")
+    record.line("objective", trials, objectives)
+    axes.step(trials, best, where="post", color="tab:red", label="best so far")
+    record.line("best so far", trials, best)
+    axes.set_xlabel("trial")
+    axes.set_ylabel("objective")
+    axes.set_title(title, fontsize="medium")
+    axes.grid(alpha=0.3)
+    axes.legend(loc="lower right", fontsize="small")
+    return figure
+
+
+def importance_figure(importances: Sequence[tuple[str, float]], title: str) -> DataFigure:
+    """``importance.png``: each searched parameter's importance, the largest on top.
+
+    Drawn sideways: the data's ``x`` is the parameter, ``y`` its importance.
+
+    Args:
+        importances: ``(parameter, importance)`` pairs, the most important first.
+        title: the figure's title.
+    """
+    height = max(2.5, 1.2 + 0.4 * len(importances))
+    figure = DataFigure(figsize=(CURVE_SIZE[0], height), dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    names = [name for name, _ in importances]
+    values = [value for _, value in importances]
+    rows = np.arange(len(importances))[::-1]
+    axes.barh(rows, values, color="tab:blue", alpha=0.8)
+    figure.data.panel("").line("importance", names, values)
+    for row, value in zip(rows, values, strict=True):
+        axes.text(value, row, f" {value:.2f}" if value >= 0.01 else " <0.01", va="center",
+                  fontsize="small")  # fmt: skip
+    axes.set_yticks(rows, names, fontsize="small")
+    axes.set_xlabel("importance (they sum to 1)")
+    axes.set_title(title, fontsize="medium")
+    axes.grid(axis="x", alpha=0.3)
+    return figure

@@ -1,7 +1,7 @@
 """Learning curves across seeds: a per-episode metric, against episodes or env steps.
 
 The curves of textbook figures are not all "return per episode": Sutton & Barto draw steps
-per episode (Figs. 8.2, 10.2), episodes completed against time steps (Fig. 6.4) and
+per episode (Figs. 8.2, 10.2), episodes completed against time steps (Example 6.5) and
 cumulative reward against time steps (Figs. 8.4, 8.5). Every one of them is a function of
 the two per-episode records every run keeps (returns and lengths), so this module turns
 those records into one curve per seed on a common x grid, then aggregates the seeds (mean

@@ -177,6 +177,8 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "scale": "x"}, 'figure.scale: "x" is not a int or float'),
         ({"metric": "length", "smooth": 0}, "figure.smooth: must be at least 1"),
         ({"metric": "length", "file": "../f.png"}, "figure.file"),
+        ({"metric": "length", "file": "points.svg"}, "would write points.csv beside it"),
+        ({"metric": "length", "file": "sweep.png"}, "would write sweep.csv beside it"),
         ([1], "figure: must be a mapping"),
         ({"metric": "length", "against": "agent.gamma"}, "figure.against: 'agent.gamma' is not"),
         ({"metric": "length", "y_min": 5, "y_max": 5}, "figure.y_min: must be below figure.y_max"),
@@ -238,7 +240,7 @@ def test_a_figure_against_an_axis_draws_each_points_mean_over_its_first_episodes
 
 
 def test_y_limits_end_the_axis_where_the_book_does() -> None:
-    """``figure.y_min``/``y_max``: Fig. 6.3's axis stops at -100 as the book's does."""
+    """``figure.y_min``/``y_max``: Example 6.6's axis stops at -100 as the book's does."""
     from cartpole_q.figures import MetricBand, metric_curve_figure
 
     values = np.array([[-1700.0, -50.0, -25.0], [-1500.0, -40.0, -30.0]])

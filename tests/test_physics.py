@@ -174,8 +174,14 @@ def test_robustness_grid_equals_eval_under_the_same_physics(solved_run, tmp_path
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     assert out.is_file() and out.read_bytes()[:4] == b"\x89PNG"
-    rows = list(csv.DictReader(out.with_suffix(".csv").open()))
+    rows = list(csv.DictReader((tmp_path / "robust_seeds.csv").open()))
     assert [float(row["force_mag"]) for row in rows] == [0.5, 5.5, 10.5]
+    # the figure's data: the one seed's means as drawn, the trained value, the threshold
+    drawn = list(csv.DictReader(out.with_suffix(".csv").open()))
+    assert [(r["series"], r["x"], r["y"]) for r in drawn] == [
+        *(("greedy mean return", row["force_mag"], row["mean"]) for row in rows),
+        ("trained with force_mag", "10.0", ""), ("threshold", "", "475.0"),
+    ]  # fmt: skip
     # the grid plays on the twin; eval --physics plays in gymnasium.make: the same returns
     for row in rows:
         played = _eval_json(

@@ -193,10 +193,22 @@ def test_robustness_names_seeds_rounds_values_and_guards_its_size(
         "--out", out,
     )  # fmt: skip
     assert result.exit_code == 0, result.output
-    with out.with_suffix(".csv").open(newline="") as file:
+    assert result.stdout.splitlines() == [str(tmp_path / "r_seeds.csv"), str(out)]
+    with (tmp_path / "r_seeds.csv").open(newline="") as file:
         rows = list(csv.DictReader(file))
     assert {row["seed"] for row in rows} == {"0", "1", "2", "3"}
     assert sorted({row["length"] for row in rows}) == ["0.1", "0.2", "0.3", "0.4", "0.5"]
+    # the figure's data beside it: at each length the seeds' median and interquartile range
+    with out.with_suffix(".csv").open(newline="") as file:
+        drawn = [row for row in csv.DictReader(file) if row["series"] == "median across seeds"]
+    for row in drawn:
+        means = [float(r["mean"]) for r in rows if r["length"] == row["x"]]
+        assert len(means) == 4
+        assert float(row["y"]) == np.median(means)
+        assert [float(row["y_low"]), float(row["y_high"])] == np.percentile(
+            means, [25, 75]
+        ).tolist()
+    assert [row["x"] for row in drawn] == ["0.1", "0.2", "0.3", "0.4", "0.5"]
     big = ("robustness", runs["cartpole"], "--vary", "length=0.1:0.5:1000", "--vary",
            "force_mag=5:15:1000", "--episodes", 10, "--out", tmp_path / "big.png")  # fmt: skip
     assert_refused(invoke(*big), "40,000,000 greedy episodes", "--yes")

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from cartpole_q.config import ConfigError, load_config
@@ -98,6 +99,16 @@ def test_a_study_writes_its_files_and_a_best_config_train_takes(
     for name in (tunedir.TUNE_FILE, tunedir.JOURNAL_FILE, tunedir.BEST_FILE, tunedir.HISTORY_FILE):
         assert (reference / name).is_file(), name
     best = max(rows, key=lambda row: float(row["objective"]))
+    # each figure's data beside it: the objectives and the best so far; the importances
+    with (reference / "history.csv").open(newline="") as file:
+        history = list(csv.DictReader(file))
+    drawn = [(r["x"], r["y"]) for r in history if r["series"] == "objective"]
+    assert drawn == [(row["trial"], row["objective"]) for row in rows]
+    best_so_far = [float(r["y"]) for r in history if r["series"] == "best so far"]
+    assert best_so_far == np.maximum.accumulate([float(y) for _, y in drawn]).tolist()
+    with (reference / "importance.csv").open(newline="") as file:
+        importances = {r["x"]: float(r["y"]) for r in csv.DictReader(file)}
+    assert set(importances) == set(TUNE["space"]) and sum(importances.values()) == pytest.approx(1)
     config = load_config(reference / tunedir.BEST_FILE)
     assert config.agent.algorithm == best["agent.algorithm"]
     assert config.agent.alpha.start == float(best["agent.alpha"])

@@ -145,13 +145,16 @@ def plot(
         Path | None,
         typer.Option(
             metavar="FILE",
-            help="The figure to write: .png, .svg or .pdf, as its extension says.",
+            help="The figure to write: .png, .svg or .pdf, as its extension says; the "
+            "numbers it draws go beside it as .csv.",
             show_default="RUN_DIR/reward_curve.png, or RUN_DIR/policy_map.png with --policy "
             "(both redrawn in place); with several run directories, reward_curves.png in the "
             "current directory",
         ),
     ] = None,
-    force: Annotated[bool, typer.Option("--force", help="Replace the file if it exists.")] = False,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace the figure and its .csv if they exist.")
+    ] = False,
     policy: Annotated[
         bool,
         typer.Option(
@@ -305,7 +308,8 @@ def robustness_command(
         Path | None,
         typer.Option(
             metavar="FILE",
-            help="The figure (.png, .svg, .pdf); the table goes beside it as .csv.",
+            help="The figure (.png, .svg, .pdf); its data goes beside it as .csv, every "
+            "seed's mean at every grid point as _seeds.csv.",
             show_default="RUN_DIR/robustness.png",
         ),
     ] = None,
@@ -356,7 +360,7 @@ def compare_command(
         typer.Option(
             metavar="FILE",
             help="Also draw IQM and optimality gap with intervals, and performance profiles, "
-            "as FILE (.png, .svg or .pdf).",
+            "as FILE (.png, .svg or .pdf), its data beside it as .csv.",
         ),
     ] = None,
     force: Annotated[
@@ -376,10 +380,9 @@ def compare_command(
         if len(runs) < 2:
             raise UserError("compare needs at least two runs.")
         if out is not None:
-            from cartpole_q.figures import FIGURE_FORMATS
-            from cartpole_q.store.atomic import check_output_file
+            from cartpole_q.store.figure_file import check_figure_file
 
-            check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+            check_figure_file(out, "--out", force)
         result = compare(runs, metric, force=force)
         for text in result.notes:
             note(text)

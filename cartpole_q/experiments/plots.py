@@ -1,6 +1,8 @@
 """The ``plot`` command's work: load runs, draw them with :mod:`cartpole_q.figures`, write.
 
-Nothing is drawn before the output file is known to be writable.
+Each figure goes out with its data beside it (``<figure>.csv``, written by
+:func:`~cartpole_q.store.figure_file.write_figure`). Nothing is drawn before both files
+are known to be writable.
 """
 
 from __future__ import annotations
@@ -17,7 +19,6 @@ from cartpole_q.config import Config, format_seeds
 from cartpole_q.errors import RunError, UserError
 from cartpole_q.experiments.compare import Comparison, compare_figure_data
 from cartpole_q.figures import (
-    FIGURE_FORMATS,
     Curve,
     GridMap,
     MetricBand,
@@ -26,7 +27,6 @@ from cartpole_q.figures import (
     blackjack_policy_figure,
     default_dims,
     dimension_names,
-    figure_bytes,
     grid_policy_figure,
     metric_curve_figure,
     policy_figure,
@@ -44,7 +44,7 @@ from cartpole_q.learning_curves import (
 from cartpole_q.profiles import profile_for
 from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
-from cartpole_q.store.atomic import atomic_write_bytes, check_output_file
+from cartpole_q.store.figure_file import check_figure_file, write_figure
 from cartpole_q.store.runsets import check_tables, load_run_set
 
 
@@ -58,13 +58,14 @@ def plot_rewards(
 
     Args:
         run_dirs: run directories, multi-seed runs or sweep points.
-        out: a ``.png``, ``.svg`` or ``.pdf`` file.
-        force: replace ``out`` if it exists.
+        out: a ``.png``, ``.svg`` or ``.pdf`` file; its data goes beside it as ``.csv``.
+        force: replace ``out`` (and its ``.csv``) if they exist.
         on_note: told what is unfinished or left out.
 
     Raises:
         RunError: a directory is not a complete run, or a sweep point kept no curves.
-        WriteError: ``out`` cannot be written (checked before the figure is drawn).
+        WriteError: ``out`` or its ``.csv`` cannot be written (checked before the figure
+            is drawn).
     """
     items: list[Curve | SeedBand] = []
     first_runs: list[rundir.Run] = []
@@ -93,8 +94,9 @@ def plot_rewards(
             [run.result.solved_episode for run in runs],
             threshold=run_set.reward_threshold,
             interrupted=sum(run.result.interrupted for run in runs),
+            seeds=[run.config.seed for run in runs],
         ))  # fmt: skip
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    check_figure_file(out, "--out", force)
     title = "Training reward" if len(items) > 1 else f"Training reward: {run_dirs[0].name}"
     if len(items) == 1 and isinstance(items[0], Curve) and items[0].interrupted:
         title += " (interrupted)"
@@ -103,8 +105,7 @@ def plot_rewards(
         figure = reward_and_paths_figure(items, None, title, grid, paths)
     else:
         figure = reward_curve_figure(items, None, title)
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
+    return write_figure(out, figure)
 
 
 @dataclass(frozen=True)
@@ -142,14 +143,14 @@ def plot_metric(
 
     Args:
         run_dirs: Run directories, multi-seed runs or sweep points, one curve each.
-        out: A ``.png``, ``.svg`` or ``.pdf`` file.
+        out: A ``.png``, ``.svg`` or ``.pdf`` file; its data goes beside it as ``.csv``.
         metric: One of :data:`cartpole_q.learning_curves.METRICS`, or ``info:KEY`` (runs
             trained with ``train.info_metric: KEY``).
         x: One of :data:`cartpole_q.learning_curves.X_AXES`.
         aggregate: ``mean`` or ``iqm`` over seeds.
         window: Trailing moving average of per-episode values (``return``, ``length``).
         log_y: A logarithmic y axis (S&B Fig. 10.2's steps per episode).
-        force: Replace ``out`` if it exists.
+        force: Replace ``out`` (and its ``.csv``) if they exist.
         on_note: Told what is unfinished or left out.
         style: Labels, a transform of the values and a reference line (a sweep file's
             ``figure``); default: the directories' names, the values as they are.
@@ -157,7 +158,8 @@ def plot_metric(
     Raises:
         RunError: A directory is not a complete run, a sweep point kept no curves, or
             (``info:KEY``) its runs kept no sums of ``info[KEY]``.
-        WriteError: ``out`` cannot be written (checked before the figure is drawn).
+        WriteError: ``out`` or its ``.csv`` cannot be written (checked before the figure
+            is drawn).
     """
     style = style or CurveStyle()
     info_key = info_key_of(metric)
@@ -185,8 +187,9 @@ def plot_metric(
             label = style.labels[number]
         else:
             label = f"point {path.name}" if run_set.kind == "sweep point" else path.name
-        bands.append(MetricBand(label, curves.x, values, centre, low, high, aggregate))
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+        seeds = [run.config.seed for run in runs]
+        bands.append(MetricBand(label, curves.x, values, centre, low, high, aggregate, seeds))
+    check_figure_file(out, "--out", force)
     y_label = style.y_label or metric_label(metric)
     if window > 1 and smoothed(metric):
         y_label += f" ({window}-episode average)"
@@ -196,8 +199,7 @@ def plot_metric(
     figure = metric_curve_figure(
         bands, X_LABELS[x], y_label, title, log_y, style.reference, style.y_limits
     )
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
+    return write_figure(out, figure)
 
 
 def check_info(path: Path, runs: Sequence[rundir.Run], info_key: str) -> None:
@@ -243,12 +245,11 @@ def _greedy_paths(
 
 
 def write_compare_figure(result: Comparison, out: Path) -> Path:
-    """Draw a comparison's aggregate figure (``compare --out``) and write ``out``."""
+    """Draw a comparison's aggregate figure (``compare --out``); write it and its data."""
     from cartpole_q.figures import compare_figure
 
     figure = compare_figure(compare_figure_data(result), f"{len(result.sides)} runs compared")
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[out.suffix.lower()]))
-    return out
+    return write_figure(out, figure)
 
 
 def follow(model: Any, policy: np.ndarray, limit: int = 1000) -> tuple[list[int], bool]:
@@ -287,7 +288,8 @@ def plot_policy(
     Raises:
         RunError: the directory is not a complete run, or ``seed`` is not one of its seeds.
         UserError: ``dims_text`` does not name two distinct dimensions of the grid.
-        WriteError: ``out`` cannot be written (checked before the figure is drawn).
+        WriteError: ``out`` or its ``.csv`` cannot be written (checked before the figure
+            is drawn).
     """
     run_set = load_run_set(run_dir)
     check_tables(run_set)  # a table drawn as another world's would be a wrong picture
@@ -321,7 +323,7 @@ def plot_policy(
         return _plot_discrete_policy(run.config, q_table, visits, out, title, force)
     bins = grid.bins
     dims = parse_dims(dims_text, bins) if dims_text else default_dims(bins)
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    check_figure_file(out, "--out", force)
     names = dimension_names(env_id, len(bins))
     low, high = grid.low, grid.high
     if grid.tilings > 1:
@@ -341,8 +343,7 @@ def plot_policy(
         q_table, visits, dims, low, high, names, title,
         action_names=action_names(env_id, q_table.shape[-1]), value_name=value_name,
     )  # fmt: skip
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
+    return write_figure(out, figure)
 
 
 def agreement_table(runs: Sequence[rundir.Run]) -> tuple[np.ndarray, np.ndarray | None]:
@@ -380,7 +381,7 @@ def _plot_discrete_policy(
     """
     from cartpole_q.envs.models import grid_layout
 
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
+    check_figure_file(out, "--out", force)
     profile = profile_for(config.env.id)
     layout = grid_layout(config.env) if profile.policy_map == "grid" else None
     actions = profile.names_actions(q.shape[-1])
@@ -416,8 +417,7 @@ def _plot_discrete_policy(
             table, counts, (0, 1), low, high, names, title, action_names=actions,
             rows_down=profile.rows_down,
         )  # fmt: skip
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out
+    return write_figure(out, figure)
 
 
 def parse_dims(text: str, bins: Sequence[int]) -> tuple[int, int]:

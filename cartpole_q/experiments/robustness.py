@@ -22,10 +22,11 @@ from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.registry import twin_for
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import under_conditions
-from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, robustness_figure
+from cartpole_q.figures import robustness_figure
 from cartpole_q.profiles import Physics, profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
-from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text, check_output_file
+from cartpole_q.store.atomic import atomic_write_text, check_output_file
+from cartpole_q.store.figure_file import check_figure_file, write_figure
 from cartpole_q.store.runsets import RunSet, check_tables, load_run_set
 
 PRESETS = {
@@ -197,7 +198,14 @@ def robustness(
     progress: SweepProgress | None = None,
     on_note: Callable[[str], None] | None = None,
 ) -> tuple[Path, Path]:
-    """Measure, then write the figure ``out`` and ``out`` with ``.csv``; return both paths.
+    """Measure, then write the figure ``out`` with its data, and the seeds' table.
+
+    The figure's data (what it draws: the median across seeds, its interquartile range) goes
+    beside it as ``<stem>.csv``, as every figure's; the table of every seed's mean at every
+    grid point as ``<stem>_seeds.csv`` (:func:`seeds_table_path`).
+
+    Returns:
+        The figure's path and the table's.
 
     Raises:
         UserError: bad axes (one or two keys, no repeat), the run is not CartPole's, or
@@ -210,9 +218,9 @@ def robustness(
     varied_physics(run_set, axes)
     check_values(run_set, axes, max_steps)  # every value, before any file or episode
     check_size(run_set, axes, episodes, yes)
-    suffix = check_output_file(out, "--out", tuple(FIGURE_FORMATS), force)
-    table_path = out.with_suffix(".csv")
-    check_output_file(table_path, "--out (its .csv)", (".csv",), force)
+    check_figure_file(out, "--out", force)
+    table_path = seeds_table_path(out)
+    check_output_file(table_path, "--out (its _seeds.csv)", (".csv",), force)
     for note in run_set.notes:
         if on_note is not None:
             on_note(note)
@@ -222,8 +230,18 @@ def robustness(
     horizon = "" if max_steps is None else f" of {max_steps} steps"
     title = f"Robustness of {run_dir.name}: greedy mean over {episodes} episodes{horizon}"
     figure = robustness_figure([(a.key, a.values) for a in axes], means, trained, threshold, title)
-    atomic_write_bytes(out, figure_bytes(figure, FIGURE_FORMATS[suffix]))
-    return out, table_path
+    return write_figure(out, figure), table_path
+
+
+def seeds_table_path(out: Path) -> Path:
+    """Where ``robustness`` writes every seed's mean: ``<stem>_seeds.csv`` beside the figure.
+
+    Not ``<stem>.csv``: that is the figure's data, as beside every figure.
+
+    >>> seeds_table_path(Path("runs/a/robustness.png")).as_posix()
+    'runs/a/robustness_seeds.csv'
+    """
+    return out.with_name(f"{out.stem}_seeds.csv")
 
 
 def _csv(axes: list[Axis], means: np.ndarray, seeds: list[int]) -> str:

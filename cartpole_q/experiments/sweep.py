@@ -33,12 +33,12 @@ from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_info, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
-from cartpole_q.figures import FIGURE_FORMATS, figure_bytes, summary_line_figure
+from cartpole_q.figures import DataFigure, summary_line_figure
 from cartpole_q.learning_curves import aggregate_band, info_key_of, metric_label, per_episode
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
-from cartpole_q.store.atomic import atomic_write_bytes
+from cartpole_q.store.figure_file import write_figure
 from cartpole_q.store.runsets import load_run_set
 from cartpole_q.store.sweepdir import PointRow, ResultRow, axis_cell
 from cartpole_q.store.tensorboard import TENSORBOARD_DIR
@@ -349,7 +349,7 @@ def run_sweep(
 
 
 def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
-    """Draw the sweep file's ``figure`` of every point into the sweep directory."""
+    """Draw the sweep file's ``figure`` of every point into the sweep directory, its data beside it."""
     figure = spec.figure
     assert figure is not None
     labels = [
@@ -418,8 +418,7 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     drawn = summary_line_figure(
         lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y
     )
-    atomic_write_bytes(out, figure_bytes(drawn, FIGURE_FORMATS[out.suffix.lower()]))
-    return out
+    return write_figure(out, drawn)
 
 
 def plan_tasks(
@@ -590,9 +589,9 @@ def summarize_sweep(spec: SweepSpec, directory: Path, rows: Sequence[ResultRow])
 
 def sweep_png(
     spec: SweepSpec, point_rows: Sequence[PointRow], by_point: dict[str, list[ResultRow]]
-) -> bytes:
+) -> DataFigure:
     """Draw ``sweep.png``: the statistics against the axes, and the performance profiles."""
-    from cartpole_q.figures import SweepAxis, figure_png, sweep_figure
+    from cartpole_q.figures import SweepAxis, sweep_figure
 
     axes = [SweepAxis(key, [axis_cell(v) for v in values]) for key, values in spec.grid.items()]
     if spec.zip:  # the zip group is one more axis
@@ -605,7 +604,7 @@ def sweep_png(
             np.array([row.result.eval_mean for row in rows if row.result.eval_mean is not None])
         )
     threshold = _threshold(spec)
-    figure = sweep_figure(
+    return sweep_figure(
         spec.name,
         axes,
         [spec.point_id(point.index) for point in spec.points],
@@ -613,7 +612,6 @@ def sweep_png(
         eval_means,
         threshold,
     )
-    return figure_png(figure)
 
 
 def _threshold(spec: SweepSpec) -> float | None:

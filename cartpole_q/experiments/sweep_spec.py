@@ -58,6 +58,12 @@ FIGURE_KEYS = (
 """the keys of a sweep file's ``figure`` section"""
 
 
+SWEEP_OWN_FILES = (
+    sweepdir.SWEEP_FILE, sweepdir.RESULTS_FILE, sweepdir.POINTS_FILE, sweepdir.FIGURE_FILE,
+)  # fmt: skip
+"""the sweep directory's files a study figure (and its ``.csv``) must not replace"""
+
+
 @dataclass(frozen=True)
 class FigureSpec:
     """The learning-curve figure a sweep draws of its points when it completes.
@@ -300,6 +306,14 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         raise ConfigError(
             f"{where}: figure.file: {shown(file)} must be a file name in the sweep directory "
             "ending in .png, .svg or .pdf."
+        )
+    # The figure's data goes beside it as <stem>.csv: it must not replace the sweep's files.
+    taken = {Path(name).stem.lower() for name in SWEEP_OWN_FILES}
+    if Path(file).stem.lower() in taken:
+        raise ConfigError(
+            f"{where}: figure.file: {file!r} would write {Path(file).stem}.csv beside it, "
+            f"which the sweep's own files ({', '.join(SWEEP_OWN_FILES)}) need; choose "
+            "another name."
         )
     if values.get("first") is not None and values["first"] < 1:
         raise ConfigError(f"{where}: figure.first: must be at least 1, got {values['first']}.")

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import contextlib
 import datetime
-import io
 import json
 import math
 import os
@@ -28,7 +27,7 @@ import warnings
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +49,9 @@ from cartpole_q.store import sweepdir, tunedir
 from cartpole_q.store.atomic import remove_stale_temporaries, write_failure
 from cartpole_q.store.sweepdir import axis_cell, cell
 from cartpole_q.store.tensorboard import TENSORBOARD_DIR
+
+if TYPE_CHECKING:
+    from cartpole_q.figures import DataFigure
 
 IQM_BONUS = 1e-3
 """with objective success_rate: the most a trial's IQM eval return adds (below one seed's share)"""
@@ -672,6 +674,8 @@ TRIAL_COLUMNS = (
 def write_outputs(spec: TuneSpec, directory: Path, the_study: Any) -> dict[str, Any]:
     """Write ``trials.csv``, ``best.yaml``, ``history.png`` and ``importance.png``.
 
+    Each figure goes out with its data beside it (``history.csv``, ``importance.csv``).
+
     Returns:
         The best trial: ``number``, ``values``, ``objective`` and its figures.
     """
@@ -694,7 +698,7 @@ def write_outputs(spec: TuneSpec, directory: Path, the_study: Any) -> dict[str, 
         {**values, "name": f"{spec.name[:59]}-best"}, f"trial {best_trial.number}"
     )
     tunedir.write_best(directory, best_config, best_trial.number)
-    tunedir.write_figures(directory, *_figures(the_study))
+    tunedir.write_figures(directory, *_figures(the_study, spec.name))
     return {"number": best_trial.number, "values": values, "objective": best_trial.value,
             **best_trial.user_attrs}  # fmt: skip
 
@@ -714,31 +718,29 @@ def _param_value(dimension: Dimension, value: Any) -> Any:
     return value
 
 
-def _figures(the_study: Any) -> tuple[bytes, bytes | None]:
-    """Optuna's history and importance plots as PNG bytes (no importance below 2 trials)."""
-    import matplotlib
+def _figures(the_study: Any, name: str) -> tuple[DataFigure, DataFigure | None]:
+    """The history and importance figures (no importance below 2 finished trials).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from optuna.visualization import matplotlib as optuna_plots
+    Drawn here rather than with Optuna's plots, so that each carries the numbers it draws:
+    the objectives, and the importances Optuna's default evaluator gives (what its
+    ``plot_param_importances`` draws), computed once.
+    """
+    from optuna.importance import get_param_importances
 
-    def png(axes: Any) -> bytes:
-        figure = axes.figure
-        figure.set_size_inches(8, 4.5)
-        figure.tight_layout()
-        buffer = io.BytesIO()
-        figure.savefig(buffer, format="png", dpi=100)
-        plt.close(figure)
-        return buffer.getvalue()
+    from cartpole_q.figures import importance_figure, tune_history_figure
 
-    history = png(optuna_plots.plot_optimization_history(the_study))
     complete = [t for t in the_study.get_trials(deepcopy=False) if t.state.name == "COMPLETE"]
+    history = tune_history_figure(
+        [t.number for t in complete], [t.value for t in complete], f"{name}: objective per trial"
+    )
     if len(complete) < 2:
         return history, None
     try:
-        return history, png(optuna_plots.plot_param_importances(the_study))
+        importances = get_param_importances(the_study)
     except (RuntimeError, ValueError):
         return history, None  # e.g. every trial had the same value
+    pairs = [(key, float(value)) for key, value in importances.items()]
+    return history, importance_figure(pairs, f"{name}: parameter importances")
 
 
 def load_best(directory: Path) -> Path:

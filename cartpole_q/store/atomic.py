@@ -14,6 +14,7 @@ import io
 import json
 import os
 import secrets
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -32,14 +33,35 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
         WriteError: the file cannot be written (``ENOSPC``, ``EACCES``, ``EROFS``,
             ``ENOTDIR``, ...); the temporary file is gone and ``path`` is untouched.
     """
-    temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    atomic_write_together([(path, data)])
+
+
+def atomic_write_together(files: Sequence[tuple[Path, bytes]]) -> None:
+    """Write several files (a figure and its data) so that a failure changes none of them.
+
+    Every file is first written whole to its temporary file; only then are they moved into
+    place, in the order given. A full disk or a refused write therefore leaves every one
+    of them absent or old; only a failing ``os.replace`` (not a matter of space) could
+    leave the first ones new and the rest old.
+
+    Raises:
+        WriteError: naming the first file that cannot be written; no temporary file is
+            left and no file is changed.
+    """
+    pending: list[tuple[Path, Path]] = []
+    path = files[0][0] if files else Path()
     try:
-        with open(temporary, "xb") as stream:
-            stream.write(data)
-        os.replace(temporary, path)
+        for path, data in files:
+            temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+            with open(temporary, "xb") as stream:
+                pending.append((temporary, path))
+                stream.write(data)
+        for temporary, path in pending:
+            os.replace(temporary, path)
     except BaseException as error:
-        with contextlib.suppress(OSError):
-            temporary.unlink(missing_ok=True)
+        for temporary, _ in pending:
+            with contextlib.suppress(OSError):
+                temporary.unlink(missing_ok=True)
         if isinstance(error, OSError):
             raise WriteError(f"{path}: cannot be written: {write_failure(path, error)}.") from None
         raise

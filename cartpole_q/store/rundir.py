@@ -44,7 +44,6 @@ from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.store import lock
 from cartpole_q.store.atomic import (
     atomic_save_npy,
-    atomic_write_bytes,
     atomic_write_text,
     make_directory,
     write_failure,
@@ -352,7 +351,8 @@ def write_run(
     )
     atomic_write_text(run_dir / EVALUATIONS_FILE, evaluations_csv(result.evaluations))
     if plot:
-        from cartpole_q.figures import Curve, figure_png, reward_curve_figure
+        from cartpole_q.figures import Curve, reward_curve_figure
+        from cartpole_q.store.figure_file import write_figure
 
         curve = Curve(
             run_dir.name, result.returns, result.solved_episode, interrupted=result.interrupted
@@ -361,7 +361,7 @@ def write_run(
             " (interrupted)" if result.interrupted else ""
         )
         figure = reward_curve_figure([curve], result.reward_threshold, title=title)
-        atomic_write_bytes(run_dir / CURVE_FILE, figure_png(figure))
+        write_figure(run_dir / CURVE_FILE, figure)
     summary = summarize(result)
     if result.config.train.tensorboard:
         from cartpole_q.store.tensorboard import write_tensorboard

@@ -17,7 +17,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import yaml
@@ -32,8 +32,12 @@ from cartpole_q.store.atomic import (
     make_directory,
     remove_stale_temporaries,
 )
+from cartpole_q.store.figure_file import write_figure as write_figure_file
 from cartpole_q.store.reading import ShapeCheck, load_npz
 from cartpole_q.store.rundir import CONFIG_FILE, NewDirectory, new_directory, write_config
+
+if TYPE_CHECKING:
+    from cartpole_q.figures import DataFigure
 
 SWEEP_FILE = "sweep.yaml"
 RESULTS_FILE = "results.csv"
@@ -411,9 +415,9 @@ def write_points(directory: Path, axes: Sequence[str], rows: Iterable[PointRow])
     atomic_write_text(directory / POINTS_FILE, csv_text(points_header(axes), cells))
 
 
-def write_figure(directory: Path, png: bytes) -> None:
-    """Write ``sweep.png``."""
-    atomic_write_bytes(directory / FIGURE_FILE, png)
+def write_figure(directory: Path, figure: DataFigure) -> None:
+    """Write ``sweep.png`` and its data, ``sweep.csv``."""
+    write_figure_file(directory / FIGURE_FILE, figure)
 
 
 def point_results(point_dir: Path) -> list[ResultRow] | None:

@@ -3,8 +3,9 @@
 ``tune.yaml`` is written before the first trial and holds the resolved tune file and the
 storage URL (none: the journal file ``study.journal`` here). The journal is Optuna's own
 append-only log; it survives a kill -9 and lets several processes share one study.
-``trials.csv``, ``best.yaml``, ``history.png`` and ``importance.png`` are rewritten at
-the end of every ``tune`` call.
+``trials.csv``, ``best.yaml``, ``history.png`` and ``importance.png`` (each figure with its
+data, ``history.csv`` and ``importance.csv``) are rewritten at the end of every ``tune``
+call.
 """
 
 from __future__ import annotations
@@ -13,15 +14,19 @@ import contextlib
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
 from cartpole_q.config import Config, ConfigError, read_yaml_mapping
 from cartpole_q.errors import RunError
-from cartpole_q.store.atomic import atomic_write_bytes, atomic_write_text
+from cartpole_q.store.atomic import atomic_write_text
+from cartpole_q.store.figure_file import write_figure
 from cartpole_q.store.rundir import NewDirectory, new_directory
 from cartpole_q.store.sweepdir import csv_text
+
+if TYPE_CHECKING:
+    from cartpole_q.figures import DataFigure
 
 TUNE_FILE = "tune.yaml"
 JOURNAL_FILE = "study.journal"
@@ -84,8 +89,8 @@ def write_best(directory: Path, config: Config, trial: int) -> None:
     atomic_write_text(directory / BEST_FILE, header + config.to_yaml())
 
 
-def write_figures(directory: Path, history: bytes, importance: bytes | None) -> None:
-    """Write ``history.png`` and, when there is one, ``importance.png``."""
-    atomic_write_bytes(directory / HISTORY_FILE, history)
+def write_figures(directory: Path, history: DataFigure, importance: DataFigure | None) -> None:
+    """Write ``history.png`` and, when there is one, ``importance.png``, each with its data."""
+    write_figure(directory / HISTORY_FILE, history)
     if importance is not None:
-        atomic_write_bytes(directory / IMPORTANCE_FILE, importance)
+        write_figure(directory / IMPORTANCE_FILE, importance)
