@@ -348,10 +348,12 @@ def summary_line_figure(
     y_label: str,
     title: str,
     log_y: bool = False,
+    y_limits: tuple[float | None, float | None] = (None, None),
 ) -> DataFigure:
     """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
 
-    Each line is ``(label, xs, centre, low, high)``.
+    Each line is ``(label, xs, centre, low, high)``; ``y_limits`` fixes either end of the y
+    axis (the book's range: Figure 7.2's 0.25 to 0.55 leaves the large errors off the top).
     """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
@@ -362,6 +364,8 @@ def summary_line_figure(
         record.line(label, xs, centre, low, high)
     if log_y:
         axes.set_yscale("log")
+    if y_limits != (None, None):
+        axes.set_ylim(*y_limits)
     axes.set_xlabel(x_label)
     axes.set_ylabel(y_label)
     axes.set_title(title, fontsize="medium")
@@ -998,7 +1002,8 @@ def draw_profiles(
     axes.set_ylim(-0.02, 1.02)
     axes.set_xlabel(xlabel)
     axes.set_ylabel("fraction of seeds ≥ τ")
-    axes.legend(loc="lower left", fontsize="x-small")
+    if labels or threshold is not None:  # (a prediction sweep's points have no scores)
+        axes.legend(loc="lower left", fontsize="x-small")
     axes.grid(alpha=0.3)
 
 

@@ -21,9 +21,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-METRICS = ("return", "length", "cumulative-return", "episodes")
+METRICS = ("return", "length", "cumulative-return", "episodes", "rms_error")
 """what ``plot --metric`` draws: per episode, its return or its length; running totals of
-returns, or of episodes"""
+returns, or of episodes; a prediction run's RMS error of ``V`` after each episode"""
+ERROR_METRIC = "rms_error"
+"""a prediction run's RMS error against the true values (``metrics.csv``'s ``rms_error``)"""
 INFO_METRIC_PREFIX = "info:"
 """``info:KEY``: each episode's sum of ``info[KEY]`` (runs with ``train.info_metric: KEY``)"""
 INFO_KEY_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
@@ -42,6 +44,7 @@ METRIC_LABELS = {
     "length": "steps per episode",
     "cumulative-return": "cumulative return",
     "episodes": "episodes completed",
+    "rms_error": "RMS error of V, averaged over states",
 }
 X_LABELS = {"episode": "training episode", "env-steps": "training env steps"}
 
@@ -55,6 +58,22 @@ def info_key_of(metric: str) -> str | None:
     if metric.startswith(INFO_METRIC_PREFIX):
         return metric.removeprefix(INFO_METRIC_PREFIX)
     return None
+
+
+def record_column(metric: str) -> str | None:
+    """The ``metrics.csv`` column a metric draws beyond returns and lengths, if it needs one.
+
+    ``info:KEY`` draws ``info_KEY`` (runs with ``train.info_metric: KEY``), ``rms_error`` the
+    column of the same name (prediction runs); the others are functions of returns and
+    lengths.
+
+    >>> record_column("info:left_from_a"), record_column("rms_error"), record_column("length")
+    ('info_left_from_a', 'rms_error', None)
+    """
+    key = info_key_of(metric)
+    if key is not None:
+        return f"info_{key}"
+    return ERROR_METRIC if metric == ERROR_METRIC else None
 
 
 def check_metric(metric: str) -> str | None:
@@ -89,7 +108,7 @@ def metric_label(metric: str) -> str:
 
 def smoothed(metric: str) -> bool:
     """Whether ``--smooth`` applies to ``metric`` (per-episode values, not running totals)."""
-    return metric in ("return", "length") or info_key_of(metric) is not None
+    return metric in ("return", "length", ERROR_METRIC) or info_key_of(metric) is not None
 
 
 @dataclass(frozen=True)
@@ -104,11 +123,12 @@ class SeedCurves:
 
 
 def per_episode(
-    returns: np.ndarray, lengths: np.ndarray, metric: str, info: np.ndarray | None = None
+    returns: np.ndarray, lengths: np.ndarray, metric: str, record: np.ndarray | None = None
 ) -> np.ndarray:
     """One run's ``metric`` after each of its episodes.
 
-    ``info`` is the run's per-episode sums of ``info[KEY]``, which ``info:KEY`` draws.
+    ``record`` is the run's column that the metric draws (:func:`record_column`): its
+    per-episode sums of ``info[KEY]`` for ``info:KEY``, its errors for ``rms_error``.
 
     >>> per_episode(np.array([1.0, 2.0]), np.array([3, 4]), "cumulative-return").tolist()
     [1.0, 3.0]
@@ -117,10 +137,11 @@ def per_episode(
     >>> per_episode(np.array([1.0]), np.array([2]), "info:left_from_a", np.array([1.0])).tolist()
     [1.0]
     """
-    if info_key_of(metric) is not None:
-        if info is None:
-            raise ValueError(f"{metric}: the run kept no per-episode info sums")
-        return np.asarray(info, dtype=np.float64)
+    column = record_column(metric)
+    if column is not None:
+        if record is None:
+            raise ValueError(f"{metric}: the run kept no column {column}")
+        return np.asarray(record, dtype=np.float64)
     if metric == "return":
         return np.asarray(returns, dtype=np.float64)
     if metric == "length":
@@ -154,7 +175,7 @@ def seed_curves(
     x: str,
     window: int = 1,
     x_max: float | None = None,
-    infos: Sequence[np.ndarray | None] | None = None,
+    records: Sequence[np.ndarray | None] | None = None,
 ) -> SeedCurves:
     """Every seed's ``metric`` on a common grid of episodes or env steps.
 
@@ -167,7 +188,7 @@ def seed_curves(
             (``return``, ``length`` and ``info:KEY``; running totals are not smoothed).
         x_max: The grid's end (the book's figures stop at a fixed step or episode);
             default: the longest seed's.
-        infos: Per seed, its episodes' sums of ``info[KEY]`` (for ``info:KEY``).
+        records: Per seed, the column the metric draws (:func:`record_column`).
 
     Returns:
         The grid and the ``(seeds, points)`` values. On ``episode``, a seed's value at
@@ -178,9 +199,9 @@ def seed_curves(
     if x not in X_AXES:
         raise ValueError(f"unknown x axis {x!r}; one of {', '.join(X_AXES)}")
     per_seed = []
-    seed_infos = [None] * len(returns) if infos is None else infos
-    for seed_returns, seed_lengths, seed_info in zip(returns, lengths, seed_infos, strict=True):
-        values = per_episode(seed_returns, seed_lengths, metric, seed_info)
+    seed_records = [None] * len(returns) if records is None else records
+    for seed_returns, seed_lengths, record in zip(returns, lengths, seed_records, strict=True):
+        values = per_episode(seed_returns, seed_lengths, metric, record)
         if smoothed(metric):
             values = smooth(values, window)
         per_seed.append(values)

@@ -365,13 +365,24 @@ def is_cached(function_name: str) -> bool:
     """Whether numba's cache holds compiled code of a function named ``function_name``.
 
     numba names a cached function's index ``<module>.<name>-<line>.py<version>.nbi``.
-    Used to say, before a first run compiles for seconds, that it is compiling.
+    Used to say, before a first run compiles for seconds, that it is compiling. A name once
+    found is remembered for the process (a sweep's worker asks before each of its runs, and
+    the directory this process uses is never pruned while it runs).
     """
+    if function_name in _found:
+        return True
     configure()
     import numba
 
     root = Path(os.environ.get("NUMBA_CACHE_DIR") or numba.config.CACHE_DIR)  # type: ignore[attr-defined]
     try:
-        return any(root.rglob(f"*.{function_name}-*.nbi"))
+        found = any(root.rglob(f"*.{function_name}-*.nbi"))
     except OSError:
         return False
+    if found:
+        _found.add(function_name)
+    return found
+
+
+_found: set[str] = set()
+"""the names :func:`is_cached` has found in this process"""

@@ -152,7 +152,7 @@ def test_the_sweep_keeps_the_curve_and_the_plot_reads_it(in_tmp: Path) -> None:
     ]
     curves = seed_curves(
         [r.metrics.returns for r in runs], [r.metrics.lengths for r in runs],
-        "info:left_from_a", "episode", infos=[r.info for r in runs],
+        "info:left_from_a", "episode", records=[r.info for r in runs],
     )  # fmt: skip
     assert curves.values.tolist() == [kept[f"seed-00{s}.info_left_from_a"].tolist()
                                       for s in range(3)]  # fmt: skip

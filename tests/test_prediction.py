@@ -20,7 +20,7 @@ from cartpole_q.envs.gym import inspect_env
 from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.store import rundir
 from cartpole_q.training import train
-from tests.conftest import invoke
+from tests.conftest import invoke, write_yaml
 
 WALK5 = {"env.id": "cartpole_q/RandomWalk5-v0", "discretization": None, "agent.gamma": 1.0}
 WALK19 = {"env.id": "cartpole_q/RandomWalk-v0", "discretization": None, "agent.gamma": 1.0}
@@ -149,3 +149,59 @@ def test_td_learns_the_walk_faster_than_mc() -> None:
             errors.append(float(result.errors[-10:].mean()))
         ends[algorithm] = float(np.mean(errors))
     assert ends["td"] < ends["mc_prediction"] < 0.12
+
+
+def test_a_sweep_draws_the_errors_and_plot_draws_them_too(tmp_path: Path) -> None:
+    """figure.metric: rms_error, each point's errors kept in curves.npz (seed-NNN.rms_error)."""
+    study = tmp_path / "walk.yaml"
+    write_yaml(
+        study,
+        {
+            "name": "walk",
+            "base": {
+                "env": {"id": WALK5["env.id"]},
+                "agent": {"algorithm": "td", "gamma": 1.0, "alpha": 0.1, "q_init": 0.5},
+                "train": {"episodes": 20, "eval_every": 0, "checkpoint_every": 0},
+                "eval": {"episodes": 1},
+            },
+            "seeds": "0-2",
+            "zip": {"agent.algorithm": ["td", "mc_prediction"], "agent.alpha": [0.1, 0.1]},
+            "figure": {"metric": "rms_error", "file": "walk.png"},
+        },
+    )
+    out = tmp_path / "sweep"
+    result = invoke("sweep", study, "--out", out, "--quiet")
+    assert result.exit_code == 0, result.output
+    kept = np.load(out / "points" / "000" / "curves.npz")
+    whole = train(
+        _config(WALK5, "td", **{"agent.alpha": 0.1, "train.episodes": 20, "seed": 1}),
+        final_eval=False,
+    )
+    assert whole.errors is not None
+    assert kept["seed-001.rms_error"].tolist() == whole.errors.tolist()
+    rows = (out / "walk.csv").read_text().splitlines()
+    assert rows[0] == "panel,series,x,y,y_low,y_high,value" and len(rows) > 40
+    plotted = invoke(
+        "plot", out / "points" / "001", "--metric", "rms_error", "--out", tmp_path / "p.png"
+    )
+    assert plotted.exit_code == 0, plotted.output
+    refused = invoke(
+        "plot", out / "points" / "001", "--metric", "info:left", "--out", tmp_path / "q.png"
+    )
+    assert refused.exit_code == 2
+
+
+def test_a_control_point_cannot_draw_errors(tmp_path: Path) -> None:
+    study = tmp_path / "mixed.yaml"
+    write_yaml(
+        study,
+        {
+            "base": {"env": {"id": WALK5["env.id"]}, "train": {"episodes": 5}},
+            "seeds": "0",
+            "grid": {"agent.algorithm": ["td", "q_learning"]},
+            "figure": {"metric": "rms_error"},
+        },
+    )
+    result = invoke("sweep", study, "--out", tmp_path / "s")
+    assert result.exit_code == 2
+    assert "point 1 runs agent.algorithm q_learning, a control algorithm" in result.stderr

@@ -23,6 +23,7 @@ import yaml
 
 from cartpole_q.config import ConfigError, load_config
 from cartpole_q.experiments import sweep as sweeping
+from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.sweep_spec import load_sweep
 from cartpole_q.statistics import summarize_point
 from cartpole_q.store import sweepdir
@@ -417,6 +418,8 @@ def _stopped_sweep(tmp_path: Path, data: dict[str, Any], after: int = 5) -> Path
     """A sweep started by the command's code and stopped after ``after`` runs."""
     path = write_yaml(tmp_path / "s.yaml", data)
     spec = load_sweep(path)
+    # Compiled first: the stop request counts runs, not the polls of a cold cache's compiling.
+    compile_ahead([point.config for point in spec.points], workers=1)
     directory = sweeping.start_sweep(spec, tmp_path / "stopped")
     calls = iter(range(10_000))
     outcome = sweeping.run_sweep(

@@ -38,6 +38,7 @@ from cartpole_q.learning_curves import (
     aggregate_band,
     info_key_of,
     metric_label,
+    record_column,
     seed_curves,
     smoothed,
 )
@@ -162,7 +163,7 @@ def plot_metric(
             is drawn).
     """
     style = style or CurveStyle()
-    info_key = info_key_of(metric)
+    column = record_column(metric)
     bands = []
     for number, path in enumerate(run_dirs):
         run_set = load_run_set(path)
@@ -175,11 +176,11 @@ def plot_metric(
                 f"{path}: this sweep kept no learning curves (its sweep file says curves: "
                 "false, or it predates them); there is nothing to draw."
             )
-        if info_key is not None:
-            check_info(path, runs, info_key)
+        check_record(path, runs, metric)
         curves = seed_curves(
             [run.metrics.returns for run in runs], [run.metrics.lengths for run in runs],
-            metric, x, window, style.x_max, [run.info for run in runs],
+            metric, x, window, style.x_max,
+            [None if column is None else run.record(column) for run in runs],
         )  # fmt: skip
         values = (curves.values + style.offset) * style.scale
         centre, low, high = aggregate_band(values, aggregate, np.random.default_rng(0))
@@ -202,14 +203,20 @@ def plot_metric(
     return write_figure(out, figure)
 
 
-def check_info(path: Path, runs: Sequence[rundir.Run], info_key: str) -> None:
-    """Refuse runs that kept no per-episode sums of ``info[info_key]`` (``info:KEY``).
+def check_record(path: Path, runs: Sequence[rundir.Run], metric: str) -> None:
+    """Refuse runs that kept no column of what ``metric`` draws (``info:KEY``, ``rms_error``).
 
     Raises:
-        RunError: naming the path, the key and what its runs recorded.
+        RunError: naming the path, the metric and what its runs recorded.
     """
+    column = record_column(metric)
+    if column is None:
+        return
+    info_key = info_key_of(metric)
     for run in runs:
-        if run.info is None or run.config.train.info_metric != info_key:
+        if run.record(column) is not None:
+            continue
+        if info_key is not None:
             recorded = run.config.train.info_metric
             kept = f"train.info_metric: {recorded}" if recorded else "no train.info_metric"
             raise RunError(
@@ -217,6 +224,11 @@ def check_info(path: Path, runs: Sequence[rundir.Run], info_key: str) -> None:
                 f"kept no per-episode sums of info[{info_key!r}]; train with train.info_metric: "
                 f"{info_key} to draw it."
             )
+        raise RunError(
+            f"{path}: --metric {metric}: its runs kept no errors: only a prediction algorithm "
+            f"(agent.algorithm {run.config.agent.algorithm} is not one, or is one on a world "
+            "without a model to know the true values by) measures them."
+        )
 
 
 def _greedy_paths(

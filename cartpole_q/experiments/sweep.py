@@ -13,7 +13,7 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -30,15 +30,16 @@ from cartpole_q.config import (
 )
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
-from cartpole_q.experiments.plots import CurveStyle, check_info, plot_metric
+from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
 from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.figures import DataFigure, summary_line_figure
-from cartpole_q.learning_curves import aggregate_band, info_key_of, metric_label, per_episode
+from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
 from cartpole_q.store.figure_file import write_figure
+from cartpole_q.store.rundir import ERRORS_COLUMN, INFO_COLUMN_PREFIX
 from cartpole_q.store.runsets import load_run_set
 from cartpole_q.store.sweepdir import PointRow, ResultRow, axis_cell
 from cartpole_q.store.tensorboard import TENSORBOARD_DIR
@@ -75,8 +76,9 @@ class FinishedRun:
     """the learning curve: each training episode's return"""
     lengths: np.ndarray
     """each training episode's length"""
-    info: np.ndarray | None = None
-    """each training episode's sum of ``info[train.info_metric]`` (``None`` without it)"""
+    records: Mapping[str, np.ndarray] = field(default_factory=dict)
+    """its further ``metrics.csv`` columns by name: ``info_KEY`` (each episode's sum of
+    ``info[train.info_metric]``), ``rms_error`` (a prediction run's errors)"""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -127,9 +129,14 @@ def run_task(
             if handle.should_stop():
                 return
             result = train(config.for_seed(seed), env_info=env_info)
+            records = {}
+            if result.info is not None:
+                records[f"{INFO_COLUMN_PREFIX}{config.train.info_metric}"] = result.info
+            if result.errors is not None:
+                records[ERRORS_COLUMN] = result.errors
             yield FinishedRun(
                 point, SeedResult.of_train(result), result.q_table, result.returns,
-                result.lengths, result.info,
+                result.lengths, records,
             )  # fmt: skip
 
 
@@ -387,12 +394,12 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     groups: dict[str, list[tuple[float, np.ndarray]]] = {}
     for point, path in zip(spec.points, paths, strict=True):
         runs = load_run_set(path).runs
-        info_key = info_key_of(figure.metric)
-        if info_key is not None:
-            check_info(path, runs, info_key)
+        check_record(path, runs, figure.metric)
+        column = record_column(figure.metric)
         per_seed = []
         for run in runs:
-            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, run.info)
+            record = None if column is None else run.record(column)
+            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, record)
             values = values[: figure.first] if figure.first is not None else values
             per_seed.append((float(np.mean(values)) + figure.offset) * figure.scale)
         others = ", ".join(
@@ -416,8 +423,9 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     y_label = figure.y_label or f"{metric_label(figure.metric)}, mean over the {first}"
     title = figure.title or spec.name
     drawn = summary_line_figure(
-        lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y
-    )
+        lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y,
+        (figure.y_min, figure.y_max),
+    )  # fmt: skip
     return write_figure(out, drawn)
 
 
@@ -477,7 +485,8 @@ class _Book:
             self._per_point[point] += 1
         self._tables: dict[int, dict[str, np.ndarray]] = {}
         self._curves: dict[int, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
-        self._info: dict[int, dict[str, np.ndarray]] = {}
+        self._records: dict[int, dict[str, dict[str, np.ndarray]]] = {}
+        """by point and seed key, the runs' further columns (``FinishedRun.records``)"""
         self._dirty: set[int] = set()
         self._last_flush = -math.inf  # the first results are saved at once
         self.saved = len(self.rows)
@@ -516,11 +525,7 @@ class _Book:
                 self._tables[point] = sweepdir.read_tables(self._directory, point_id)
                 if spec.curves:
                     self._curves[point] = sweepdir.read_curves(self._directory, point_id)
-                    info_key = spec.points[point].config.train.info_metric
-                    if info_key is not None:
-                        self._info[point] = sweepdir.read_info_curves(
-                            self._directory, point_id, info_key
-                        )
+                    self._records[point] = sweepdir.read_records(self._directory, point_id)
             self._tables[point][spec.seed_key(seed)] = run.q_table
             config = spec.points[point].config
             if config.train.tensorboard:
@@ -528,8 +533,8 @@ class _Book:
                 write_run_events(board / spec.seed_key(seed), config.for_seed(seed), run)
             if spec.curves:
                 self._curves[point][spec.seed_key(seed)] = (run.returns, run.lengths)
-                if run.info is not None:
-                    self._info[point][spec.seed_key(seed)] = run.info
+                if run.records:
+                    self._records[point][spec.seed_key(seed)] = dict(run.records)
             values = spec.points[point].values
             self.rows[(point, seed)] = ResultRow(
                 spec.point_id(point), {key: axis_cell(values[key]) for key in spec.axes}, run.result
@@ -546,9 +551,8 @@ class _Book:
             point_id = self._spec.point_id(point)
             sweepdir.write_tables(self._directory, point_id, self._tables[point])
             if self._spec.curves:
-                info_key = self._spec.points[point].config.train.info_metric
                 sweepdir.write_curves(
-                    self._directory, point_id, self._curves[point], self._info.get(point), info_key
+                    self._directory, point_id, self._curves[point], self._records.get(point)
                 )
         rows = self.sorted_rows()
         sweepdir.write_results(self._directory, self._spec.axes, rows)
@@ -558,7 +562,7 @@ class _Book:
             if self._per_point[point] == len(self._spec.seeds):
                 del self._tables[point]  # complete: its files hold every seed
                 self._curves.pop(point, None)
-                self._info.pop(point, None)
+                self._records.pop(point, None)
         self._dirty.clear()
         self._last_flush = time.monotonic()
 

@@ -198,13 +198,24 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     except ValueError as error:
         raise ConfigError(f"{where}: seeds: {error}") from None
     grid = _axes(raw.get("grid"), "grid", where)
-    zipped = _axes(raw.get("zip"), "zip", where)
+    zipped = _axes(raw.get("zip"), "zip", where, each_distinct=False)
     lengths = {key: len(values) for key, values in zipped.items()}
     if len(set(lengths.values())) > 1:
         shown = ", ".join(f"{key} has {n}" for key, n in lengths.items())
         raise ConfigError(
             f"{where}: zip: its axes move together, so they need the same number of values "
             f"({shown})."
+        )
+    # The zip group is one axis: its tuples must differ (one key may repeat a value, as
+    # TD's and MC's step sizes beside agent.algorithm: [td, td, mc_prediction, ...]).
+    tuples = [
+        tuple(axis_cell(values[i]) for values in zipped.values())
+        for i in range(len(next(iter(zipped.values()), [])))
+    ]
+    twice = next((cells for cells in tuples if tuples.count(cells) > 1), None)
+    if twice is not None:
+        raise ConfigError(
+            f"{where}: zip: gives the values {', '.join(twice)} twice; each point must differ."
         )
     for key in zipped:
         if key in grid:
@@ -236,9 +247,23 @@ def _check_against(key: str, axes: Mapping[str, list[Any]], where: str) -> None:
 
 
 def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None:
-    """Refuse ``figure.metric: info:KEY`` unless every point records KEY."""
-    from cartpole_q.learning_curves import info_key_of
+    """Refuse a figure metric some point does not record.
 
+    ``info:KEY`` needs every point to record KEY; ``rms_error`` needs every point to run a
+    prediction algorithm.
+    """
+    from cartpole_q.learning_curves import ERROR_METRIC, info_key_of
+    from cartpole_q.rl.algorithms import get as get_algorithm
+
+    if metric == ERROR_METRIC:
+        for point in points:
+            algorithm = point.config.agent.algorithm
+            if not get_algorithm(algorithm).predicts:
+                raise ConfigError(
+                    f"{where}: figure.metric: rms_error is a prediction run's error of V, but "
+                    f"point {point.index} runs agent.algorithm {algorithm}, a control "
+                    "algorithm; draw return, length, ... of it, or make every point predict."
+                )
     key = info_key_of(metric)
     if key is None:
         return
@@ -408,8 +433,12 @@ def load_base(base: Any, where: str, base_dir: Path) -> Config:
     return config.for_seed(config.seed)
 
 
-def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
-    """Check one axes section: dotted keys mapped to non-empty lists of values."""
+def _axes(axes: Any, section: str, where: str, each_distinct: bool = True) -> dict[str, list[Any]]:
+    """Check one axes section: dotted keys mapped to non-empty lists of values.
+
+    With ``each_distinct`` (a grid) no axis may repeat a value; a zip group's axes may (its
+    tuples are checked instead).
+    """
     if axes is None:
         return {}
     if not isinstance(axes, Mapping):
@@ -437,7 +466,7 @@ def _axes(axes: Any, section: str, where: str) -> dict[str, list[Any]]:
             )
         cells = [axis_cell(value) for value in values]
         twice = next((cell for cell in cells if cells.count(cell) > 1), None)
-        if twice is not None:
+        if twice is not None and each_distinct:
             raise ConfigError(
                 f"{where}: {section}.{key}: has the value {twice} twice; each point must differ."
             )

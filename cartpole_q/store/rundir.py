@@ -403,6 +403,16 @@ class Run:
         """The directory's name."""
         return self.path.name
 
+    def record(self, column: str) -> np.ndarray | None:
+        """Its per-episode ``metrics.csv`` column beyond the five every run has, if kept.
+
+        ``info_KEY`` (with ``train.info_metric: KEY``) or ``rms_error`` (a prediction run's).
+        """
+        info_key = self.config.train.info_metric
+        if info_key is not None and column == f"{INFO_COLUMN_PREFIX}{info_key}":
+            return self.info
+        return self.errors if column == ERRORS_COLUMN else None
+
 
 def is_multi_seed(path: Path) -> bool:
     """Whether ``path`` is the parent directory of a multi-seed run."""

@@ -20,6 +20,7 @@ import numpy as np
 from cartpole_q.config import Config, Schedule, config_differences, shown_value
 from cartpole_q.engines.base import EpisodeMetrics
 from cartpole_q.errors import RunError
+from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.store import rundir, sweepdir
 
 if TYPE_CHECKING:
@@ -210,8 +211,9 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
         sweep, point_dir.name, rundir.table_check(None if grid is None else grid.table_shape)
     )
     curves = sweepdir.read_curves(sweep, point_dir.name)
-    info_key = config.train.info_metric
-    infos = {} if info_key is None else sweepdir.read_info_curves(sweep, point_dir.name, info_key)
+    records = sweepdir.read_records(sweep, point_dir.name)
+    info_column = f"{rundir.INFO_COLUMN_PREFIX}{config.train.info_metric}"
+    predicts = get_algorithm(config.agent.algorithm).predicts
     threshold = rundir.config_threshold(config)
     seeds = sweepdir.sweep_seeds(sweep)
     runs = []
@@ -233,7 +235,9 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
                 visits=None,
                 metrics=_metrics(seed_config, returns, lengths),
                 result=dataclasses.replace(row.result, reward_threshold=threshold),
-                info=infos.get(key),
+                info=records.get(key, {}).get(info_column),
+                errors=records.get(key, {}).get(rundir.ERRORS_COLUMN),
+                predicts=predicts,
             )
         )
     total = len(seeds)

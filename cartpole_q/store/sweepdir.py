@@ -47,7 +47,8 @@ TABLES_FILE = "q_tables.npz"
 CURVES_FILE = "curves.npz"
 """a point's learning curves: ``seed-NNN.returns`` (float64) and ``seed-NNN.lengths``
 (int64) per finished seed, one value per training episode, compressed; with
-``train.info_metric: KEY`` also ``seed-NNN.info_KEY`` (float64, the per-episode sums)"""
+``train.info_metric: KEY`` also ``seed-NNN.info_KEY`` (float64, the per-episode sums), and a
+prediction run's ``seed-NNN.rms_error`` (float64, its error after each episode)"""
 FIGURE_FILE = "sweep.png"
 SWEEPS_ROOT = Path("sweeps")
 RESULT_COLUMNS = (
@@ -292,21 +293,20 @@ def write_curves(
     directory: Path,
     point_id: str,
     curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
-    info: Mapping[str, np.ndarray] | None = None,
-    info_key: str | None = None,
+    records: Mapping[str, Mapping[str, np.ndarray]] | None = None,
 ) -> None:
     """Rewrite a point's ``curves.npz`` whole: each seed's returns and lengths, compressed.
 
-    With ``info`` (by seed key, the sums of ``info[info_key]``), each seed's
-    ``seed-NNN.info_<info_key>`` too.
+    ``records`` (by seed key, the seed's further ``metrics.csv`` columns by name:
+    ``info_KEY``, ``rms_error``) go in as ``seed-NNN.<column>`` too.
     """
     arrays: dict[str, Any] = {}
     for key in sorted(curves):
         returns, lengths = curves[key]
         arrays[f"{key}.returns"] = np.asarray(returns, dtype=np.float64)
         arrays[f"{key}.lengths"] = np.asarray(lengths, dtype=np.int64)
-        if info is not None and key in info:
-            arrays[f"{key}.info_{info_key}"] = np.asarray(info[key], dtype=np.float64)
+        for column, values in sorted((records or {}).get(key, {}).items()):
+            arrays[f"{key}.{column}"] = np.asarray(values, dtype=np.float64)
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)
     atomic_write_bytes(curves_path(directory, point_id), buffer.getvalue())
@@ -338,8 +338,8 @@ def _one_dimensional(where: str, dtype: np.dtype[Any], shape: tuple[int, ...]) -
         )
 
 
-def read_info_curves(directory: Path, point_id: str, info_key: str) -> dict[str, np.ndarray]:
-    """A point's kept per-episode sums of ``info[info_key]`` by seed key (none if none).
+def read_records(directory: Path, point_id: str) -> dict[str, dict[str, np.ndarray]]:
+    """A point's kept further columns (``info_KEY``, ``rms_error``) by seed key, then column.
 
     Raises:
         RunError: the file is damaged.
@@ -347,11 +347,13 @@ def read_info_curves(directory: Path, point_id: str, info_key: str) -> dict[str,
     path = curves_path(directory, point_id)
     if not path.is_file():
         return {}
-    suffix = f".info_{info_key}"
     archive = load_npz(path, str(path), check=_one_dimensional)
-    return {
-        name.removesuffix(suffix): array for name, array in archive.items() if name.endswith(suffix)
-    }
+    records: dict[str, dict[str, np.ndarray]] = {}
+    for name, array in archive.items():
+        key, _, column = name.partition(".")
+        if column not in ("returns", "lengths"):
+            records.setdefault(key, {})[column] = array
+    return records
 
 
 def tables_path(directory: Path, point_id: str) -> Path:
