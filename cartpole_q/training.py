@@ -332,7 +332,7 @@ def _run(
     finished = state.episode >= total or (
         state.solved_episode is not None and settings.stop_when_solved
     )
-    if resume is not None and _evaluation_missing(state, settings.eval_every):
+    if resume is not None and _evaluation_missing(state, evaluate_every):
         interrupted = not periodic_evaluation()  # the one a stop cut short
     while not finished and not interrupted:
         stop = min(
@@ -371,7 +371,7 @@ def _run(
 
     stopped_when_solved = state.solved_episode is not None and settings.stop_when_solved
     checkpointed = on_checkpoint is not None and (interrupted or not stopped_when_solved)
-    if checkpointed and on_checkpoint is not None:
+    if checkpointed and on_checkpoint is not None:  # (checkpointed says so; mypy cannot see it)
         # Interrupted: for --resume. Reached train.episodes: to extend the run later.
         on_checkpoint(snapshot())
     wall_seconds = wall_before + time.perf_counter() - started
@@ -424,21 +424,44 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
             f"config asks for {[array.shape for array in live.memory]}; it was written by "
             "another algorithm or grid."
         )
+    # A damaged file must be a RunError, not numpy's ValueError from a slice of another length.
+    expected = [
+        ("q", live.q.shape, saved.q.shape),
+        ("visits", live.visits.shape, saved.visits.shape),
+        *(
+            (name, (episode,), column.shape)
+            for name, column in zip(EpisodeMetrics._fields, checkpoint.metrics, strict=True)
+        ),
+        *(
+            (name, (episode,), None if array is None else array.shape)
+            for name, array in (("info", checkpoint.info), ("rms_errors", checkpoint.errors))
+            if array is not None
+        ),
+    ]
+    for name, wanted, found in expected:
+        if found != wanted or episode > len(state.metrics.returns):
+            raise RunError(
+                f"the checkpoint's {name} has shape {found}, the run needs {wanted} (episode "
+                f"{episode} of {len(state.metrics.returns)}); the checkpoint is damaged or was "
+                "written with another config."
+            )
     live.q[...] = saved.q
     live.visits[...] = saved.visits
     for array, kept in zip(live.memory, saved.memory, strict=True):
         array[...] = kept
     for column, values in zip(state.metrics, checkpoint.metrics, strict=True):
         column[:episode] = values
-    if (state.info is None) != (checkpoint.info is None):
-        raise RunError(
-            "the checkpoint and the config disagree on train.info_metric (one keeps "
-            "per-episode info sums, the other none); it was written with another config."
-        )
-    if state.info is not None and checkpoint.info is not None:
-        state.info[:episode] = checkpoint.info
-    if state.errors is not None and checkpoint.errors is not None:
-        state.errors[:episode] = checkpoint.errors
+    for what, live_column, kept_column in (
+        ("train.info_metric (per-episode info sums)", state.info, checkpoint.info),
+        ("a prediction run's per-episode errors", state.errors, checkpoint.errors),
+    ):
+        if (live_column is None) != (kept_column is None):
+            raise RunError(
+                f"the checkpoint and the config disagree on {what}: one keeps them, the other "
+                "none; it was written with another config."
+            )
+        if live_column is not None and kept_column is not None:
+            live_column[:episode] = kept_column
     state.agent_rng.bit_generator.state = checkpoint.agent_rng_state
     if checkpoint.physics_rng_state is not None:
         state.physics_rng.bit_generator.state = checkpoint.physics_rng_state

@@ -985,28 +985,42 @@ class TrueOnlineTDLambda(Prediction, TraceAgent):
 def true_values(
     env: gymnasium.Env[Any, Any], n: int, gamma: float
 ) -> tuple[list[int], list[float]]:
-    """docs/algorithms.md, "The error": the uniform policy's values on the non-terminal states.
+    """docs/algorithms.md, "The error": the uniform policy's values on the measured states.
 
-    ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; a
-    terminal state is one whose every outcome stays in it, pays 0 and terminates.
+    ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; measured
+    are the states reachable from the start distribution along outcomes that do not
+    terminate, but the terminal ones (every outcome stays in the state, pays 0, terminates).
     """
     table = env.unwrapped.P  # type: ignore[attr-defined]
     states = len(table)
     matrix = np.zeros((states, states))
     expected = np.zeros(states)
     terminal = []
+    following: dict[int, set[int]] = {x: set() for x in range(states)}
     for x in range(states):
         ends = True
         for b in range(n):
-            for probability, following, reward, done in table[x][b]:
+            for probability, to, reward, done in table[x][b]:
                 weight = (1.0 / n) * probability
                 expected[x] += weight * reward
                 if not done:
-                    matrix[x, following] += weight
-                ends = ends and done and reward == 0.0 and following == x
+                    matrix[x, to] += weight
+                    if weight > 0.0:
+                        following[x].add(to)
+                ends = ends and done and reward == 0.0 and to == x
         terminal.append(ends)
-    values = np.linalg.solve(np.eye(states) - gamma * matrix, expected)
-    measured = [x for x in range(states) if not terminal[x]]
+    start = env.unwrapped.initial_state_distrib  # type: ignore[attr-defined]
+    reached = {x for x in range(states) if start[x] > 0.0}
+    frontier = list(reached)
+    while frontier:
+        for to in following[frontier.pop()]:
+            if to not in reached:
+                reached.add(to)
+                frontier.append(to)
+    order = sorted(reached)  # the system restricted to the reachable states, in order
+    system = np.eye(len(order)) - gamma * matrix[np.ix_(order, order)]
+    values = dict(zip(order, np.linalg.solve(system, expected[order]), strict=True))
+    measured = [x for x in order if not terminal[x]]
     return measured, [float(values[x]) for x in measured]
 
 

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cartpole_q.config import load_config
+from cartpole_q.config import ConfigError, load_config
 from cartpole_q.engines.base import prediction_truth
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.experiments.run import execute_run, prepare, start_run
@@ -115,6 +115,10 @@ def test_an_interrupted_prediction_run_resumes_byte_identically(
     loaded = rundir.load_run(run)
     assert whole.errors is not None and loaded.errors is not None
     assert loaded.errors.tolist() == whole.errors.tolist()
+    # resumed at a multiple of train.eval_every (10): still no greedy evaluation of V
+    assert (run / "evaluations.csv").read_text().splitlines()[1:] == []
+    assert json.loads((run / "summary.json").read_text())["eval"] is None
+    assert set(loaded.metrics.epsilons.tolist()) == {0.0}  # epsilon is ignored: 0
 
 
 @pytest.mark.parametrize(
@@ -205,3 +209,72 @@ def test_a_control_point_cannot_draw_errors(tmp_path: Path) -> None:
     result = invoke("sweep", study, "--out", tmp_path / "s")
     assert result.exit_code == 2
     assert "point 1 runs agent.algorithm q_learning, a control algorithm" in result.stderr
+
+
+def test_optimum_prints_the_policy_s_exact_values() -> None:
+    result = invoke("optimum", WALK5["env.id"], "--policy", "random", "--json")
+    assert result.exit_code == 0, result.output
+    found = json.loads(result.stdout)
+    assert (found["policy"], found["gamma"]) == ("random", 1.0)
+    assert [round(v * 6, 12) for v in found["values"].values()] == [1.0, 2.0, 3.0, 4.0, 5.0]
+    text = invoke("optimum", "FrozenLake-v1", "--policy", "random", "--gamma", "0.9")
+    assert text.exit_code == 0 and "values of the random policy (gamma 0.9)" in text.stdout
+    refused = invoke("optimum", "CartPole-v1", "--policy", "random")
+    assert refused.exit_code == 2 and "no exact values" in refused.stderr
+
+
+def test_the_measured_states_are_those_an_episode_can_be_in() -> None:
+    """Taxi's 100 states with the passenger at the destination are never occupied."""
+    taxi = load_config(overrides={"env.id": "Taxi-v4", "agent.algorithm": "td", "agent.gamma": 0.9})
+    truth = prediction_truth(taxi, inspect_env(taxi))
+    assert len(truth.rows) == 400 and len(set(truth.rows.tolist())) == 400
+
+
+def test_a_policy_that_may_never_end_is_refused_at_gamma_1() -> None:
+    endless = {"env.id": "FrozenLake-v1", "env.kwargs.desc": ["SF", "FF"], "agent.algorithm": "td"}
+    with pytest.raises(ConfigError, match=r"agent\.policy: .* not defined at agent\.gamma 1"):
+        train(load_config(overrides={**endless, "agent.gamma": 1.0, "train.episodes": 1}))
+    assert prediction_truth(
+        load_config(overrides={**endless, "agent.gamma": 0.9}),
+        inspect_env(load_config(overrides=endless)),
+    ).measured
+
+
+def test_what_needs_a_policy_refuses_a_prediction_run(tmp_path: Path) -> None:
+    run = tmp_path / "run"
+    base = ["--set", f"env.id={WALK5['env.id']}", "--set", "agent.algorithm=td"]
+    assert invoke("train", *base, "--episodes", "5", "--out", run, "-q").exit_code == 0
+    watched = invoke("train", *base, "--video-every", "2", "--out", tmp_path / "w")
+    assert watched.exit_code == 2 and "there is none to watch" in watched.stderr
+    other = tmp_path / "other"
+    assert invoke("train", *base, "--episodes", "5", "--out", other, "-q").exit_code == 0
+    compared = invoke("compare", run, other)
+    assert compared.exit_code == 2 and "is a prediction run (td)" in compared.stderr
+    tune = write_yaml(
+        tmp_path / "t.yaml",
+        {"base": {"env": {"id": WALK5["env.id"]}, "agent": {"algorithm": "td"}},
+         "space": {"agent.alpha": [0.1, 0.5]}},
+    )  # fmt: skip
+    tuned = invoke("tune", tune, "--out", tmp_path / "tune")
+    assert tuned.exit_code == 2 and "is a prediction algorithm" in tuned.stderr
+
+
+def test_a_checkpoint_of_another_length_is_refused(tmp_path: Path) -> None:
+    overrides = {
+        **WALK19,
+        "agent.algorithm": "td",
+        "train.episodes": 20,
+        "train.checkpoint_every": 10,
+    }
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    execute_run(run, prepared, should_stop=lambda: next(polls) >= 0)
+    with np.load(run / "checkpoint.npz") as data:
+        arrays = {name: data[name] for name in data.files}
+    arrays["rms_errors"] = arrays["rms_errors"][:-1]  # one error short
+    np.savez(run / "checkpoint.npz", **arrays)
+    resumed = invoke("train", "--resume", str(run), "-q")
+    assert resumed.exit_code == 2, resumed.output
+    assert "the checkpoint's rms_errors has shape" in resumed.stderr
+    assert "Traceback" not in resumed.output

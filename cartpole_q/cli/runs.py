@@ -414,15 +414,35 @@ def optimum_command(
             "limit, so it must be below 1).",
         ),
     ] = None,
+    policy: Annotated[
+        str | None,
+        typer.Option(
+            metavar="POLICY",
+            help="Instead, the exact state values of this fixed policy (random: uniform over "
+            "the actions), which a prediction run's rms_error is measured against; --gamma "
+            "then defaults to 1.",
+        ),
+    ] = None,
     json_output: JsonOutput = False,
 ) -> None:
     """The best expected return from the start, by value iteration on the environment's model."""
     with exit_codes():
         from cartpole_q.cli.exact_text import exact_lines, policy_grid
         from cartpole_q.config import parse_assignment
-        from cartpole_q.experiments.evaluate_runs import optimum
+        from cartpole_q.experiments.evaluate_runs import optimum, policy_values
 
-        found = optimum(env_id, [parse_assignment(text) for text in set_values or []], gamma)
+        assignments = [parse_assignment(text) for text in set_values or []]
+        if policy is not None:
+            values = policy_values(env_id, assignments, policy, 1.0 if gamma is None else gamma)
+            if json_output:
+                typer.echo(json.dumps(values.to_json()))
+                return
+            typer.echo(f"{env_id} {json.dumps(values.kwargs)}")
+            typer.echo(f"values of the {policy} policy (gamma {values.gamma:g}), by state:")
+            for state, value in values.values.items():
+                typer.echo(f"  {state}: {value:.6g}")
+            return
+        found = optimum(env_id, assignments, gamma)
         if json_output:
             typer.echo(json.dumps(found.to_json()))
             return
@@ -436,5 +456,5 @@ def optimum_command(
             legend += ", # wall" if "#" in layout.cells else ""
             legend += ", E end" if "E" in layout.cells else ""
             typer.echo(f"optimal first actions ({legend}):")
-            policy = list(found.exact.optimal_policy)
-            typer.echo(policy_grid(policy, layout.rows, layout.columns, layout.arrows(), marks))
+            optimal = list(found.exact.optimal_policy)
+            typer.echo(policy_grid(optimal, layout.rows, layout.columns, layout.arrows(), marks))

@@ -134,7 +134,7 @@ def train(
             with directory_lock(resume, "run") if resume.is_dir() else nullcontext():
                 prepared = runner.prepare_resume(resume, episodes)
                 _check_options(prepared.config.train.seeds, watch, video_every, backend)
-                _check_outputs(prepared.config, tensorboard, video_every)
+                _check_outputs(prepared.config, tensorboard, video_every, watch)
                 with backend_connection(backend, workers, address):
                     _train_into(
                         resume, prepared, True, workers, backend, address, quiet, watch,
@@ -149,7 +149,7 @@ def train(
             engine=None if engine is None else engine.value,
         )  # fmt: skip
         _check_options(prepared.config.train.seeds, watch, video_every, backend)
-        _check_outputs(prepared.config, tensorboard, video_every)
+        _check_outputs(prepared.config, tensorboard, video_every, watch)
         # Connected (or refused) before the run directory is created.
         with (
             backend_connection(backend, workers, address),
@@ -181,12 +181,21 @@ def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendCho
             raise UserError(f"--watch needs a window, but {problem}; use --video-every N instead.")
 
 
-def _check_outputs(config: Any, tensorboard: bool, video_every: int) -> None:
+def _check_outputs(config: Any, tensorboard: bool, video_every: int, watch: int) -> None:
     """Refuse outputs that cannot be written, before the run directory is created.
 
     TensorBoard event files need the optional writer; videos need an environment that
-    renders itself.
+    renders itself; watching and videos need a greedy policy (not a prediction run's V).
     """
+    if video_every or watch:
+        from cartpole_q.rl.algorithms import get as get_algorithm
+
+        if get_algorithm(config.agent.algorithm).predicts:
+            raise UserError(
+                f"--watch and --video-every play the greedy policy, but agent.algorithm "
+                f"{config.agent.algorithm} learns the values V of a given policy: there is "
+                "none to watch."
+            )
     if config.train.tensorboard:
         from cartpole_q.store.tensorboard import require_writer
 

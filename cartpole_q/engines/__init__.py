@@ -86,7 +86,7 @@ def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...
     functions (named by the one that learns).
     """
     from cartpole_q.engines.base import (
-        ScheduleRecord,
+        epsilon_record,
         kernel_name,
         loops_played,
         step_function_name,
@@ -104,7 +104,7 @@ def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...
         )
         assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
         randomized = bool(config.env.randomize)
-        played = loops_played(ScheduleRecord.of(config.agent.epsilon), 0, config.train.episodes)
+        played = loops_played(epsilon_record(config), 0, config.train.episodes)
         return tuple(
             kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy)
             for greedy in played

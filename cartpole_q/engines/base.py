@@ -15,14 +15,15 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from cartpole_q.config import Config, Schedule
+from cartpole_q.config import Config, ConfigError, Schedule
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
+from cartpole_q.profiles import profile_for
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
-from cartpole_q.rl.schedules import schedule_value
-from cartpole_q.rl.value_iteration import evaluate_policy
+from cartpole_q.rl.schedules import SCHEDULE_KINDS, schedule_value
+from cartpole_q.rl.value_iteration import evaluate_policy, reachable_states
 
 
 def kernel_name(
@@ -59,6 +60,18 @@ class ScheduleRecord(NamedTuple):
     def of(cls, schedule: Schedule) -> ScheduleRecord:
         """The record of a config's schedule."""
         return cls(schedule.code, schedule.start, schedule.end, schedule.rate)
+
+
+def epsilon_record(config: Config) -> ScheduleRecord:
+    """The epsilon schedule the compiled code runs: the config's, or a prediction run's 0.
+
+    A prediction algorithm's actions are its policy's, so epsilon plays no part: it is the
+    constant 0 (``metrics.csv``'s epsilon column), and the numba engine runs its greedy
+    loop alone.
+    """
+    if get_algorithm(config.agent.algorithm).predicts:
+        return ScheduleRecord(SCHEDULE_KINDS.index("constant"), 0.0, 0.0, 1.0)
+    return ScheduleRecord.of(config.agent.epsilon)
 
 
 def loops_played(epsilon: ScheduleRecord, start: int, stop: int) -> tuple[bool, ...]:
@@ -237,7 +250,7 @@ class AgentParams:
             agent=AgentRecord(
                 gamma=config.agent.gamma,
                 alpha=ScheduleRecord.of(config.agent.alpha),
-                epsilon=ScheduleRecord.of(config.agent.epsilon),
+                epsilon=epsilon_record(config),
                 threshold=math.inf if threshold is None else float(threshold),
             ),
             params=algorithm.hook_params(config.agent.params, config.agent.tie_break),
@@ -250,7 +263,7 @@ class AgentParams:
 def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     """The evaluated policy's exact values on the world's non-terminal states.
 
-    From the world's model (its transition table, or Blackjack's), by
+    From the world's transition table, by
     :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
     ``agent.gamma``; each model state is measured on the table row it is observed as.
     Nothing is measured for a world without a model, or on tiles.
@@ -261,7 +274,7 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     # A sweep's runs of one point ask for the same values: solved once per process.
     key = (
         repr(config.env), env_info.max_episode_steps, env_info.state_shape, env_info.n_actions,
-        config.agent.gamma, repr(sorted(config.agent.params.items())),
+        config.agent.gamma, config.agent.params.get("policy"),
     )  # fmt: skip
     found = _TRUTHS.get(key)
     if found is None:
@@ -281,8 +294,8 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     from cartpole_q.envs.models import EnvModel, env_model
 
     model = env_model(config.env, env_info.max_episode_steps)
-    if not isinstance(model, EnvModel):
-        return Truth.none()
+    if not isinstance(model, EnvModel) or profile_for(config.env.id).model == "blackjack":
+        return Truth.none()  # (Blackjack's naturals share a row with another state)
     tabular, row_of_state = model.model, model.row_of_state
     rows_pi = policy_table(
         MemoryContext(
@@ -290,9 +303,22 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
             dict(config.agent.params), 0,
         )
     )  # fmt: skip
-    values = evaluate_policy(tabular, rows_pi[row_of_state], config.agent.gamma)
-    states = np.flatnonzero(~tabular.terminal_states())
-    return Truth(row_of_state[states].astype(np.int64), values[states].astype(np.float64))
+    pi = rows_pi[row_of_state]
+    reachable = np.flatnonzero(reachable_states(tabular, pi))
+    try:
+        values = evaluate_policy(tabular, pi, config.agent.gamma, reachable)
+    except ValueError as error:
+        raise ConfigError(
+            f"agent.policy: the {config.agent.params.get('policy')} policy's values on "
+            f"{config.env.id} are not defined at agent.gamma {config.agent.gamma:g} ({error}); "
+            "give agent.gamma below 1."
+        ) from None
+    measured = ~tabular.terminal_states()[reachable]
+    states = reachable[measured]
+    rows = row_of_state[states]
+    if len(np.unique(rows)) != len(rows):
+        return Truth.none()  # states observed alike: no one value per row
+    return Truth(rows.astype(np.int64), values[measured].astype(np.float64))
 
 
 @dataclass

@@ -95,7 +95,8 @@ class NumbaEngine:
             if state.episode == started:
                 # Both loops handing back the same episode cannot happen (they read one
                 # schedule value); a bug must not spin forever.
-                assert not handed_back, f"no training loop takes episode {started}"
+                if handed_back:
+                    raise RuntimeError(f"no training loop takes episode {started}")
                 handed_back = True
             else:
                 handed_back = False
@@ -138,7 +139,8 @@ class NumbaEngine:
             self._compile_side_by_side(state, needed)
         for greedy in needed:
             self._load(state, greedy)
-        self.evaluate(state.tables.q, 0, 0)
+        if not self._params.algorithm.predicts:  # (a prediction run plays no greedy policy)
+            self.evaluate(state.tables.q, 0, 0)
 
     def _load(self, state: TrainingState, greedy: bool) -> None:
         """Compile one loop, or load it from the cache, by a call that plays no episode.
@@ -161,7 +163,12 @@ class NumbaEngine:
         command answers it once) and dies with it; if this process stops compiling (a second
         Ctrl-C), the child is killed, not waited for.
         """
-        if not hasattr(os, "fork") or threading.active_count() > 1 or not needed:
+        plays = not self._params.algorithm.predicts  # the greedy play, compiled in the child
+        if (
+            not hasattr(os, "fork")
+            or threading.active_count() > 1
+            or (len(needed) < 2 and not plays)
+        ):
             return
         parent = os.getpid()
         child = os.fork()
@@ -171,7 +178,8 @@ class NumbaEngine:
                 leave_signals_to_parent(parent)
                 for greedy in needed[1:]:
                     self._load(state, greedy)
-                self.evaluate(state.tables.q.copy(), 0, 0)
+                if plays:
+                    self.evaluate(state.tables.q.copy(), 0, 0)
                 code = 0
             finally:
                 os._exit(code)

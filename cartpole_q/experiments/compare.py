@@ -195,6 +195,13 @@ def compare(paths: Sequence[Path], metric: str = "eval_mean", *, force: bool = F
     if len(paths) < 2:
         raise UserError("compare needs at least two runs.")
     run_sets = [load_run_set(path) for path in paths]
+    for run_set in run_sets:
+        if any(run.predicts for run in run_set.runs):
+            raise UserError(
+                f"{run_set.path}: is a prediction run ({run_set.config.agent.algorithm}): it "
+                "has no greedy policy, no evaluation and no solve point to compare; `cartpole-q "
+                "plot RUN... --metric rms_error` draws their errors side by side."
+            )
     labels = labels_for(len(run_sets))
     notes = [note for run_set in run_sets for note in run_set.notes]
     differences = incomparable(run_sets, labels)

@@ -339,3 +339,57 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
             "(env.unwrapped.P: FrozenLake, Taxi, CliffWalking) or Blackjack's rules."
         )
     return Optimum(env_id, dict(config.env.kwargs), exact, grid_layout(config.env))
+
+
+@dataclass(frozen=True)
+class PolicyValues:
+    """A fixed policy's exact state values on a world with a model (``optimum --policy``)."""
+
+    env_id: str
+    kwargs: dict[str, Any]
+    policy: str
+    gamma: float
+    values: dict[int, float]
+    """the non-terminal states' values, by state (a terminal state's value is 0)"""
+
+    def to_json(self) -> dict[str, Any]:
+        """The JSON object ``optimum --policy --json`` prints (states as string keys)."""
+        return {
+            "env_id": self.env_id, "kwargs": self.kwargs, "policy": self.policy,
+            "gamma": self.gamma, "values": {str(state): v for state, v in self.values.items()},
+        }  # fmt: skip
+
+
+def policy_values(
+    env_id: str, assignments: list[tuple[str, Any]], policy: str, gamma: float
+) -> PolicyValues:
+    """The exact values ``v_pi`` of ``agent.policy`` (what a prediction run is measured against).
+
+    Raises:
+        UserError: a key is not an env key, the world has no model, or the policy's values
+            are not defined (it never ends an episode and ``gamma`` is 1).
+        ConfigError: the id, an argument or the policy is unknown.
+    """
+    from cartpole_q.engines.base import prediction_truth
+    from cartpole_q.envs.gym import inspect_env
+
+    overrides: dict[str, Any] = {"env.id": env_id}
+    for key, value in assignments:
+        if key != "env" and not key.startswith("env."):
+            raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
+        overrides[key] = value
+    overrides |= {"agent.algorithm": "td", "agent.policy": policy, "agent.gamma": gamma}
+    config = load_config(overrides=overrides, override_source=COMMAND_LINE)
+    info = inspect_env(config)
+    try:
+        truth = prediction_truth(config, info)
+    except ValueError as error:
+        raise UserError(f"{env_id}: the {policy} policy's values: {error}.") from None
+    if not truth.measured:
+        raise UserError(
+            f"{env_id}: no exact values: it needs a model (a transition table, "
+            "env.unwrapped.P: FrozenLake, Taxi, CliffWalking, the book's worlds; or "
+            "Blackjack's rules)."
+        )
+    values = {int(row): float(value) for row, value in zip(truth.rows, truth.values, strict=True)}
+    return PolicyValues(env_id, dict(config.env.kwargs), policy, gamma, values)

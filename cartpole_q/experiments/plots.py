@@ -238,6 +238,8 @@ def _greedy_paths(
     envs = {(run.config.env.id, repr(sorted(run.config.env.kwargs.items()))) for run in runs}
     if len(envs) != 1 or runs[0].config.discretization is not None:
         return None, []
+    if any(run.predicts for run in runs):  # V is no policy: there is no greedy path
+        return None, []
     from cartpole_q.envs.models import EnvModel, env_model, grid_layout
 
     env = runs[0].config.env

@@ -34,6 +34,7 @@ from cartpole_q.experiments.sweep_spec import (
     load_base,
     safe_name,
 )
+from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.store.sweepdir import axis_cell
 
 TUNE_KEYS = ("name", "base", "seeds", "trials", "objective", "space", "sampler", "pruner")
@@ -127,7 +128,14 @@ def load_tune(source: Path | Mapping[str, Any], *, label: str | None = None) -> 
         where, base_dir, default_name = label or str(source), source.parent, safe_name(source.stem)
     check_top_keys(raw, TUNE_KEYS, where)
     name = checked_name(raw, default_name, where)
-    base = load_base(raw.get("base"), where, base_dir).to_dict()
+    loaded = load_base(raw.get("base"), where, base_dir)
+    if get_algorithm(loaded.agent.algorithm).predicts:
+        raise ConfigError(
+            f"{where}: base: agent.algorithm {loaded.agent.algorithm} is a prediction "
+            "algorithm: its runs have no greedy policy to score, so tune has nothing to "
+            "optimise; a sweep over its keys with figure.metric: rms_error compares them."
+        )
+    base = loaded.to_dict()
     try:
         seeds = parse_seeds(raw.get("seeds", "0-19"))
     except ValueError as error:

@@ -38,10 +38,6 @@ POLICY = Param(
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""
 
-RANDOM_POLICY = 0.0
-"""``agent.policy: random`` as the hooks get it"""
-
-
 @compilable
 def policy_action(policy: np.ndarray, state: int, params: Params, rng: Rng) -> int:
     """The evaluated policy's action in ``state``: ``random``: ``rng.integers(0, n)``."""

@@ -171,12 +171,44 @@ class TabularModel:
         return ends
 
 
-def evaluate_policy(model: TabularModel, pi: np.ndarray, gamma: float) -> np.ndarray:
+def reachable_states(model: TabularModel, pi: np.ndarray) -> np.ndarray:
+    """bool, ``(n_states,)``: the states an episode under ``pi`` can be in before it ends.
+
+    From the start distribution's states, along the outcomes of positive probability under
+    ``pi`` that do not terminate. (A prediction run measures its error on these: a state no
+    episode visits keeps its initial value whatever the algorithm.)
+
+    >>> P = {0: {0: [(1.0, 1, 0.0, False)]}, 1: {0: [(1.0, 1, 0.0, True)]}, 2: {0: [(1.0, 0, 0.0, False)]}}
+    >>> model = TabularModel.from_transitions(P, initial=[1.0, 0.0, 0.0])
+    >>> reachable_states(model, np.ones((3, 1))).tolist()
+    [True, True, False]
+    """
+    weight = pi[model.state, model.action] * model.probability
+    going = ~model.terminated & (weight > 0.0)
+    following: list[list[int]] = [[] for _ in range(model.n_states)]
+    for state, next_state in zip(model.state[going], model.next_state[going], strict=True):
+        following[int(state)].append(int(next_state))
+    reached = model.initial > 0.0
+    frontier = [int(state) for state in np.flatnonzero(reached)]
+    while frontier:
+        state = frontier.pop()
+        for next_state in following[state]:
+            if not reached[next_state]:
+                reached[next_state] = True
+                frontier.append(next_state)
+    return reached
+
+
+def evaluate_policy(
+    model: TabularModel, pi: np.ndarray, gamma: float, states: np.ndarray | None = None
+) -> np.ndarray:
     """The exact values ``v_pi`` of a stochastic stationary policy: ``(I - gamma P_pi) v = r_pi``.
 
-    ``pi[s, a]`` is the probability of ``a`` in ``s`` (each row sums to 1). With ``gamma =
-    1`` the policy must end every episode with probability 1 (the system is then regular).
-    Sutton & Barto's 5-state random walk (Example 6.2), uniformly random, undiscounted:
+    ``pi[s, a]`` is the probability of ``a`` in ``s`` (each row sums to 1). ``states``
+    (indices, ascending) restricts the system to them; they must be closed under the
+    policy's non-terminating outcomes, as :func:`reachable_states` are (states outside,
+    such as unreachable loops, cannot then make it singular). Sutton & Barto's 5-state random
+    walk (Example 6.2), uniformly random, undiscounted:
 
     >>> P = {s: {a: [(1.0, s + (1 if a else -1), float(s == 5 and a == 1), s + (1 if a else -1) in (0, 6))]
     ...          for a in (0, 1)} for s in range(1, 6)}
@@ -186,17 +218,42 @@ def evaluate_policy(model: TabularModel, pi: np.ndarray, gamma: float) -> np.nda
     >>> [round(float(v) * 6, 12) for v in evaluate_policy(model, np.full((7, 2), 0.5), 1.0)]
     [0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 0.0]
 
+    Returns:
+        The values of ``states`` (of every state when ``None``), in order.
+
     Raises:
-        ValueError: ``gamma`` outside [0, 1], or a policy that never ends (a singular system).
+        ValueError: ``gamma`` outside [0, 1], or (``gamma = 1``) a state from which the
+            policy may never end an episode.
     """
     if not 0.0 <= gamma <= 1.0:
         raise ValueError(f"gamma must be in [0, 1], got {gamma}")
+    chosen = np.arange(model.n_states) if states is None else np.asarray(states, dtype=np.int64)
     expected, matrix = model.stochastic_policy_matrix(np.asarray(pi, dtype=np.float64))
-    try:
-        values: np.ndarray = np.linalg.solve(np.eye(model.n_states) - gamma * matrix, expected)
-    except np.linalg.LinAlgError:
-        raise ValueError("the policy's values are not defined: it does not end episodes") from None
+    if gamma == 1.0:
+        stuck = _never_ending(model, pi, chosen)
+        if stuck is not None:
+            raise ValueError(f"from state {stuck} the policy may never end an episode")
+    system = np.eye(len(chosen)) - gamma * matrix[np.ix_(chosen, chosen)]
+    values: np.ndarray = np.linalg.solve(system, expected[chosen])
     return values
+
+
+def _never_ending(model: TabularModel, pi: np.ndarray, states: np.ndarray) -> int | None:
+    """A state of ``states`` from which no outcome of positive probability ends the episode."""
+    weight = pi[model.state, model.action] * model.probability
+    positive = weight > 0.0
+    can_end = np.zeros(model.n_states, dtype=bool)
+    can_end[model.state[positive & model.terminated]] = True
+    going = positive & ~model.terminated
+    sources, targets = model.state[going], model.next_state[going]
+    while True:  # backwards: a state that can step to one that can end can end
+        grown = can_end.copy()
+        grown[sources[can_end[targets]]] = True
+        if np.array_equal(grown, can_end):
+            break
+        can_end = grown
+    stuck = [int(state) for state in states if not can_end[state]]
+    return stuck[0] if stuck else None
 
 
 @dataclass(frozen=True)
