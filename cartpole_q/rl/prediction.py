@@ -38,6 +38,7 @@ POLICY = Param(
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""
 
+
 @compilable
 def policy_action(policy: np.ndarray, state: int, params: Params, rng: Rng) -> int:
     """The evaluated policy's action in ``state``: ``random``: ``rng.integers(0, n)``."""
