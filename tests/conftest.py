@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import signal
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +26,22 @@ settings.load_profile("cartpole-q")
 # Rendering in tests never opens a window.
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+
+
+@pytest.fixture(autouse=True)
+def signals_as_they_were() -> Iterator[None]:
+    """Give SIGINT and SIGTERM back their handlers after each test.
+
+    A command run in-process that ends interrupted leaves both ignored on purpose (its
+    process is on its way out); in the test process that would leak into every later test,
+    and into the subprocesses they start (an ignored signal stays ignored across exec: a
+    command started so never sees Ctrl-C).
+    """
+    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for signum, handler in before.items():
+        if handler is not None and signal.getsignal(signum) is not handler:
+            signal.signal(signum, handler)
 
 
 def write_yaml(path: Path, data: object) -> Path:

@@ -23,7 +23,13 @@ def _would_run(tmp_path: Path, target: str) -> str:
     for name in ("Makefile", "pyproject.toml"):
         shutil.copy(REPO / name, tmp_path / name)
     return subprocess.run(
-        ["make", "-n", target], cwd=tmp_path, capture_output=True, text=True, check=True
+        # (--no-print-directory: under `make test` this make is a sub-make, which names its
+        # directory otherwise)
+        ["make", "--no-print-directory", "-n", target],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=True,
     ).stdout
 
 
