@@ -412,11 +412,24 @@ def _run(
     )
 
 
+def _fits(live: tuple[int, ...], saved: tuple[int, ...], growing: bool) -> bool:
+    """Whether a saved memory array restores into the live one.
+
+    The same shape; or, for an array that grows with ``train.episodes`` (a run extended), a
+    first axis no longer than the live one's and the same other axes.
+    """
+    if not growing:
+        return live == saved
+    return live[1:] == saved[1:] and len(live) == len(saved) > 0 and saved[0] <= live[0]
+
+
 def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     episode = checkpoint.episode
     live, saved = state.tables, checkpoint.tables
+    growing = state.algorithm.growing_memory
     if len(live.memory) != len(saved.memory) or any(
-        a.shape != b.shape for a, b in zip(live.memory, saved.memory, strict=False)
+        not _fits(a.shape, b.shape, index in growing)
+        for index, (a, b) in enumerate(zip(live.memory, saved.memory, strict=False))
     ):
         raise RunError(
             f"the checkpoint holds {len(saved.memory)} memory arrays of "
@@ -448,7 +461,10 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     live.q[...] = saved.q
     live.visits[...] = saved.visits
     for array, kept in zip(live.memory, saved.memory, strict=True):
-        array[...] = kept
+        if array.shape == kept.shape:
+            array[...] = kept
+        else:  # an array that grows with train.episodes: the start of a longer one
+            array[: kept.shape[0]] = kept
     for column, values in zip(state.metrics, checkpoint.metrics, strict=True):
         column[:episode] = values
     for what, live_column, kept_column in (

@@ -982,6 +982,45 @@ class TrueOnlineTDLambda(Prediction, TraceAgent):
         return self.draw(s2)
 
 
+class BatchPrediction(Prediction):
+    """``batch_prediction``: every transition kept as ``(s, g, w, b)``, ``y = g + w * V(b)``;
+    after each episode, passes over all of them until a pass moves V by less than the
+    tolerance in total (or is not finite), or max_passes passes."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.batch: list[list[Any]] = []  # [s, g, w, b] per transition, in order
+        self.buffer_length = NO_TIME_LIMIT_LENGTH
+        self.episode_start = 0
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.batch.append([s, r, 0.0 if terminated else self.gamma, s2])
+        cut = len(self.batch) - self.episode_start == self.buffer_length
+        if not terminated and not truncated and not cut:
+            return self.draw(s2)
+        if self.params["target"] == "mc":
+            g, w = 0.0, 0.0 if terminated else 1.0
+            for i in range(len(self.batch) - 1, self.episode_start - 1, -1):
+                g = self.gamma * g + self.batch[i][1]
+                w = self.gamma * w
+                self.batch[i][1:] = [g, w, s2]
+        self.episode_start = len(self.batch)
+        for _ in range(int(self.params["max_passes"])):
+            sums = [0.0] * len(self.q)
+            for x, g, w, b in self.batch:
+                sums[x] = sums[x] + (g + w * self.v(b) - self.v(x))
+            moved = 0.0
+            for x in range(len(self.q)):
+                moved += abs(self.alpha * sums[x])
+            if moved < float(self.params["tolerance"]) or not math.isfinite(moved):
+                break
+            for x in range(len(self.q)):
+                self.q[x][0] = self.q[x][0] + self.alpha * sums[x]
+        return None
+
+
 def true_values(
     env: gymnasium.Env[Any, Any], n: int, gamma: float
 ) -> tuple[list[int], list[float]]:
@@ -1050,6 +1089,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "td": TD,
     "n_step_td": NStepTD,
     "mc_prediction": MCPrediction,
+    "batch_prediction": BatchPrediction,
     "td_lambda": TDLambda,
     "true_online_td_lambda": TrueOnlineTDLambda,
 }
@@ -1065,6 +1105,9 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "tie_break": "lowest",  # agent.tie_break, a key of every algorithm
     "policy": "random",
     "visits": "every",
+    "target": "td",
+    "tolerance": 1e-6,
+    "max_passes": 100_000,
 }
 PREDICTION_DEFAULTS: dict[str, Any] = {"update": "constant_alpha"}
 """mc_prediction's own default of a key another algorithm defaults otherwise"""
@@ -1167,7 +1210,7 @@ def reference_train(
         if hasattr(env.unwrapped, "P"):
             measured, truth = true_values(env, n, float(gamma))
             errors = []
-    if isinstance(agent, (MonteCarlo, MCPrediction)):
+    if isinstance(agent, (MonteCarlo, MCPrediction, BatchPrediction)):
         assert env.spec is not None
         limit = env.spec.max_episode_steps
         agent.buffer_length = int(limit) if limit is not None else NO_TIME_LIMIT_LENGTH

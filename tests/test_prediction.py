@@ -278,3 +278,54 @@ def test_a_checkpoint_of_another_length_is_refused(tmp_path: Path) -> None:
     assert resumed.exit_code == 2, resumed.output
     assert "the checkpoint's rms_errors has shape" in resumed.stderr
     assert "Traceback" not in resumed.output
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_a_batch_run_extends_byte_identically(tmp_path: Path, engine: str) -> None:
+    """batch_prediction keeps every transition: an extended run's batch grows from its checkpoint."""
+    overrides = {
+        **WALK5, "engine": engine, "agent.algorithm": "batch_prediction", "agent.alpha": 0.002,
+        "agent.tolerance": 1e-4, "seed": 5,
+    }  # fmt: skip
+    whole = train(load_config(overrides={**overrides, "train.episodes": 40}), final_eval=False)
+    prepared = prepare(load_config(overrides={**overrides, "train.episodes": 15}), "test")
+    run = start_run(prepared, tmp_path / "run")
+    execute_run(run, prepared)
+    extended = invoke("train", "--resume", str(run), "--episodes", "40", "-q")
+    assert extended.exit_code == 0, extended.output
+    assert np.load(run / rundir.V_TABLE_FILE).tobytes() == whole.v_table.tobytes()
+    loaded = rundir.load_run(run)
+    assert whole.errors is not None and loaded.errors is not None
+    assert loaded.errors.tolist() == whole.errors.tolist()
+
+
+def test_batch_mc_converges_to_every_visit_average_returns() -> None:
+    """Sutton & Barto 6.3: batch constant-alpha MC settles on each state's average return.
+
+    The policy draws the same actions in both runs, so both see the same episodes; every-visit
+    sample-average MC's values are those averages, computed incrementally.
+    """
+    base = {**WALK19, "train.episodes": 12, "seed": 9, "agent.q_init": 0.0}
+    batch = train(
+        load_config(
+            overrides={
+                **base, "agent.algorithm": "batch_prediction", "agent.target": "mc",
+                "agent.alpha": 0.001, "agent.tolerance": 1e-13,
+            }
+        ),
+        final_eval=False,
+    )  # fmt: skip
+    averaged = train(
+        load_config(
+            overrides={
+                **base, "agent.algorithm": "mc_prediction", "agent.update": "sample_average",
+                "agent.alpha": 0.1,
+            }
+        ),
+        final_eval=False,
+    )  # fmt: skip
+    assert batch.lengths.tolist() == averaged.lengths.tolist()
+    visited = averaged.visits.sum(axis=-1) > 0
+    assert visited.sum() > 5
+    np.testing.assert_allclose(batch.v_table[visited], averaged.v_table[visited], atol=1e-9)
+    assert (batch.v_table[~visited] == 0.0).all()  # never a state of the batch: as it began

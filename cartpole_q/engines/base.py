@@ -375,6 +375,7 @@ class TrainingState:
             q_init=q_init,
             params=dict(config.agent.params),
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
+            episodes=config.train.episodes,
         )
         columns = algorithm.table_columns(env_info.n_actions)  # V: one column
         return cls(

@@ -100,6 +100,8 @@ class MemoryContext:
     """the algorithm's parameters by key (defaults filled)"""
     max_steps: int
     """the longest an episode can be (its time limit, or the greedy cap without one)"""
+    episodes: int = 0
+    """the run's training episodes (``train.episodes``; 0 where no run is sized)"""
 
 
 def no_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
@@ -149,6 +151,10 @@ class Algorithm:
     divides by the probability ``epsilon / n`` of an exploratory action, which a smaller
     positive epsilon could round to 0. Configs whose epsilon takes a positive value below
     it in any episode are refused"""
+    growing_memory: tuple[int, ...] = ()
+    """the memory arrays (by index) whose first axis grows with ``train.episodes`` (a batch
+    of every transition seen): a run extended past its episodes resumes from a checkpoint
+    whose arrays are shorter, copied into the start of the longer ones"""
     key: str = field(default="", compare=False)
     """the name and a digest of the module's source: compiled code is cached under it, so
     an edited algorithm is compiled again (set when registered)"""

@@ -15,6 +15,7 @@ from collections.abc import Iterator
 
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.algorithms import (
+    batch_prediction,
     double_q_learning,
     dyna_q,
     dyna_q_plus,
@@ -38,7 +39,8 @@ from cartpole_q.rl.algorithms import (
 PACKAGE = (
     q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
     sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus, monte_carlo,
-    off_policy_monte_carlo, td, mc_prediction, n_step_td, td_lambda, true_online_td_lambda,
+    off_policy_monte_carlo, td, mc_prediction, batch_prediction, n_step_td, td_lambda,
+    true_online_td_lambda,
 )  # fmt: skip
 """the package's algorithm modules, in the order the documentation lists them (control,
 then prediction)"""
