@@ -1021,6 +1021,35 @@ class BatchPrediction(Prediction):
         return None
 
 
+class OfflineLambdaReturn(Prediction):
+    """``offline_lambda_return``: every step's lambda-return from V as the episode ended,
+    computed backwards, then the updates in step order."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.buffer_length = NO_TIME_LIMIT_LENGTH
+        self.episode: list[tuple[int, float]] = []
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.episode.append((s, r))
+        if not terminated and not truncated and len(self.episode) < self.buffer_length:
+            return self.draw(s2)
+        lam = float(self.params["lambda"])
+        returns = [0.0] * len(self.episode)
+        g = self.episode[-1][1] + self.gamma * (0.0 if terminated else self.v(s2))
+        returns[-1] = g
+        for t in range(len(self.episode) - 2, -1, -1):
+            later = self.v(self.episode[t + 1][0])
+            g = self.episode[t][1] + self.gamma * ((1.0 - lam) * later + lam * g)
+            returns[t] = g
+        for (x, _), g in zip(self.episode, returns, strict=True):
+            self.update(x, 0, g)
+        self.episode = []
+        return None
+
+
 def true_values(
     env: gymnasium.Env[Any, Any], n: int, gamma: float
 ) -> tuple[list[int], list[float]]:
@@ -1090,6 +1119,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "n_step_td": NStepTD,
     "mc_prediction": MCPrediction,
     "batch_prediction": BatchPrediction,
+    "offline_lambda_return": OfflineLambdaReturn,
     "td_lambda": TDLambda,
     "true_online_td_lambda": TrueOnlineTDLambda,
 }
@@ -1210,7 +1240,7 @@ def reference_train(
         if hasattr(env.unwrapped, "P"):
             measured, truth = true_values(env, n, float(gamma))
             errors = []
-    if isinstance(agent, (MonteCarlo, MCPrediction, BatchPrediction)):
+    if isinstance(agent, (MonteCarlo, MCPrediction, BatchPrediction, OfflineLambdaReturn)):
         assert env.spec is not None
         limit = env.spec.max_episode_steps
         agent.buffer_length = int(limit) if limit is not None else NO_TIME_LIMIT_LENGTH

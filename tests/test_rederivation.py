@@ -141,6 +141,8 @@ PREDICTION_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "td_lambda-dutch": ("td_lambda", {"lambda": 0.6, "trace": "dutch"}),
     "td_lambda-lambda0": ("td_lambda", {"lambda": 0.0}),
     "true_online_td_lambda": ("true_online_td_lambda", {"lambda": 0.8}),
+    "offline_lambda_return": ("offline_lambda_return", {"lambda": 0.8}),
+    "offline_lambda_return-lambda1": ("offline_lambda_return", {"lambda": 1.0}),
     # Small alphas: the batch's sums grow with the episodes seen (a large alpha diverges).
     "batch_prediction-td": ("batch_prediction", {"alpha": 0.002, "tolerance": 1e-3}),
     "batch_prediction-mc-capped": (
