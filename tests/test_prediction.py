@@ -329,3 +329,61 @@ def test_batch_mc_converges_to_every_visit_average_returns() -> None:
     assert visited.sum() > 5
     np.testing.assert_allclose(batch.v_table[visited], averaged.v_table[visited], atol=1e-9)
     assert (batch.v_table[~visited] == 0.0).all()  # never a state of the batch: as it began
+
+
+def test_a_values_figure_draws_v_beside_the_true_values(tmp_path: Path) -> None:
+    """figure.metric: values (Example 6.2's left panel): V per state, the truth, the start."""
+    study = write_yaml(
+        tmp_path / "values.yaml",
+        {
+            "name": "values",
+            "base": {
+                "env": {"id": WALK5["env.id"]}, "discretization": None,
+                "agent": {"algorithm": "td", "gamma": 1.0, "alpha": 0.1, "q_init": 0.5},
+                "train": {"episodes": 10, "eval_every": 0, "checkpoint_every": 0},
+                "eval": {"episodes": 1},
+            },
+            "seeds": "0-2",
+            "grid": {"train.episodes": [1, 10]},
+            "figure": {"metric": "values", "file": "v.png"},
+        },
+    )  # fmt: skip
+    done = invoke("sweep", study, "--out", tmp_path / "sweep", "-q")
+    assert done.exit_code == 0, done.output
+    rows = (tmp_path / "sweep" / "v.csv").read_text().splitlines()[1:]
+    series = {row.split(",")[1] for row in rows}
+    assert series == {"initial values", "episodes 1", "episodes 10", "true values"}
+    truth = [float(row.split(",")[3]) for row in rows if ",true values," in row]
+    assert truth == pytest.approx([1 / 6, 2 / 6, 3 / 6, 4 / 6, 5 / 6], abs=1e-15)
+    ten = train(_config(WALK5, **{"train.episodes": 10, "seed": 1}), final_eval=False)
+    tables = np.load(tmp_path / "sweep" / "points" / "001" / "q_tables.npz")
+    assert tables[sorted(tables.files)[1]].tobytes() == ten.v_table.tobytes()
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ({"base.agent.algorithm": "q_learning"}, "figure.metric: values is a prediction run's"),
+        ({"figure.against": "train.episodes"}, "figure.against: draws a metric against an axis"),
+    ],
+)
+def test_a_values_figure_refuses_control_runs_and_against(
+    tmp_path: Path, change: dict[str, str], words: str
+) -> None:
+    study: dict = {
+        "name": "values",
+        "base": {"env": {"id": WALK5["env.id"]}, "discretization": None,
+                 "agent": {"algorithm": "td", "gamma": 1.0}, "train": {"episodes": 5}},
+        "seeds": "0",
+        "grid": {"train.episodes": [1, 5]},
+        "figure": {"metric": "values"},
+    }  # fmt: skip
+    for dotted, value in change.items():
+        *parents, last = dotted.split(".")
+        node = study
+        for parent in parents:
+            node = node[parent]
+        node[last] = value
+    refused = invoke("sweep", write_yaml(tmp_path / "v.yaml", study), "--out", tmp_path / "s")
+    assert refused.exit_code == 2, refused.output
+    assert words in refused.stderr and "Traceback" not in refused.output

@@ -31,7 +31,7 @@ from cartpole_q.config import (
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
-from cartpole_q.experiments.sweep_spec import SweepSpec, load_sweep
+from cartpole_q.experiments.sweep_spec import VALUES_FIGURE, SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.figures import DataFigure, summary_line_figure
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
@@ -376,6 +376,8 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     if figure.against is not None:
         return plot_against(spec, paths, directory / figure.file)
+    if figure.metric == VALUES_FIGURE:
+        return plot_values(spec, paths, labels, directory / figure.file)
     return plot_metric(
         paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
         figure.smooth, figure.log_y, force=True, style=style,
@@ -425,6 +427,46 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     drawn = summary_line_figure(
         lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y,
         (figure.y_min, figure.y_max),
+    )  # fmt: skip
+    return write_figure(out, drawn)
+
+
+def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path) -> Path:
+    """The ``figure.metric: values`` figure: each point's learned ``V`` against the state.
+
+    One line per point (the mean of its seeds' ``V`` on the measured states, a 95% bootstrap
+    interval over seeds), the evaluated policy's true values, and the values every run
+    started from (``agent.q_init``, when the points share it): Sutton & Barto Example 6.2's
+    left panel.
+    """
+    from cartpole_q.engines.base import prediction_truth
+    from cartpole_q.envs.gym import inspect_env
+
+    figure = spec.figure
+    assert figure is not None
+    first = spec.points[0].config
+    truth = prediction_truth(first, inspect_env(first))
+    if not truth.measured:
+        raise RunError(
+            f"figure.metric: values draws V beside the true values, but {first.env.id} has no "
+            "model to compute them from (a world with a transition table has one)."
+        )
+    states = [float(row) for row in truth.rows]
+    rng = np.random.default_rng(0)
+    lines = []
+    starts = {point.config.agent.q_init for point in spec.points}
+    if len(starts) == 1:
+        start = np.full(len(states), starts.pop())
+        lines.append(("initial values", states, start, start, start))
+    for label, path in zip(labels, paths, strict=True):
+        runs = load_run_set(path).runs
+        per_seed = np.array([run.q_table.reshape(-1)[truth.rows] for run in runs])
+        centre, low, high = aggregate_band(per_seed, "mean", rng)
+        lines.append((label, states, centre, low, high))
+    lines.append(("true values", states, truth.values, truth.values, truth.values))
+    drawn = summary_line_figure(
+        lines, "state", figure.y_label or "estimated value", figure.title or spec.name,
+        figure.log_y, (figure.y_min, figure.y_max),
     )  # fmt: skip
     return write_figure(out, drawn)
 

@@ -64,6 +64,11 @@ SWEEP_OWN_FILES = (
 """the sweep directory's files a study figure (and its ``.csv``) must not replace"""
 
 
+VALUES_FIGURE = "values"
+"""``figure.metric: values``: each point's learned ``V`` against the state, beside the true
+values (prediction; Sutton & Barto Example 6.2's left panel)"""
+
+
 @dataclass(frozen=True)
 class FigureSpec:
     """The learning-curve figure a sweep draws of its points when it completes.
@@ -74,6 +79,9 @@ class FigureSpec:
     """
 
     metric: str
+    """a learning-curve metric (``plot --metric``), or ``values``: each point's learned
+    ``V`` per state (the mean over seeds, a 95% bootstrap interval), the policy's true
+    values and the initial values beside them"""
     x: str = "episode"
     aggregate: str = "mean"
     smooth: int = 1
@@ -255,12 +263,12 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
     from cartpole_q.learning_curves import ERROR_METRIC, info_key_of
     from cartpole_q.rl.algorithms import get as get_algorithm
 
-    if metric == ERROR_METRIC:
+    if metric in (ERROR_METRIC, VALUES_FIGURE):
         for point in points:
             algorithm = point.config.agent.algorithm
             if not get_algorithm(algorithm).predicts:
                 raise ConfigError(
-                    f"{where}: figure.metric: rms_error is a prediction run's error of V, but "
+                    f"{where}: figure.metric: {metric} is a prediction run's (V), but "
                     f"point {point.index} runs agent.algorithm {algorithm}, a control "
                     "algorithm; draw return, length, ... of it, or make every point predict."
                 )
@@ -302,6 +310,13 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         )
     metric = values["metric"]
     problem = check_metric(metric) if isinstance(metric, str) else "not a string"
+    if metric == VALUES_FIGURE:
+        problem = None
+        if values.get("against") is not None:
+            raise ConfigError(
+                f"{where}: figure.against: draws a metric against an axis; metric: values "
+                "draws V against the state, so leave one of them out."
+            )
     if problem is not None:
         raise ConfigError(f"{where}: figure.metric: {shown_value(metric)} is {problem}.")
     for key, allowed in choices.items():
