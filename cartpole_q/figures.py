@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -1223,6 +1223,8 @@ class GridPanel:
     """bool, ``(rows * columns, actions)``: the tied best actions, an arrow each"""
     ends: np.ndarray | None = None
     """bool, ``(rows * columns,)``: terminal cells (shaded, no arrow)"""
+    labels: Mapping[int, str] = field(default_factory=dict)
+    """names written small in the corner of some cells (Example 3.5's A, A', B, B')"""
 
 
 def book_round(value: float, decimals: int) -> float:
@@ -1251,7 +1253,8 @@ def dp_grid_figure(
     """
     across = columns or len(panels)
     down = -(-len(panels) // across)
-    figure = DataFigure(figsize=(2.9 * across, 3.1 * down + 0.5), dpi=DPI, layout="constrained")
+    width = max(2.9 * across, 5.0)
+    figure = DataFigure(figsize=(width, 3.1 * down + 0.7), dpi=DPI, layout="constrained")
     grid_axes = np.atleast_1d(figure.subplots(down, across, squeeze=False)).ravel()
     for axes, panel in zip(grid_axes, panels, strict=False):
         record = figure.data.panel(panel.title)
@@ -1259,6 +1262,10 @@ def dp_grid_figure(
         ends = np.zeros(rows * cols, bool) if panel.ends is None else panel.ends
         for end in np.flatnonzero(ends):
             axes.add_patch(_square(*divmod(int(end), cols), "#c8c8c8"))
+        for state, name in panel.labels.items():
+            label_row, label_column = divmod(state, cols)
+            axes.text(label_column - 0.42, label_row - 0.42, name, ha="left", va="top",
+                      fontsize=7, color="#9a3c3c")  # fmt: skip
         if panel.values is not None:
             record.cells("value", range(cols), range(rows), panel.values)
             if panel.tied is None:
@@ -1288,7 +1295,9 @@ def dp_grid_figure(
         axes.set_title(panel.title, fontsize=10)
     for axes in grid_axes[len(panels) :]:
         axes.set_axis_off()
-    figure.suptitle(title)
+    import textwrap
+
+    figure.suptitle(textwrap.fill(title, int(width * 9)))
     return figure
 
 
@@ -1347,26 +1356,34 @@ def car_rental_figure(
         name = f"pi_{index}"
         axes.pcolormesh(cars, cars, policy, cmap=colours, norm=norm, shading="nearest")
         if policy.min() != policy.max():
-            lines = axes.contour(cars, cars, policy, levels=levels[1:-1], colors="black",
-                                 linewidths=0.8)  # fmt: skip
-            axes.clabel(lines, fmt=lambda level: f"{level + 0.5:.0f}", fontsize=7)
+            axes.contour(cars, cars, policy, levels=levels[1:-1], colors="black", linewidths=0.8)
+        for move in np.unique(policy):  # each move's number on its region, as the book writes
+            cells = np.argwhere(policy == move)
+            row, column = cells[np.argmin(((cells - cells.mean(axis=0)) ** 2).sum(axis=1))]
+            axes.text(column, row, str(int(move)), ha="center", va="center", fontsize=9,
+                      fontweight="bold")  # fmt: skip
         figure.data.panel(name).cells("cars moved", cars.tolist(), cars.tolist(), policy)
         axes.set_title(f"{name}: cars moved from the first location (negative: to it)", fontsize=8)
-        axes.set_xlabel("cars at the second location")
-        axes.set_ylabel("cars at the first location")
-        axes.set_aspect("equal")
+        _car_axes(axes, size)
     axes = panels[len(policies)]
     image = axes.pcolormesh(cars, cars, values, cmap="viridis", shading="nearest")
     figure.colorbar(image, ax=axes, shrink=0.85)
     figure.data.panel(value_title).cells("value", cars.tolist(), cars.tolist(), values)
     axes.set_title(f"{value_title}: {values.min():.1f} to {values.max():.1f}", fontsize=9)
-    axes.set_xlabel("cars at the second location")
-    axes.set_ylabel("cars at the first location")
-    axes.set_aspect("equal")
+    _car_axes(axes, size)
     for axes in panels[count:]:
         axes.set_axis_off()
     figure.suptitle(title)
     return figure
+
+
+def _car_axes(axes: Axes, size: int) -> None:
+    """Cars at the second location across, at the first upwards, ticks every 5."""
+    axes.set_xticks(range(0, size, 5))
+    axes.set_yticks(range(0, size, 5))
+    axes.set_xlabel("cars at the second location")
+    axes.set_ylabel("cars at the first location")
+    axes.set_aspect("equal")
 
 
 def _moves_colour(move: int) -> tuple[float, ...]:

@@ -285,3 +285,136 @@ def test_dp_refuses_a_missing_study_file_and_a_bad_out(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "study file not found" in result.stderr
     result = invoke("dp", BOOK / "fig4_1_small_gridworld.yaml", "--out", tmp_path / "f.txt")
     assert result.exit_code == 2 and "--out cannot write files ending in .txt" in result.stderr
+
+
+# -- Figure 4.3: the gambler ------------------------------------------------------------------
+
+
+def test_fig_4_3_gambler_v_star_50_and_the_books_policy_shape() -> None:
+    world = _world("cartpole_q/Gambler-v0")
+    model = world.model
+    sweeps = dp.value_iteration_sweeps(model, 1.0, tolerance=1e-9)
+    values = sweeps.values[-1]
+    assert sweeps.sweeps == 31
+    assert values[50] == pytest.approx(0.4, abs=1e-12)  # stake everything once
+    assert values[25] == pytest.approx(0.16, abs=1e-12) and values[75] == pytest.approx(
+        0.64, abs=1e-12
+    )
+    assert values[0] == values[100] == 0.0  # the ends; +1 is the reward of reaching 100
+    stakes = dp.greedy(model.q_values(values, 1.0), model.allowed, 1e-9)
+    # The book's figure (and Zhang's rounded argmax): spikes at 25, 50, 75; between them
+    # triangles rising by one a capital from 1 to 12 and falling back to 1.
+    triangle = [*range(1, 13), *range(12, 0, -1)]
+    assert stakes[1:100].tolist() == [*triangle, 25, *triangle, 50, *triangle, 25, *triangle]
+    # Zhang's rule, state for state.
+    for capital in range(1, 100):
+        returns = model.q_values(values, 1.0)[capital, : min(capital, 100 - capital) + 1]
+        assert stakes[capital] == np.argmax(np.round(returns[1:], 5)) + 1
+
+
+def test_the_gambler_plays_its_stakes_and_ends() -> None:
+    env = gymnasium.make("cartpole_q/Gambler-v0", p_h=0.5, start=10)
+    state, _ = env.reset(seed=1)
+    assert state == 10
+    # A stake above min(s, 100 - s) plays that; stake 0 plays 1.
+    state, reward, terminated, _, _ = env.step(50)
+    assert state in (0, 20) and terminated == (state == 0) and reward == 0.0
+    allowed = env.unwrapped.allowed_actions()
+    assert allowed[10].tolist() == [False] + [True] * 10 + [False] * 40
+    with pytest.raises(ValueError, match="p_h"):
+        gymnasium.make("cartpole_q/Gambler-v0", p_h=1.0)
+
+
+# -- Figure 4.2: Jack's car rental ------------------------------------------------------------
+
+
+def test_the_car_rental_model_is_exact_and_sums_to_one() -> None:
+    from cartpole_q.worlds.car_rental import day_at_location
+
+    following, rented = day_at_location(3.0, 3.0, 20)
+    np.testing.assert_allclose(following.sum(axis=1), 1.0, atol=1e-12)
+    assert rented[0] == 0.0 and rented[1] == pytest.approx(1 - np.exp(-3.0))
+    assert rented[20] == pytest.approx(3.0, abs=1e-6)  # 20 cars: nearly every request met
+    model = _world("cartpole_q/CarRental-v0").model
+    np.testing.assert_allclose(model.transition.sum(axis=2), 1.0, atol=1e-12)
+    # No car, no move: nothing rented. From (20, 0), moving 5 costs $10 and leaves 15 cars
+    # at the first location (3 requests a day) and 5 at the second (4 a day).
+    assert model.reward[0, 5] == 0.0
+    _, rented_second = day_at_location(4.0, 2.0, 20)
+    expected = 10 * (rented[15] + rented_second[5]) - 10.0
+    assert model.reward[20 * 21 + 0, 10] == pytest.approx(expected, abs=1e-12)
+
+
+def test_fig_4_2_policy_iteration_stops_at_pi_4() -> None:
+    model = _world("cartpole_q/CarRental-v0").model
+    found = dp.policy_iteration(model, 0.9, np.full(441, 5))
+    assert found.improvements == 4
+    moves = found.policies - 5
+    assert moves[0].tolist() == [0] * 441
+    assert moves[-1].max() == 5 and moves[-1].min() == -4
+    assert moves[-1][20 * 21 + 0] == 5 and moves[-1][0 * 21 + 20] == -4
+    assert moves[-1][10 * 21 + 10] == 0
+    values = found.values[-1]
+    assert 421 < values.min() < 422 and 636 < values.max() < 638
+    # Each improvement improves: v_pi(i+1) >= v_pi(i) everywhere.
+    assert np.all(np.diff(found.values, axis=0) >= -1e-9)
+    # The last policy is greedy with respect to its own values (policy iteration's stop).
+    tied = dp.tied_best(model.q_values(values, 0.9), model.allowed, 1e-9)
+    assert tied[np.arange(441), found.policies[-1]].all()
+
+
+def test_the_car_rental_env_moves_what_it_can() -> None:
+    env = gymnasium.make("cartpole_q/CarRental-v0")
+    env.reset(seed=0)
+    env.unwrapped.cars = (2, 7)
+    _, reward, terminated, truncated, info = env.step(10)  # move 5: only 2 are there
+    assert info["moved"] == 2 and not terminated and not truncated
+    assert reward >= -4.0 and (reward + 4.0) % 10 == 0
+
+
+DP_STUDIES = {
+    "fig3_2_gridworld": set(),
+    "fig3_5_gridworld_optimal": set(),
+    "fig4_1_small_gridworld": set(),
+    "fig4_3_gambler": {"sweeps (the book's last curve: sweep 32)"},
+    "fig4_2_car_rental": {
+        "lowest v_pi4 (the book's axis: 420)",
+        "highest v_pi4 (the book's axis: 612)",
+    },
+}
+"""each dynamic programming study file, and the book's numbers ours do not round to"""
+
+
+@pytest.mark.parametrize("name", DP_STUDIES)
+def test_each_dp_study_runs_and_agrees_with_the_book_where_documented(
+    name: str, tmp_path: Path
+) -> None:
+    result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / f"{name}.png")
+    assert result.exit_code == 0, result.output
+    differs = {
+        line.strip().partition(": book")[0]
+        for line in result.stdout.splitlines()
+        if line.endswith("differs)")
+    }
+    assert differs == DP_STUDIES[name]
+    assert (tmp_path / f"{name}.csv").is_file() and (tmp_path / f"{name}_sweeps.csv").is_file()
+
+
+def test_the_docs_figures_data_is_what_dp_writes(tmp_path: Path) -> None:
+    # docs/book holds each figure's data as the command writes it; the numbers agree to
+    # 1e-9 (another machine's BLAS may sum in another order), the rest exactly.
+    for name in DP_STUDIES:
+        result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / f"{name}.png")
+        assert result.exit_code == 0, result.output
+        shipped = (REPO / "docs" / "book" / f"{name}.csv").read_text(encoding="utf-8")
+        made = (tmp_path / f"{name}.csv").read_text(encoding="utf-8")
+        rows = list(
+            zip(csv.reader(made.splitlines()), csv.reader(shipped.splitlines()), strict=True)
+        )
+        for ours, theirs in rows:
+            assert ours[:2] == theirs[:2], name
+            for a, b in zip(ours[2:], theirs[2:], strict=True):
+                try:
+                    assert float(a) == pytest.approx(float(b), rel=1e-9, abs=1e-9), (name, ours)
+                except ValueError:
+                    assert a == b, (name, ours)

@@ -271,6 +271,8 @@ class PlanningModel:
     """a grid world's ``(rows, columns)`` (state ``row * columns + column``), else ``None``"""
     moves: tuple[tuple[int, int], ...]
     """a grid world's ``(row step, column step)`` per action, else empty"""
+    labels: Mapping[int, str]
+    """names of some states, for figures (the world's ``labels``; Example 3.5's A, B)"""
 
 
 def planning_model(env: EnvConfig, source: str = "config") -> PlanningModel | str:
@@ -312,8 +314,9 @@ def planning_model(env: EnvConfig, source: str = "config") -> PlanningModel | st
         rows, columns = getattr(unwrapped, "rows", None), getattr(unwrapped, "columns", None)
         moves = tuple(getattr(unwrapped, "moves", ()))
         shape = (rows, columns) if isinstance(rows, int) and isinstance(columns, int) else None
+        labels = dict(getattr(unwrapped, "labels", {}))
         if shape is None or shape[0] * shape[1] != model.n_states:
-            return PlanningModel(model, action_values, where, None, ())
-        return PlanningModel(model, action_values, where, shape, moves)
+            return PlanningModel(model, action_values, where, None, (), labels)
+        return PlanningModel(model, action_values, where, shape, moves, labels)
     finally:
         made.close()

@@ -441,7 +441,11 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
                 name = f"v{symbol}" if final else f"v_k, k = {k}"
             values_panels.append(
                 figures.GridPanel(
-                    name, world.shape, values=outcome.values[k].reshape(world.shape), ends=ends
+                    name,
+                    world.shape,
+                    values=outcome.values[k].reshape(world.shape),
+                    ends=ends,
+                    labels=world.labels,
                 )
             )
             if spec.greedy:

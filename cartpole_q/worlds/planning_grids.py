@@ -68,6 +68,11 @@ class PlanningGrid(TableWorld):
         start[ends] = 0.0
         self.initial_state_distrib = start / start.sum()
         self.P = self._table()
+        self.labels: dict[int, str] = {}
+        """names of some states, for figures (Example 3.5's A, A', B, B')"""
+        for name, (cell, (target, _)) in zip("AB", self.teleports.items(), strict=False):
+            self.labels[self.state_of(cell)] = name
+            self.labels[self.state_of(target)] = f"{name}'"
 
     def state_of(self, cell: Cell) -> int:
         """The state of cell ``(row, column)``."""
