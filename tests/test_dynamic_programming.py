@@ -70,6 +70,13 @@ def test_fig_4_1_first_sweeps_are_the_books_synchronous_ones(small_grid: dp.Dens
     ]  # fmt: skip
 
 
+def test_in_place_sweeps_are_not_the_books_figure_4_1(small_grid: dp.DenseModel) -> None:
+    sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0, order="in_place")
+    assert sweeps.values[1][:4].tolist() == [0.0, -1.0, -1.25, -1.3125]
+    assert sweeps.values[2][1] == -1.9375  # the book's synchronous -1.75 (printed -1.7)
+    np.testing.assert_allclose(sweeps.values[-1][[1, 5, 2, 3]], [-14, -18, -20, -22], atol=1e-8)
+
+
 def test_fig_4_1_k_infinity_is_the_books_exact_values(small_grid: dp.DenseModel) -> None:
     sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0, tolerance=1e-12)
     book = [[0, -14, -20, -22], [-14, -18, -20, -20], [-20, -20, -18, -14], [-22, -20, -14, 0]]
