@@ -425,3 +425,18 @@ def test_the_docs_figures_data_is_what_dp_writes(tmp_path: Path) -> None:
                     assert float(a) == pytest.approx(float(b), rel=1e-9, abs=1e-9), (name, ours)
                 except ValueError:
                     assert a == b, (name, ours)
+
+
+def test_the_planning_worlds_have_profiles_for_maps_and_models() -> None:
+    from cartpole_q.envs.models import grid_layout
+    from cartpole_q.profiles import profile_for
+
+    config = load_config({"env": {"id": "cartpole_q/SmallGridworld-v0"}})
+    layout = grid_layout(config.env)
+    assert layout is not None and (layout.rows, layout.columns) == (4, 4)
+    assert layout.cells[0] == layout.cells[15] == "E" and set(layout.cells[1:15]) == {"F"}
+    assert layout.arrows() == "^v<>"
+    rental = profile_for("cartpole_q/CarRental-v0")
+    assert rental.policy_map == "components" and rental.state_components == (21, 21)
+    assert rental.names_actions(11) == [f"move {move}" for move in range(-5, 6)]
+    assert profile_for("cartpole_q/Gambler-v0").model == "transition_table"
