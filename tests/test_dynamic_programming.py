@@ -270,6 +270,17 @@ def test_dp_draws_fig_4_1_with_its_data_and_prints_the_books_numbers(tmp_path: P
         ({"policy": 7}, "policy: action 7 does not exist"),
         ({"max_sweeps": 5}, "did not converge in 5 sweeps"),
         ({"tolerance": "fast"}, "tolerance: must be a number"),
+        ({"tolerance": 0}, "tolerance: must be positive"),
+        ({"policy": "greedy"}, "policy: must be random or an action"),
+        ({"sweeps": "backwards"}, "sweeps: must be one of synchronous, in_place"),
+        ({"figure": {"kind": "grid", "file": "a/b.png"}}, "figure.file: must be a file name"),
+        (
+            {"figure": {"kind": "gambler"}, "algorithm": "policy_iteration", "policy": 0},
+            "gambler draws sweeps",
+        ),
+        ({"figure": {"kind": "car_rental"}}, "car_rental draws policy iteration"),
+        ({"book": [{"label": "x", "value": 1, "of": "mean"}]}, "book[0].of: must be one of"),
+        ({"env": {"id": "cartpole_q/Gambler-v0", "kwargs": {"p_h": 2}}}, "p_h"),
     ],
 )
 def test_dp_refuses_bad_study_files_with_exit_code_2(

@@ -1,8 +1,9 @@
 """The ``cartpole-q`` command line: every command registered on one Typer app.
 
-Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``, ``cli/planning.py``) parses its options,
-calls one library function and prints what it returns; what they share (exit codes, the
-stop routine, the options declared once) is in ``cli/base.py`` and ``cli/options.py``.
+Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``, ``cli/planning.py``)
+parses its options, calls one library function and prints what it returns; what they share
+(exit codes, the stop routine, the options declared once) is in ``cli/base.py`` and
+``cli/options.py``.
 """
 
 from __future__ import annotations

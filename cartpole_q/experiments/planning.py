@@ -183,9 +183,11 @@ def load_study(path: Path) -> Study:
             f"{where}: algorithm: must be one of {', '.join(ALGORITHMS)}, got "
             f"{shown_value(algorithm)}."
         )
-    gamma = _number(raw, "gamma", math.nan if "gamma" not in raw else 0.0, where)
-    if "gamma" not in raw or not 0.0 <= gamma <= 1.0:
-        raise ConfigError(f"{where}: gamma: must be a number in [0, 1] (the book's discount).")
+    if "gamma" not in raw:
+        raise ConfigError(f"{where}: gamma: is missing; the discount, in [0, 1].")
+    gamma = _number(raw, "gamma", 0.0, where)
+    if not 0.0 <= gamma <= 1.0:
+        raise ConfigError(f"{where}: gamma: must be a number in [0, 1], got {gamma:g}.")
     policy = raw.get("policy", "random")
     if policy != "random" and (
         isinstance(policy, bool) or not isinstance(policy, int) or policy < 0
@@ -206,8 +208,10 @@ def load_study(path: Path) -> Study:
         )
     tolerance = _number(raw, "tolerance", 1e-10, where)
     tie_tolerance = _number(raw, "tie_tolerance", 1e-9, where)
-    if tolerance <= 0 or tie_tolerance < 0:
-        raise ConfigError(f"{where}: tolerance must be positive and tie_tolerance not negative.")
+    if tolerance <= 0:
+        raise ConfigError(f"{where}: tolerance: must be positive, got {tolerance:g}.")
+    if tie_tolerance < 0:
+        raise ConfigError(f"{where}: tie_tolerance: must not be negative, got {tie_tolerance:g}.")
     max_sweeps = _integer(raw, "max_sweeps", 100_000, where) or 0
     if max_sweeps < 1:
         raise ConfigError(f"{where}: max_sweeps: must be at least 1.")

@@ -101,7 +101,9 @@ WORLDS: Sequence[World] = (
 """every world this package registers, with :data:`PLANNING_WORLDS`"""
 
 PLANNING_TIME_LIMIT = 1_000
-"""steps before an episode of a continuing task of chapters 3-4 is truncated"""
+"""steps before an episode of the gridworlds or the car rental is truncated (Example 3.5's
+gridworld and the car rental never end; the 4 x 4 gridworld's random episodes take some
+twenty steps on average)"""
 
 PLANNING_WORLDS: Sequence[World] = (
     World(
@@ -121,9 +123,9 @@ PLANNING_WORLDS: Sequence[World] = (
     ),
     World(f"{NAMESPACE}/Gambler-v0", "cartpole_q.worlds.gambler:GamblerEnv", GRID_TIME_LIMIT),
 )
-"""the worlds of dynamic programming (chapters 3-4); their models are exact
-(``cartpole-q dp``). Time limits: 1,000 steps in the continuing gridworld and car rental
-(the book's tasks never end), and in the 4 x 4 gridworld; 10,000 for the gambler"""
+"""the worlds of dynamic programming (chapters 3-4, ``cartpole-q dp``), their models exact;
+the gambler's time limit is the grid worlds' 10,000 steps (with stakes of 1 an episode can
+be long)"""
 
 
 def register_worlds() -> None:
