@@ -467,13 +467,20 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
         inner = slice(1, world.model.n_states - 1)
         steps = [k for k in spec.show if k < last] + [last]
         curves = [(f"sweep {k}", outcome.values[k][inner]) for k in steps]
-        stakes = np.array(world.action_values)[outcome.policies[last][inner]]
+        stakes = _meanings(world)[outcome.policies[last][inner]]
         return figures.gambler_figure(curves, stakes, spec.title)
     size = math.isqrt(world.model.n_states)
-    moves = np.array(world.action_values)
+    moves = _meanings(world)
     policies = [moves[policy].reshape(size, size) for policy in outcome.policies]
     value = outcome.values[last].reshape(size, size)
     return figures.car_rental_figure(policies, value, spec.title, f"v_pi{last}")
+
+
+def _meanings(world: PlanningModel) -> np.ndarray:
+    """Each action's meaning (a stake, cars moved), as integers when they are whole."""
+    meanings = np.array(world.action_values)
+    whole = np.all(meanings == np.round(meanings))
+    return meanings.astype(np.int64) if whole else meanings
 
 
 def _move_name(move: tuple[int, int]) -> str:
