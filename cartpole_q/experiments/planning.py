@@ -408,10 +408,15 @@ def book_rows(study: Study, outcome: Outcome) -> list[BookRow]:
 
 def summary(study: Study, outcome: Outcome) -> str:
     """One line: what ran, on what, and how long it took to converge."""
+    if study.policy == "random":
+        policy = "the random policy"
+    else:
+        meaning = _meanings(outcome.world)[int(study.policy)]
+        policy = f"action {study.policy} ({meaning}) in every state"
     what = {
-        "policy_evaluation": f"policy evaluation of the {study.policy if study.policy == 'random' else f'action-{study.policy}'} policy",
+        "policy_evaluation": f"policy evaluation of {policy}",
         "value_iteration": "value iteration",
-        "policy_iteration": f"policy iteration from action {study.policy} everywhere",
+        "policy_iteration": f"policy iteration from {policy}",
     }[study.algorithm]
     if study.algorithm == "policy_iteration":
         done = f"policy stable after {outcome.steps} improvements (each policy evaluated exactly)"
