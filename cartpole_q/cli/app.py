@@ -1,18 +1,19 @@
 """The ``cartpole-q`` command line: every command registered on one Typer app.
 
-Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``) parses its options,
-calls one library function and prints what it returns; what they share (exit codes, the
-stop routine, the options declared once) is in ``cli/base.py`` and ``cli/options.py``.
+Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``, ``cli/planning.py``)
+parses its options, calls one library function and prints what it returns; what they share
+(exit codes, the stop routine, the options declared once) is in ``cli/base.py`` and
+``cli/options.py``.
 """
 
 from __future__ import annotations
 
-from cartpole_q.cli import runs, studies, train
+from cartpole_q.cli import planning, runs, studies, train
 from cartpole_q.cli.base import app
 
 __all__ = ["app", "main"]
 
-COMMAND_MODULES = (train, runs, studies)
+COMMAND_MODULES = (train, runs, studies, planning)
 """the modules whose commands are registered on :data:`app` (imported for that)"""
 
 

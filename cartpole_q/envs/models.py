@@ -25,6 +25,7 @@ import numpy as np
 
 from cartpole_q.config import EnvConfig
 from cartpole_q.profiles import profile_for
+from cartpole_q.rl.dynamic_programming import DenseModel
 from cartpole_q.rl.value_iteration import TabularModel
 
 GREEDY_STEP_CAP = 10_000
@@ -253,5 +254,69 @@ def grid_layout(env: EnvConfig) -> GridLayout | None:
     try:
         rows, columns, cells, moves = reader(made.unwrapped)
         return GridLayout(rows, columns, tuple(cells), tuple(moves))
+    finally:
+        made.close()
+
+
+@dataclass(frozen=True)
+class PlanningModel:
+    """A world's exact model as dynamic programming takes it, and what figures need of it."""
+
+    model: DenseModel
+    action_values: tuple[float, ...]
+    """what each action means as a number (a stake, cars moved), else its index"""
+    source: str
+    """where the model comes from, in a few words"""
+    shape: tuple[int, int] | None
+    """a grid world's ``(rows, columns)`` (state ``row * columns + column``), else ``None``"""
+    moves: tuple[tuple[int, int], ...]
+    """a grid world's ``(row step, column step)`` per action, else empty"""
+    labels: Mapping[int, str]
+    """names of some states, for figures (the world's ``labels``; Example 3.5's A, B)"""
+
+
+def planning_model(env: EnvConfig, source: str = "config") -> PlanningModel | str:
+    """The dense model of ``gymnasium.make(env.id, **env.kwargs)``, or why there is none.
+
+    A world with a ``dense_model()`` method (Jack's car rental) gives its arrays; any other
+    with a transition table ``env.unwrapped.P`` (the book's gridworlds, the gambler,
+    FrozenLake, Taxi, CliffWalking) is read from it. ``allowed_actions()``, where the world
+    has it, says which actions each state offers (else all).
+
+    Raises:
+        ConfigError: the environment cannot be made (as :func:`~cartpole_q.envs.gym.make_env`).
+    """
+    from cartpole_q.envs.gym import make_env
+
+    made = make_env(env, source=source)
+    try:
+        unwrapped = made.unwrapped
+        n_actions = int(made.action_space.n)
+        allowed_of = getattr(unwrapped, "allowed_actions", None)
+        allowed = None if allowed_of is None else np.asarray(allowed_of(), dtype=bool)
+        dense = getattr(unwrapped, "dense_model", None)
+        if dense is not None:
+            transition, reward = dense()
+            model = DenseModel(
+                transition, reward, np.zeros((0, 0), bool) if allowed is None else allowed
+            )
+            where = f"{type(unwrapped).__name__}.dense_model()"
+        else:
+            found = env_model(env)
+            if isinstance(found, str):
+                return found
+            model = DenseModel.from_tabular(found.model, allowed)
+            where = found.source
+        values = getattr(unwrapped, "action_values", None)
+        action_values = (
+            tuple(float(v) for v in values) if values else tuple(map(float, range(n_actions)))
+        )
+        rows, columns = getattr(unwrapped, "rows", None), getattr(unwrapped, "columns", None)
+        moves = tuple(getattr(unwrapped, "moves", ()))
+        shape = (rows, columns) if isinstance(rows, int) and isinstance(columns, int) else None
+        labels = dict(getattr(unwrapped, "labels", {}))
+        if shape is None or shape[0] * shape[1] != model.n_states:
+            return PlanningModel(model, action_values, where, None, (), labels)
+        return PlanningModel(model, action_values, where, shape, moves, labels)
     finally:
         made.close()

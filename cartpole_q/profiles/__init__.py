@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 
-from cartpole_q.profiles import acrobot, book, cartpole, mountaincar, toy_text
+from cartpole_q.profiles import acrobot, book, cartpole, mountaincar, planning, toy_text
 from cartpole_q.profiles.base import UNKNOWN, EnvProfile, Physics, PhysicsRange
 
 __all__ = [
@@ -88,5 +88,6 @@ for _profile in (
     cartpole.PROFILE, mountaincar.PROFILE, acrobot.PROFILE, toy_text.FROZENLAKE,
     toy_text.TAXI, toy_text.CLIFFWALKING, toy_text.BLACKJACK, book.WINDY_GRIDWORLD,
     book.KINGS_WINDY_GRIDWORLD, book.DYNA_MAZE, book.MAXIMIZATION_BIAS, book.RANDOM_WALK,
+    planning.GRIDWORLDS, planning.GAMBLER, planning.CAR_RENTAL,
 ):  # fmt: skip
     register_profile(_profile)

@@ -14,6 +14,17 @@ id                                         world
 ``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
 =========================================  ==================================================
 
+The worlds of dynamic programming (chapters 3-4, ``cartpole-q dp``), :data:`PLANNING_WORLDS`:
+
+=========================================  ==================================================
+id                                         world
+=========================================  ==================================================
+``cartpole_q/Gridworld-v0``                Example 3.5, Figures 3.2, 3.5 (:mod:`~cartpole_q.worlds.planning_grids`)
+``cartpole_q/SmallGridworld-v0``           Example 4.1, Figure 4.1: the 4 x 4 gridworld
+``cartpole_q/CarRental-v0``                Example 4.2, Figure 4.2 (:mod:`~cartpole_q.worlds.car_rental`)
+``cartpole_q/Gambler-v0``                  Example 4.3, Figure 4.3 (:mod:`~cartpole_q.worlds.gambler`)
+=========================================  ==================================================
+
 **Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
 in 1.0), so the ids are registered by this package: importing ``cartpole_q`` (which the
 command line does) registers them as soon as Gymnasium is imported, before or after, and
@@ -87,14 +98,41 @@ WORLDS: Sequence[World] = (
         f"{NAMESPACE}/RandomWalk-v0", "cartpole_q.worlds.random_walk:RandomWalkEnv", WALK_TIME_LIMIT
     ),
 )
-"""every world this package registers"""
+"""every world this package registers, with :data:`PLANNING_WORLDS`"""
+
+PLANNING_TIME_LIMIT = 1_000
+"""steps before an episode of the gridworlds or the car rental is truncated (Example 3.5's
+gridworld and the car rental never end; the 4 x 4 gridworld's random episodes take some
+twenty steps on average)"""
+
+PLANNING_WORLDS: Sequence[World] = (
+    World(
+        f"{NAMESPACE}/Gridworld-v0",
+        "cartpole_q.worlds.planning_grids:GridworldEnv",
+        PLANNING_TIME_LIMIT,
+    ),
+    World(
+        f"{NAMESPACE}/SmallGridworld-v0",
+        "cartpole_q.worlds.planning_grids:SmallGridworldEnv",
+        PLANNING_TIME_LIMIT,
+    ),
+    World(
+        f"{NAMESPACE}/CarRental-v0",
+        "cartpole_q.worlds.car_rental:CarRentalEnv",
+        PLANNING_TIME_LIMIT,
+    ),
+    World(f"{NAMESPACE}/Gambler-v0", "cartpole_q.worlds.gambler:GamblerEnv", GRID_TIME_LIMIT),
+)
+"""the worlds of dynamic programming (chapters 3-4, ``cartpole-q dp``), their models exact;
+the gambler's time limit is the grid worlds' 10,000 steps (with stakes of 1 an episode can
+be long)"""
 
 
 def register_worlds() -> None:
     """Register every world with Gymnasium (an id registered already is left as it is)."""
     import gymnasium
 
-    for world in WORLDS:
+    for world in (*WORLDS, *PLANNING_WORLDS):
         if world.id not in gymnasium.registry:
             gymnasium.register(
                 world.id,
