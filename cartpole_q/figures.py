@@ -78,7 +78,21 @@ class FigureData:
         buffer = io.StringIO()
         writer = csv.writer(buffer, lineterminator="\n")
         writer.writerow(DATA_COLUMNS)
-        writer.writerows([_data_cell(value) for value in row] for row in self.rows)
+        labels: dict[str, str] = {}
+
+        def cell(value: Cell) -> str:
+            # The common cells first, without _data_cell's checks: a long run's curve has
+            # millions (a float64 is a float: its repr is the float's).
+            kind = type(value)
+            if kind is float or kind is np.float64:
+                return float.__repr__(value) if value == value else ""
+            if isinstance(value, str):
+                if value not in labels:
+                    labels[value] = _data_cell(value)
+                return labels[value]
+            return _data_cell(value)
+
+        writer.writerows([cell(value) for value in row] for row in self.rows)
         return buffer.getvalue()
 
 
@@ -806,6 +820,37 @@ def blackjack_policy_figure(
 
     figure.legend(handles=[Patch(color="#c0392b", label="hit"), Patch(color="#d9e6f2", label="stick")],
                   loc="outside right center")  # fmt: skip
+    figure.suptitle(title)
+    return figure
+
+
+def blackjack_values_figure(maps: Sequence[tuple[str, np.ndarray]], title: str) -> DataFigure:
+    """Blackjack's state values as Sutton & Barto's Figure 5.1: usable ace above, none below.
+
+    Each map is ``(label, V)`` with ``V`` of shape ``(32, 11, 2)`` (player sum, dealer's
+    card, usable ace), drawn as one column: player sums 12-21 against the dealer's card, on
+    one colour scale from -1 to 1.
+    """
+    sums, dealer = np.arange(12, 22), np.arange(1, 11)
+    figure = DataFigure(figsize=(3.6 * len(maps) + 1.2, 6.4), dpi=DPI, layout="constrained")
+    panels = np.asarray(figure.subplots(2, len(maps), squeeze=False))
+    image = None
+    for column, (label, values) in enumerate(maps):
+        for row, usable in enumerate((1, 0)):
+            axes = panels[row, column]
+            shown = values[12:22, 1:11, usable]
+            image = axes.imshow(shown, origin="lower", cmap="RdYlGn", vmin=-1.0, vmax=1.0,
+                                aspect="auto", extent=(0.5, 10.5, 11.5, 21.5),
+                                interpolation="nearest")  # fmt: skip
+            name = f"{label}, {'usable ace' if usable else 'no usable ace'}"
+            figure.data.panel(name).cells("value", dealer.tolist(), sums.tolist(), shown)
+            axes.set_xticks(dealer, ["A", *map(str, range(2, 11))])
+            axes.set_yticks(sums)
+            axes.set_xlabel("dealer showing")
+            axes.set_ylabel("player sum")
+            axes.set_title(name, fontsize="small")
+    if image is not None:
+        figure.colorbar(image, ax=panels, label="estimated value", shrink=0.8)
     figure.suptitle(title)
     return figure
 

@@ -854,7 +854,11 @@ class Prediction(Agent):
         self.q = [[q_init] for _ in range(n_states)]
 
     def draw(self, x: int) -> int:
-        """``pi``'s action: ``agent.policy: random``, one ``rng.integers(0, n)``."""
+        """``pi``'s action: ``agent.policy: random``, one ``rng.integers(0, n)``; ``stick_20``
+        (Blackjack, rows in C order over (32, 11, 2)): stick (0) on a player sum of 20 or
+        21, else hit (1), no draw."""
+        if self.params["policy"] == "stick_20":
+            return 0 if x // (11 * 2) >= 20 else 1
         return int(self.rng.integers(0, self.n))
 
     def v(self, x: int) -> float:

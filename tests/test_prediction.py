@@ -387,3 +387,34 @@ def test_a_values_figure_refuses_control_runs_and_against(
     refused = invoke("sweep", write_yaml(tmp_path / "v.yaml", study), "--out", tmp_path / "s")
     assert refused.exit_code == 2, refused.output
     assert words in refused.stderr and "Traceback" not in refused.output
+
+
+def test_a_named_policy_plays_its_rule_without_draws() -> None:
+    """stick_20 (Blackjack, Example 5.1): stick on 20 or 21, else hit; no rng draw."""
+    overrides = {
+        "env.id": "Blackjack-v1", "agent.algorithm": "mc_prediction", "agent.policy": "stick_20",
+        "agent.update": "sample_average", "agent.visits": "first", "agent.gamma": 1.0,
+        "train.episodes": 2000, "seed": 3,
+    }  # fmt: skip
+    result = train(load_config(overrides=overrides), final_eval=False)
+    visits = result.visits  # (32, 11, 2, 2): the actions the rule took in each state
+    assert visits[:20, ..., 0].sum() == 0 and visits[20:, ..., 1].sum() == 0
+    assert visits[12:20, ..., 1].sum() > 1000 and visits[20:22, ..., 0].sum() > 300
+
+
+@pytest.mark.parametrize(
+    ("overrides", "words"),
+    [
+        ({"env.id": WALK5["env.id"], "discretization": None}, "stick_20 is a rule another world"),
+        (
+            {"env.id": "MountainCar-v0", "discretization.tilings": 4,
+             "discretization.bins": [4, 4], "discretization.low": [-1.2, -0.07],
+             "discretization.high": [0.6, 0.07]},
+            "stick_20 is a rule another world",
+        ),
+    ],
+)  # fmt: skip
+def test_a_named_policy_of_another_world_is_refused(overrides: dict, words: str) -> None:
+    with pytest.raises(ConfigError, match=r"agent\.policy") as raised:
+        load_config(overrides={**overrides, "agent.algorithm": "td", "agent.policy": "stick_20"})
+    assert words in str(raised.value)

@@ -349,7 +349,9 @@ OTHER_TWIN_VARIANTS = {
     "cartpole_tiles": {"q_learning", "sarsa_lambda-dutch"},
     # test_twins_tabular.py trains several algorithms on FrozenLake and a multi-step one on
     # each world alike on both engines; here the tabular twins run Q-learning.
-    **{world: {"q_learning"} for world in ("taxi", "cliffwalking", "blackjack")},
+    **{world: {"q_learning"} for world in ("taxi", "cliffwalking")},
+    # and Blackjack the named policy of Figure 5.1's study (its loop is compiled anyway)
+    "blackjack": {"q_learning", "mc_prediction-stick_20"},
     "frozenlake": {"q_learning", "q_learning-random-ties"},  # the tie rule is no new loop
 }
 
@@ -466,6 +468,25 @@ def test_prediction(world: str, variant: str, engine: str) -> None:
     """V of the random policy, and its RMS error after every episode, on three worlds."""
     expected = _assert_same(world, variant, engine)
     assert expected.errors is not None and len(expected.errors) == CASES[world]["episodes"]
+    assert expected.solved_episode is None
+
+
+NAMED_POLICY_VARIANTS = {
+    "mc_prediction-stick_20": (
+        "mc_prediction",
+        {"policy": "stick_20", "update": "sample_average", "visits": "first"},
+    ),
+    "td-stick_20": ("td", {"policy": "stick_20"}),
+}
+ALL_VARIANTS.update(NAMED_POLICY_VARIANTS)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"), _params(["blackjack"], list(NAMED_POLICY_VARIANTS))
+)
+def test_a_named_policy(world: str, variant: str, engine: str) -> None:
+    """Blackjack's "stick on 20 or 21" (Example 5.1), a rule the world declares, evaluated."""
+    expected = _assert_same(world, variant, engine)
     assert expected.solved_episode is None
 
 

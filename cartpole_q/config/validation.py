@@ -84,10 +84,12 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
         _check_on_tiles(reader, agent.algorithm)
     train = TrainConfig(**reader.fields(TrainConfig, "train."))
     _check_epsilon_floor(reader, agent, train.episodes)
+    env = _env(reader)
+    _check_named_policy(reader, agent, env.id)
     return Config(
         name=name,
         **reader.fields(Config, "", skip=("name",)),
-        env=_env(reader),
+        env=env,
         discretization=discretization,
         agent=agent,
         train=train,
@@ -135,6 +137,27 @@ def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
             "discretization.tilings",
             f"tile coding (tilings > 1) does not run agent.algorithm {algorithm}: {reason}. "
             "Use tilings: 1, or a one-step, n-step or trace algorithm.",
+        )
+
+
+def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str) -> None:
+    """A named ``agent.policy`` (not ``random``) is a rule of the world.
+
+    It gives an action per table row (the worlds that declare one have Discrete
+    observations: no grid, no tiles).
+    """
+    from cartpole_q.profiles import profile_for
+
+    name = agent.params.get("policy", "random")
+    if name == "random" or not get_algorithm(agent.algorithm).predicts:
+        return
+    declared = profile_for(env_id).policies
+    if name not in declared:
+        rules = ", ".join(declared) or "none"
+        raise reader.error(
+            "agent.policy",
+            f"{name} is a rule another world declares; {env_id} declares {rules}. Use "
+            "random, or an env.id whose rule it is (stick_20: Blackjack-v1).",
         )
 
 

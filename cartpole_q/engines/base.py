@@ -289,6 +289,18 @@ _TRUTHS: dict[tuple[Any, ...], Truth] = {}
 """the true values solved in this process, by what decides them"""
 
 
+def named_policy(config: Config, env_info: EnvInfo) -> list[int] | None:
+    """A prediction run's named ``agent.policy`` (not ``random``): its action in every row.
+
+    The rule is the world's (its profile's ``policies``); validation has checked it has it.
+    """
+    name = config.agent.params.get("policy", "random")
+    if name == "random":
+        return None
+    rule = profile_for(config.env.id).policies[str(name)]
+    return rule(tuple(env_info.state_shape))
+
+
 def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     """:func:`prediction_truth`, solved (see there)."""
     from cartpole_q.envs.models import EnvModel, env_model
@@ -300,7 +312,7 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     rows_pi = policy_table(
         MemoryContext(
             math.prod(env_info.state_shape), env_info.n_actions, 0.0,
-            dict(config.agent.params), 0,
+            dict(config.agent.params), 0, policy=named_policy(config, env_info),
         )
     )  # fmt: skip
     pi = rows_pi[row_of_state]
@@ -376,6 +388,7 @@ class TrainingState:
             params=dict(config.agent.params),
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
             episodes=config.train.episodes,
+            policy=named_policy(config, env_info) if algorithm.predicts else None,
         )
         columns = algorithm.table_columns(env_info.n_actions)  # V: one column
         return cls(

@@ -33,8 +33,9 @@ from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
 from cartpole_q.experiments.sweep_spec import VALUES_FIGURE, SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
-from cartpole_q.figures import DataFigure, summary_line_figure
+from cartpole_q.figures import DataFigure, blackjack_values_figure, summary_line_figure
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
+from cartpole_q.profiles import profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
@@ -445,7 +446,15 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
-    truth = prediction_truth(first, inspect_env(first))
+    info = inspect_env(first)
+    if profile_for(first.env.id).policy_map == "blackjack":  # Figure 5.1's value surfaces
+        maps = []
+        for label, path in zip(labels, paths, strict=True):
+            runs = load_run_set(path).runs
+            tables = np.array([run.q_table.reshape(info.state_shape) for run in runs])
+            maps.append((label, tables.mean(axis=0)))
+        return write_figure(out, blackjack_values_figure(maps, figure.title or spec.name))
+    truth = prediction_truth(first, info)
     if not truth.measured:
         raise RunError(
             f"figure.metric: values draws V beside the true values, but {first.env.id} has no "

@@ -101,6 +101,11 @@ class EnvProfile:
     ``blackjack`` (from the rules), if any"""
     description: str = ""
     """one line for the documentation"""
+    policies: Mapping[str, Callable[[tuple[int, ...]], list[int]]] = field(
+        default_factory=lambda: MappingProxyType({})
+    )
+    """named deterministic policies a prediction run may evaluate (``agent.policy``): from
+    the table's state shape, the action of every table row in C order"""
 
     def names_observations(self, count: int) -> list[str]:
         """Axis names for ``count`` dimensions (``observation N`` when they do not fit).

@@ -9,6 +9,7 @@ Blackjack its own.
 
 from __future__ import annotations
 
+from types import MappingProxyType
 from typing import Any
 
 from cartpole_q.profiles.base import EnvProfile, GridCells
@@ -73,6 +74,18 @@ CLIFFWALKING = EnvProfile(
     twin="cartpole_q.envs.twins.transition_table",
 )
 
+
+def stick_on_20(state_shape: tuple[int, ...]) -> list[int]:
+    """Sutton & Barto's Example 5.1 policy: stick (0) on a player sum of 20 or 21, else hit (1).
+
+    >>> actions = stick_on_20((32, 11, 2))
+    >>> actions[(19 * 11 + 5) * 2 + 1], actions[(20 * 11 + 5) * 2 + 0], len(actions)
+    (1, 0, 704)
+    """
+    per_sum = state_shape[1] * state_shape[2]
+    return [0 if row // per_sum >= 20 else 1 for row in range(state_shape[0] * per_sum)]
+
+
 BLACKJACK = EnvProfile(
     name="Blackjack",
     description="hit or stick against the dealer (Sutton & Barto's Example 5.1)",
@@ -83,4 +96,5 @@ BLACKJACK = EnvProfile(
     policy_map="blackjack",
     model="blackjack",
     twin="cartpole_q.envs.twins.blackjack",
+    policies=MappingProxyType({"stick_20": stick_on_20}),
 )

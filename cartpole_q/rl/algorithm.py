@@ -26,7 +26,7 @@ configs, validation, the README's table and the benchmarks read the registry the
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -102,6 +102,9 @@ class MemoryContext:
     """the longest an episode can be (its time limit, or the greedy cap without one)"""
     episodes: int = 0
     """the run's training episodes (``train.episodes``; 0 where no run is sized)"""
+    policy: Sequence[int] | None = None
+    """a prediction run's named policy (``agent.policy`` other than ``random``): the action
+    of each state, from the world's profile"""
 
 
 def no_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:

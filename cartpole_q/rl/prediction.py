@@ -28,12 +28,15 @@ import numpy as np
 from cartpole_q.rl.algorithm import MemoryContext, Param
 from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable, value
 
-POLICIES = ("random",)
+POLICIES = ("random", "stick_20")
 """``agent.policy`` values, in the order of their codes: ``random`` is uniform over the
-actions (Sutton & Barto's random walks)"""
+actions (Sutton & Barto's random walks); the others are deterministic rules a world declares
+(its profile's ``policies``): ``stick_20`` is Blackjack's "stick on 20 or 21" (Example 5.1)"""
 
 POLICY = Param(
-    "policy", "random", "the policy whose values are learnt: random (uniform over the actions)",
+    "policy", "random",
+    "the policy whose values are learnt: random (uniform over the actions), or a rule the "
+    "world declares (stick_20: Blackjack's stick on 20 or 21)",
     kind="choice", choices=POLICIES,
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""
@@ -41,8 +44,18 @@ POLICY = Param(
 
 @compilable
 def policy_action(policy: np.ndarray, state: int, params: Params, rng: Rng) -> int:
-    """The evaluated policy's action in ``state``: ``random``: ``rng.integers(0, n)``."""
-    return int(rng.integers(0, policy.shape[1]))
+    """The evaluated policy's action in ``state``.
+
+    ``random``: ``rng.integers(0, n)``; a named rule: the action of probability 1 in the
+    table (no draw).
+    """
+    if params[0] == 0.0:
+        return int(rng.integers(0, policy.shape[1]))
+    chosen = 0
+    for action in range(1, policy.shape[1]):
+        if policy[state, action] > policy[state, chosen]:
+            chosen = action
+    return chosen
 
 
 @compilable
@@ -54,8 +67,21 @@ def first_policy_action(
 
 
 def policy_table(context: MemoryContext) -> np.ndarray:
-    """``pi`` as a table: ``random`` gives every action ``1 / n`` in every state."""
-    return np.full((context.n_states, context.n_actions), 1.0 / context.n_actions)
+    """``pi`` as a table, one row per state.
+
+    ``random`` gives every action ``1 / n`` in every state; a named rule, 1.0 to its action
+    in each state (``context.policy``, from the world's profile).
+
+    Raises:
+        ValueError: a named rule without its actions in ``context.policy``.
+    """
+    if context.params.get("policy", "random") == "random":
+        return np.full((context.n_states, context.n_actions), 1.0 / context.n_actions)
+    if context.policy is None or len(context.policy) != context.n_states:
+        raise ValueError(f"agent.policy {context.params['policy']} needs its actions per state")
+    table = np.zeros((context.n_states, context.n_actions))
+    table[np.arange(context.n_states), np.asarray(context.policy, dtype=np.int64)] = 1.0
+    return table
 
 
 @compilable
