@@ -17,10 +17,13 @@ Rows:
   tabular worlds    FrozenLake8x8-v1 and Taxi-v4 (the shipped configs frozenlake8x8 and taxi):
                     the numba engine's twin against the gymnasium engine on the same training
                     (the twins are bit-identical, so both engines play the same env steps)
+  prediction        every prediction algorithm on the 19-state random walk (Figure 7.2's),
+                    the random policy, its error measured per episode: the numba engine
+                    against the gymnasium engine on the same training
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
 same run, so they hold across machines even when absolute rates do not. --only SECTION runs
-one section (cartpole, algorithms, environments, tabular, progress); the algorithms section
+one section (cartpole, algorithms, environments, tabular, prediction, tiles, progress); the algorithms section
 then measures its own Q-learning baseline.
 """
 
@@ -42,6 +45,7 @@ from rich.console import Console
 from cartpole_q.config import load_config
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.progress import RichReporter
+from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.algorithms import names as algorithm_names
 from cartpole_q.training import train
 
@@ -190,7 +194,9 @@ TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
            ("Taxi-v4 (taxi)", "taxi", 5_000))  # fmt: skip
 """the tabular worlds' rows: label, shipped config, its episodes (the whole training)"""
 
-SECTIONS = ("cartpole", "algorithms", "environments", "tabular", "tiles", "progress")
+SECTIONS = (
+    "cartpole", "algorithms", "environments", "tabular", "prediction", "tiles", "progress",
+)  # fmt: skip
 """what --only can pick; by default every section runs, in this order"""
 
 
@@ -245,6 +251,8 @@ def algorithm_rows(repeats: int, numba_episodes: int, q_learning: float | None) 
         f"{'vs q_learning':>13s} {'updates/step':>13s} {'updates/s':>14s}"
     )
     for algorithm in algorithm_names():
+        if get_algorithm(algorithm).predicts:
+            continue  # (the prediction section: they evaluate a policy of the random walk)
         engine_rate(None, "numba", 5, 0, algorithm=algorithm)  # compile or load the cache
         rate = median_rate(
             lambda a=algorithm: engine_rate(None, "numba", numba_episodes // 10, 0, algorithm=a),
@@ -305,6 +313,55 @@ def tabular_rows(repeats: int, scale: float) -> None:
         )
         print(
             f"{name:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x "
+            f"{episodes:9,d} {steps:10,d}"
+        )
+
+
+PREDICTION_WALK = {
+    "env": {"id": "cartpole_q/RandomWalk-v0"}, "discretization": None,
+    "agent": {"policy": "random", "gamma": 1.0, "alpha": 0.1, "q_init": 0.0},
+}  # fmt: skip
+"""the prediction section's world: Figure 7.2's 19-state walk, the random policy"""
+PREDICTION_PARAMS = {"batch_prediction": {"alpha": 0.001}}
+"""a small enough alpha for the batch to converge (its sums grow with the episodes)"""
+
+
+def prediction_rows(repeats: int, scale: float) -> None:
+    """Each prediction algorithm on the 19-state walk: numba against the gymnasium engine.
+
+    Both engines train the same config from the same seed (the twin is bit-identical, so
+    they play the same env steps, checked), with the per-episode RMS error measured as in
+    every prediction run. The batch method's cost grows with the episodes seen (each
+    episode passes over all earlier ones), so it plays fewer.
+    """
+    print(
+        f"{'prediction, 19-state walk':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s} "
+        f"{'episodes':>9s} {'env steps':>10s}"
+    )
+    for algorithm in algorithm_names():
+        if not get_algorithm(algorithm).predicts:
+            continue
+        batch = algorithm == "batch_prediction"
+        episodes = max(20, int((50 if batch else 2000) * scale))
+        config = {
+            **PREDICTION_WALK,
+            "agent": {**PREDICTION_WALK["agent"], "algorithm": algorithm,
+                      **PREDICTION_PARAMS.get(algorithm, {})},
+        }  # fmt: skip
+        engine_rate(config, "numba", 5, 0)  # compile or load the cache
+        engine_rate(config, "gymnasium", 5, 0)
+        steps, _ = engine_rate(config, "numba", episodes, 0)
+        gym_steps, _ = engine_rate(config, "gymnasium", episodes, 0)
+        if steps != gym_steps:
+            raise SystemExit(f"{algorithm}: the engines played {gym_steps} and {steps} env steps")
+        gym_rate = median_rate(
+            lambda c=config, e=episodes: engine_rate(c, "gymnasium", e, 0), repeats
+        )
+        numba_rate = median_rate(
+            lambda c=config, e=episodes: engine_rate(c, "numba", e, 0), max(5, repeats)
+        )
+        print(
+            f"{algorithm:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x "
             f"{episodes:9,d} {steps:10,d}"
         )
 
@@ -386,6 +443,8 @@ def main() -> None:
             environment_rows(args.repeats, scale)
         elif section == "tabular":
             tabular_rows(args.repeats, scale)
+        elif section == "prediction":
+            prediction_rows(args.repeats, scale)
         elif section == "tiles":
             tile_rows(args.repeats, scale)
         else:
