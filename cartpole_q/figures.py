@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -201,6 +202,11 @@ class SeedBand:
     the series are numbered ``run 1``, ``run 2``, ...)"""
 
 
+CURVE_POINTS = 20_000
+"""the most episodes a run's reward curve draws: a longer run's every ``stride``-th
+(``ceil(episodes / CURVE_POINTS)``), its data likewise"""
+
+
 def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
     """Trailing mean over the last ``window`` values (fewer at the start).
 
@@ -254,13 +260,17 @@ def _draw_reward_curves(
         if isinstance(item, SeedBand):
             _draw_band(axes, record, item, colour)
             continue
-        episodes = np.arange(1, len(item.returns) + 1)
-        axes.plot(episodes, item.returns, color=colour, alpha=0.25, linewidth=0.8)
-        record.line(f"{item.label}: return", episodes, item.returns)
+        # A long run's curve is drawn at every stride-th episode (at most CURVE_POINTS
+        # points): a million points are no clearer on a page and took seconds to draw and
+        # write. The moving average is of every episode all the same.
+        stride = max(1, math.ceil(len(item.returns) / CURVE_POINTS))
+        episodes = np.arange(1, len(item.returns) + 1)[::stride]
+        axes.plot(episodes, item.returns[::stride], color=colour, alpha=0.25, linewidth=0.8)
+        record.line(f"{item.label}: return", episodes, item.returns[::stride])
         suffix = f" (solved at {item.solved_episode})" if item.solved_episode else ""
         if item.interrupted:
             suffix += f" (interrupted at episode {len(item.returns)})"
-        average = moving_average(item.returns)
+        average = moving_average(item.returns)[::stride]
         axes.plot(episodes, average, color=colour, linewidth=2.0,
                   label=f"{item.label}{suffix}")  # fmt: skip
         record.line(f"{item.label}: {SOLVE_WINDOW}-episode average", episodes, average)

@@ -200,3 +200,18 @@ def test_a_figure_that_cannot_be_written_leaves_its_old_data(tmp_path: Path) -> 
         atomic_write_together([(data, b"new\n"), (unwritable, b"\x89PNG")])
     assert data.read_text(encoding="utf-8") == "old\n"
     assert sorted(path.name for path in tmp_path.iterdir()) == ["figure.csv"]  # no temporaries
+
+
+@pytest.mark.parametrize(("episodes", "stride"), [(20_000, 1), (20_001, 2), (100_000, 5)])
+def test_a_long_runs_reward_curve_draws_every_kth_episode(episodes: int, stride: int) -> None:
+    """At most CURVE_POINTS points per line; the moving average is of every episode."""
+    returns = np.arange(episodes, dtype=np.float64) % 7.0
+    drawn = figures.reward_curve_figure([figures.Curve("run", returns)], None)
+    rows = list(csv.DictReader(drawn.data.csv_text().splitlines()))
+    raw = [row for row in rows if row["series"] == "run: return"]
+    average = [row for row in rows if row["series"] == "run: 100-episode average"]
+    assert len(raw) == len(average) == len(range(0, episodes, stride)) <= figures.CURVE_POINTS
+    assert [float(row["x"]) for row in raw[:2]] == [1.0, 1.0 + stride]
+    last = (len(raw) - 1) * stride  # the last drawn episode, 0-based
+    assert float(raw[-1]["y"]) == returns[last]
+    assert float(average[-1]["y"]) == pytest.approx(returns[last - 99 : last + 1].mean())
