@@ -325,6 +325,7 @@ def metric_curve_figure(
     log_y: bool = False,
     reference: tuple[float, str] | None = None,
     y_limits: tuple[float | None, float | None] = (None, None),
+    log_x: bool = False,
 ) -> DataFigure:
     """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
 
@@ -356,12 +357,14 @@ def metric_curve_figure(
         record.level(reference[1], reference[0])
     if log_y:
         axes.set_yscale("log")
+    if log_x:
+        axes.set_xscale("log")
     if y_limits != (None, None):
         axes.set_ylim(*y_limits)
     axes.set_xlabel(x_label)
     axes.set_ylabel(y_label)
     axes.set_title(title, fontsize="medium")
-    axes.grid(alpha=0.3, which="both" if log_y else "major")
+    axes.grid(alpha=0.3, which="both" if log_y or log_x else "major")
     axes.legend(loc="best", fontsize="small")
     return figure
 

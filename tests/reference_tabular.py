@@ -1054,6 +1054,52 @@ class OfflineLambdaReturn(Prediction):
         return None
 
 
+class OffPolicyMCPrediction(Prediction):
+    """``off_policy_mc_prediction``: a uniform behaviour draws every action; returns weighted
+    backwards by pi / b over the steps after each visit, ordinary or weighted sampling."""
+
+    def __init__(self, n_states: int, *args: Any) -> None:
+        super().__init__(n_states, *args)
+        self.buffer_length = NO_TIME_LIMIT_LENGTH
+        self.episode: list[tuple[int, int, float]] = []
+        self.sums = [0.0] * n_states
+
+    def draw(self, x: int) -> int:
+        return int(self.rng.integers(0, self.n))  # b: uniform, whatever the target
+
+    def pi(self, b: int, x: int) -> float:
+        """The target's probability of ``b`` in ``x``: ``1 / n``, or a rule's 1.0 or 0.0."""
+        if self.params["policy"] == "random":
+            return 1.0 / self.n
+        return 1.0 if b == Prediction.draw(self, x) else 0.0
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        self.episode.append((s, a, r))
+        if not terminated and not truncated and len(self.episode) < self.buffer_length:
+            return self.draw(s2)
+        first: dict[int, int] = {}
+        for t, (x, _, _) in enumerate(self.episode):
+            first.setdefault(x, t)
+        g = 0.0 if terminated else self.v(s2)
+        w = 1.0
+        for t in range(len(self.episode) - 1, -1, -1):
+            x, b, reward = self.episode[t]
+            g = self.gamma * g + reward
+            w = w * (self.pi(b, x) / (1.0 / self.n))
+            if self.params["visits"] == "every" or first[x] == t:
+                if self.params["sampling"] == "ordinary":
+                    self.sums[x] = self.sums[x] + 1.0
+                    self.q[x][0] = self.q[x][0] + (w * g - self.q[x][0]) / self.sums[x]
+                else:
+                    self.sums[x] = self.sums[x] + w
+                    if self.sums[x] > 0.0:
+                        self.q[x][0] = self.q[x][0] + (w / self.sums[x]) * (g - self.q[x][0])
+        self.episode = []
+        return None
+
+
 def true_values(
     env: gymnasium.Env[Any, Any], n: int, gamma: float
 ) -> tuple[list[int], list[float]]:
@@ -1124,6 +1170,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "mc_prediction": MCPrediction,
     "batch_prediction": BatchPrediction,
     "offline_lambda_return": OfflineLambdaReturn,
+    "off_policy_mc_prediction": OffPolicyMCPrediction,
     "td_lambda": TDLambda,
     "true_online_td_lambda": TrueOnlineTDLambda,
 }
@@ -1142,6 +1189,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "target": "td",
     "tolerance": 1e-6,
     "max_passes": 100_000,
+    "sampling": "weighted",
 }
 PREDICTION_DEFAULTS: dict[str, Any] = {"update": "constant_alpha"}
 """mc_prediction's own default of a key another algorithm defaults otherwise"""
@@ -1244,7 +1292,10 @@ def reference_train(
         if hasattr(env.unwrapped, "P"):
             measured, truth = true_values(env, n, float(gamma))
             errors = []
-    if isinstance(agent, (MonteCarlo, MCPrediction, BatchPrediction, OfflineLambdaReturn)):
+    if isinstance(
+        agent,
+        (MonteCarlo, MCPrediction, BatchPrediction, OfflineLambdaReturn, OffPolicyMCPrediction),
+    ):
         assert env.spec is not None
         limit = env.spec.max_episode_steps
         agent.buffer_length = int(limit) if limit is not None else NO_TIME_LIMIT_LENGTH

@@ -75,6 +75,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/BlockingMaze-v0": (54, 4, 10_000),
         "cartpole_q/ShortcutMaze-v0": (54, 4, 10_000),
         "cartpole_q/MaximizationBias-v0": (3, 10, None),
+        "cartpole_q/OneState-v0": (2, 2, 1_000),
         "cartpole_q/RandomWalk5-v0": (7, 2, 1_000),
         "cartpole_q/RandomWalk-v0": (21, 2, 1_000),
     }

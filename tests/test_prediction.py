@@ -418,3 +418,34 @@ def test_a_named_policy_of_another_world_is_refused(overrides: dict, words: str)
     with pytest.raises(ConfigError, match=r"agent\.policy") as raised:
         load_config(overrides={**overrides, "agent.algorithm": "td", "agent.policy": "stick_20"})
     assert words in str(raised.value)
+
+
+def test_the_one_state_mdp_and_importance_sampling() -> None:
+    """Example 5.5: v(s) = 1 under left (1/11 under random); weighted IS is exact at once."""
+    import gymnasium
+    from gymnasium.utils.env_checker import check_env
+
+    check_env(gymnasium.make("cartpole_q/OneState-v0").unwrapped)
+    base = {
+        "env.id": "cartpole_q/OneState-v0", "discretization": None, "agent.gamma": 1.0,
+        "agent.q_init": 0.0,
+    }  # fmt: skip
+    for policy, value in (("left", 1.0), ("random", 1 / 11)):
+        config = load_config(overrides={**base, "agent.algorithm": "td", "agent.policy": policy})
+        truth = prediction_truth(config, inspect_env(config))
+        assert truth.rows.tolist() == [0] and truth.values[0] == pytest.approx(value, abs=1e-15)
+    overrides = {
+        **base, "agent.algorithm": "off_policy_mc_prediction", "agent.policy": "left",
+        "train.episodes": 200, "seed": 2,
+    }  # fmt: skip
+    weighted = train(load_config(overrides=overrides), final_eval=False)
+    assert weighted.errors is not None
+    # Weighted: every episode that ended with right has W = 0 and leaves V at 0 ...
+    first = int(np.flatnonzero(weighted.errors < 1.0)[0])
+    assert (weighted.errors[:first] == 1.0).all()
+    # ... and from the first that ends left with +1, V(s) = G = 1 exactly, for good.
+    assert (weighted.errors[first:] == 0.0).all()
+    ordinary = train(
+        load_config(overrides={**overrides, "agent.sampling": "ordinary"}), final_eval=False
+    )
+    assert ordinary.errors is not None and len(set(ordinary.errors.tolist())) > 20

@@ -142,6 +142,7 @@ PREDICTION_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "td_lambda-lambda0": ("td_lambda", {"lambda": 0.0}),
     "true_online_td_lambda": ("true_online_td_lambda", {"lambda": 0.8}),
     "offline_lambda_return": ("offline_lambda_return", {"lambda": 0.8}),
+    "off_policy_mc_prediction-ordinary": ("off_policy_mc_prediction", {"sampling": "ordinary"}),
     "offline_lambda_return-lambda1": ("offline_lambda_return", {"lambda": 1.0}),
     # Small alphas: the batch's sums grow with the episodes seen (a large alpha diverges).
     "batch_prediction-td": ("batch_prediction", {"alpha": 0.002, "tolerance": 1e-3}),
@@ -351,7 +352,11 @@ OTHER_TWIN_VARIANTS = {
     # each world alike on both engines; here the tabular twins run Q-learning.
     **{world: {"q_learning"} for world in ("taxi", "cliffwalking")},
     # and Blackjack the named policy of Figure 5.1's study (its loop is compiled anyway)
-    "blackjack": {"q_learning", "mc_prediction-stick_20"},
+    "blackjack": {
+        "q_learning",
+        "mc_prediction-stick_20",
+        "off_policy_mc_prediction-weighted-stick_20",
+    },
     "frozenlake": {"q_learning", "q_learning-random-ties"},  # the tie rule is no new loop
 }
 
@@ -477,6 +482,14 @@ NAMED_POLICY_VARIANTS = {
         {"policy": "stick_20", "update": "sample_average", "visits": "first"},
     ),
     "td-stick_20": ("td", {"policy": "stick_20"}),
+    "off_policy_mc_prediction-ordinary-stick_20": (
+        "off_policy_mc_prediction",
+        {"policy": "stick_20", "sampling": "ordinary", "visits": "first"},
+    ),
+    "off_policy_mc_prediction-weighted-stick_20": (
+        "off_policy_mc_prediction",
+        {"policy": "stick_20", "sampling": "weighted"},
+    ),
 }
 ALL_VARIANTS.update(NAMED_POLICY_VARIANTS)
 

@@ -126,6 +126,8 @@ class CurveStyle:
     """where the x axis ends (default: the longest seed's training)"""
     y_limits: tuple[float | None, float | None] = (None, None)
     """the y axis's ends (``None``: matplotlib's choice), as the book's figure shows it"""
+    log_x: bool = False
+    """a logarithmic x axis (S&B Figures 5.3 and 5.4)"""
 
 
 def plot_metric(
@@ -198,7 +200,14 @@ def plot_metric(
     if len(run_dirs) == 1 and style.title is None:
         title += f": {run_dirs[0].name}"
     figure = metric_curve_figure(
-        bands, X_LABELS[x], y_label, title, log_y, style.reference, style.y_limits
+        bands,
+        X_LABELS[x],
+        y_label,
+        title,
+        log_y,
+        style.reference,
+        style.y_limits,
+        log_x=style.log_x,
     )
     return write_figure(out, figure)
 

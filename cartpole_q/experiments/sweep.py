@@ -372,7 +372,7 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
         reference = (figure.reference, figure.reference_label)
     style = CurveStyle(
         labels, figure.title, figure.y_label, figure.offset, figure.scale, reference,
-        figure.x_max, (figure.y_min, figure.y_max),
+        figure.x_max, (figure.y_min, figure.y_max), log_x=figure.log_x,
     )  # fmt: skip
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     if figure.against is not None:

@@ -52,7 +52,7 @@ class Point:
 
 
 FIGURE_KEYS = (
-    "metric", "x", "aggregate", "smooth", "log_y", "title", "y_label", "offset", "scale",
+    "metric", "x", "aggregate", "smooth", "log_y", "log_x", "title", "y_label", "offset", "scale",
     "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
@@ -86,6 +86,8 @@ class FigureSpec:
     aggregate: str = "mean"
     smooth: int = 1
     log_y: bool = False
+    log_x: bool = False
+    """a logarithmic x axis (S&B Figures 5.3 and 5.4: episodes on a log scale)"""
     title: str | None = None
     y_label: str | None = None
     offset: float = 0.0
@@ -326,7 +328,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
                 f"{', '.join(allowed)}."
             )
     kinds: dict[str, tuple[type, ...]] = {
-        "smooth": (int,), "log_y": (bool,), "title": (str,), "y_label": (str,),
+        "smooth": (int,), "log_y": (bool,), "log_x": (bool,), "title": (str,), "y_label": (str,),
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
         "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),

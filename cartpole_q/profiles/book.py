@@ -9,6 +9,7 @@ shows.
 
 from __future__ import annotations
 
+from types import MappingProxyType
 from typing import Any
 
 from cartpole_q.profiles.base import EnvProfile, GridCells
@@ -84,6 +85,28 @@ MAXIMIZATION_BIAS = EnvProfile(
     ids=("cartpole_q/MaximizationBias-v0",),
     entry_points=("cartpole_q.worlds.bias:MaximizationBiasEnv",),
     model="transition_table",
+)
+
+
+def always_left(state_shape: tuple[int, ...]) -> list[int]:
+    """The one-state MDP's target policy (Example 5.5): left (0) in every state.
+
+    >>> always_left((2,))
+    [0, 0]
+    """
+    return [0] * state_shape[0]
+
+
+ONE_STATE = EnvProfile(
+    name="OneState",
+    description="left comes back (0.9) or ends with +1, right ends with 0 (Sutton & Barto's "
+    "Example 5.5)",
+    ids=("cartpole_q/OneState-v0",),
+    entry_points=("cartpole_q.worlds.one_state:OneStateEnv",),
+    action_names=("left", "right"),
+    model="transition_table",
+    twin="cartpole_q.envs.twins.transition_table",
+    policies=MappingProxyType({"left": always_left}),
 )
 
 RANDOM_WALK = EnvProfile(

@@ -28,15 +28,16 @@ import numpy as np
 from cartpole_q.rl.algorithm import MemoryContext, Param
 from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable, value
 
-POLICIES = ("random", "stick_20")
+POLICIES = ("random", "stick_20", "left")
 """``agent.policy`` values, in the order of their codes: ``random`` is uniform over the
 actions (Sutton & Barto's random walks); the others are deterministic rules a world declares
-(its profile's ``policies``): ``stick_20`` is Blackjack's "stick on 20 or 21" (Example 5.1)"""
+(its profile's ``policies``): ``stick_20`` is Blackjack's "stick on 20 or 21" (Example 5.1),
+``left`` the one-state MDP's "always left" (Example 5.5)"""
 
 POLICY = Param(
     "policy", "random",
     "the policy whose values are learnt: random (uniform over the actions), or a rule the "
-    "world declares (stick_20: Blackjack's stick on 20 or 21)",
+    "world declares (stick_20: Blackjack's stick on 20 or 21; left: the one-state MDP's)",
     kind="choice", choices=POLICIES,
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""

@@ -10,6 +10,7 @@ id                                         world
 ``cartpole_q/BlockingMaze-v0``             Example 8.2, Figure 8.4 (``change_at=1000``)
 ``cartpole_q/ShortcutMaze-v0``             Example 8.3, Figure 8.5 (``change_at=3000``)
 ``cartpole_q/MaximizationBias-v0``         Example 6.7, Figure 6.5 (:mod:`~cartpole_q.worlds.bias`)
+``cartpole_q/OneState-v0``                 Example 5.5, Figure 5.4 (:mod:`~cartpole_q.worlds.one_state`)
 ``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.worlds.random_walk`)
 ``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
 =========================================  ==================================================
@@ -88,6 +89,7 @@ WORLDS: Sequence[World] = (
     World(f"{NAMESPACE}/BlockingMaze-v0", f"{_GRIDS}:BlockingMazeEnv", GRID_TIME_LIMIT),
     World(f"{NAMESPACE}/ShortcutMaze-v0", f"{_GRIDS}:ShortcutMazeEnv", GRID_TIME_LIMIT),
     World(f"{NAMESPACE}/MaximizationBias-v0", "cartpole_q.worlds.bias:MaximizationBiasEnv", None),
+    World(f"{NAMESPACE}/OneState-v0", "cartpole_q.worlds.one_state:OneStateEnv", WALK_TIME_LIMIT),
     World(
         f"{NAMESPACE}/RandomWalk5-v0",
         "cartpole_q.worlds.random_walk:RandomWalkEnv",
