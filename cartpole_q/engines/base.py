@@ -101,18 +101,24 @@ class Truth(NamedTuple):
     """The true values a prediction run's ``V`` is measured against after every episode.
 
     Empty arrays for a control run, or where the values cannot be known (no model of the
-    world, tile coding): nothing is measured then.
+    world, tile coding): nothing is measured then. One entry per measured state of the
+    world's model; where the world aggregates states (state aggregation), several states
+    are observed as one row and each is measured against ``V`` of its row.
     """
 
     rows: np.ndarray
-    """int64: the table rows (states) measured, the world's non-terminal states in order"""
+    """int64: the table row each measured state is observed as, the states in order"""
     values: np.ndarray
     """float64: the evaluated policy's exact value of each"""
+    states: np.ndarray
+    """int64: the measured states of the world's model (its reachable non-terminal states),
+    in order: the x axis of a values figure"""
 
     @classmethod
     def none(cls) -> Truth:
         """Nothing to measure."""
-        return cls(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.float64))
+        nothing = np.zeros(0, dtype=np.int64)
+        return cls(nothing, np.zeros(0, dtype=np.float64), nothing.copy())
 
     @property
     def measured(self) -> bool:
@@ -265,8 +271,10 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
 
     From the world's transition table, by
     :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
-    ``agent.gamma``; each model state is measured on the table row it is observed as.
-    Nothing is measured for a world without a model, or on tiles.
+    ``agent.gamma``; each model state is measured on the table row it is observed as
+    (several on one row only where the world aggregates states by design: Blackjack's
+    naturals, which share a row by accident, are not measured). Nothing is measured for a
+    world without a model, or on tiles.
     """
     tiled = config.discretization is not None and config.discretization.tilings > 1
     if tiled:
@@ -316,9 +324,11 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     measured = ~tabular.terminal_states()[reachable]
     states = reachable[measured]
     rows = row_of_state[states]
-    if len(np.unique(rows)) != len(rows):
-        return Truth.none()  # states observed alike: no one value per row
-    return Truth(rows.astype(np.int64), values[measured].astype(np.float64))
+    if not model.aggregates and len(np.unique(rows)) != len(rows):
+        return Truth.none()  # states observed alike by accident: no one value per row
+    return Truth(
+        rows.astype(np.int64), values[measured].astype(np.float64), states.astype(np.int64)
+    )
 
 
 @dataclass

@@ -98,3 +98,14 @@ RANDOM_WALK = EnvProfile(
     model="transition_table",
     twin="cartpole_q.envs.twins.transition_table",
 )
+
+RANDOM_WALK_1000 = EnvProfile(
+    name="RandomWalk1000",
+    description="Example 9.1's walk of 1000 states, jumps of up to 100 either way, -1 and +1 "
+    "ends; env.kwargs.groups aggregates the states (Figures 9.1, 9.2)",
+    ids=("cartpole_q/RandomWalk1000-v0",),
+    entry_points=("cartpole_q.worlds.random_walk:JumpingWalkEnv",),
+    action_names=("left", "right"),
+    model="transition_table",
+    twin="cartpole_q.envs.twins.aggregated_table",
+)

@@ -1,0 +1,107 @@
+"""Sutton & Barto chapter 9: the 1000-state walk (Example 9.1) and state aggregation.
+
+The world, its table and its groups; the true values on the aggregated world (one per
+true state, measured on the state's group); the on-policy distribution; the values figure
+drawn against the true states. The re-derivation of the algorithms on the aggregated walk
+is in ``test_rederivation.py`` (case ``walk1000``).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from typing import Any
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+from cartpole_q import load_config
+from cartpole_q.engines.base import prediction_truth
+from cartpole_q.envs.gym import inspect_env
+from cartpole_q.envs.models import EnvModel, env_model
+from cartpole_q.envs.registry import twin_settings
+from cartpole_q.rl.value_iteration import on_policy_distribution, reachable_states
+
+WALK = "cartpole_q/RandomWalk1000-v0"
+
+
+def _config(groups: int | None = None, **agent: Any) -> Any:
+    kwargs = {} if groups is None else {"groups": groups}
+    return load_config({
+        "env": {"id": WALK, "kwargs": kwargs},
+        "agent": {"algorithm": "td", "policy": "random", "gamma": 1.0, **agent},
+    })  # fmt: skip
+
+
+@pytest.mark.parametrize("groups", [None, 10, 20])
+def test_the_walk_passes_check_env_and_observes_its_groups(groups: int | None) -> None:
+    env = gymnasium.make(WALK, **({} if groups is None else {"groups": groups}))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped)
+    assert env.spec is not None and env.spec.max_episode_steps == 10_000
+    assert env.action_space.n == 2 and len(env.unwrapped.P) == 1002
+    assert env.observation_space.n == (1002 if groups is None else groups)
+    observation, _ = env.reset(seed=0)
+    assert observation == (500 if groups is None else 499 * groups // 1000)
+    if groups is not None:  # groups of 1000 / groups neighbours; each end in its neighbour's
+        expected = [0, *((s - 1) * groups // 1000 for s in range(1, 1001)), groups - 1]
+        assert env.unwrapped.observation_of_state.tolist() == expected
+
+
+def test_the_table_is_example_9_1s() -> None:
+    """Jumps of 1-100 either way, each 1/100; the jumps beyond an end terminate there."""
+    table = gymnasium.make(WALK).unwrapped.P
+    for state in range(1002):
+        for action in (0, 1):
+            assert math.isclose(sum(p for p, *_ in table[state][action]), 1.0, abs_tol=1e-12)
+    assert table[500][1] == [(0.01, 500 + k, 0.0, False) for k in range(1, 101)]
+    assert table[50][0][:49] == [(0.01, 50 - k, 0.0, False) for k in range(1, 50)]
+    assert table[50][0][49:] == [(0.51, 0, -1.0, True)]
+    assert table[1000][1] == [(1.0, 1001, 1.0, True)]
+    assert table[0][0] == [(1.0, 0, 0.0, True)] and table[1001][1] == [(1.0, 1001, 0.0, True)]
+    with pytest.raises(ValueError, match="groups must divide"):
+        gymnasium.make(WALK, groups=3)
+
+
+def test_the_true_values_are_the_books_s_curve_per_true_state() -> None:
+    """v(1) = -0.922 ... v(1000) = 0.922, odd about the middle; the same with groups."""
+    plain = prediction_truth(_config(), inspect_env(_config()))
+    assert plain.states.tolist() == list(range(1, 1001)) == plain.rows.tolist()
+    values = plain.values
+    assert values[0] == pytest.approx(-0.92196046, abs=1e-8)
+    assert values[-1] == pytest.approx(0.92196046, abs=1e-8)
+    assert np.allclose(values, -values[::-1], atol=1e-12)
+    assert np.all(np.diff(values) > 0)
+    # Nearly straight in the middle, bending near the ends (the book's figure).
+    assert values[399] == pytest.approx(-0.18964, abs=1e-5)
+    assert values[99] == pytest.approx(-0.75418, abs=1e-5)
+    grouped = prediction_truth(_config(10), inspect_env(_config(10)))
+    assert grouped.states.tolist() == list(range(1, 1001))
+    assert grouped.rows.tolist() == [(s - 1) // 100 for s in range(1, 1001)]
+    assert grouped.values.tobytes() == values.tobytes()  # the world is the same, observed in groups
+
+
+def test_the_model_maps_each_state_to_its_group_and_the_twin_plays_it() -> None:
+    model = env_model(_config(20).env)
+    assert isinstance(model, EnvModel) and model.aggregates
+    assert model.row_of_state[[0, 1, 50, 51, 1000, 1001]].tolist() == [0, 0, 0, 1, 19, 19]
+    settings = twin_settings(WALK, {"groups": 20}, 10_000)
+    assert not isinstance(settings, str)
+    assert settings.twin.name == "aggregated_table"
+    assert settings.params[-1].tolist() == model.row_of_state.tolist()
+
+
+def test_the_on_policy_distribution_is_figure_9_1s() -> None:
+    """mu peaks at the start (about 0.0137, the book's axis) and sums to 1."""
+    model = env_model(_config().env)
+    assert isinstance(model, EnvModel)
+    pi = np.full((1002, 2), 0.5)
+    states = np.flatnonzero(reachable_states(model.model, pi))[1:-1]
+    mu = on_policy_distribution(model.model, pi, states)
+    assert math.isclose(float(mu.sum()), 1.0, abs_tol=1e-12)
+    assert int(np.argmax(mu)) + 1 in (500, 501)
+    assert float(mu.max()) == pytest.approx(0.0137, abs=0.0001)
+    assert np.allclose(mu, mu[::-1], atol=1e-12)
