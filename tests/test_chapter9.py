@@ -8,8 +8,10 @@ is in ``test_rederivation.py`` (case ``walk1000``).
 
 from __future__ import annotations
 
+import csv
 import math
 import warnings
+from pathlib import Path
 from typing import Any
 
 import gymnasium
@@ -22,7 +24,11 @@ from cartpole_q.engines.base import prediction_truth
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.models import EnvModel, env_model
 from cartpole_q.envs.registry import twin_settings
+from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.rl.value_iteration import on_policy_distribution, reachable_states
+from cartpole_q.store import rundir
+from cartpole_q.training import train
+from tests.conftest import invoke, write_yaml
 
 WALK = "cartpole_q/RandomWalk1000-v0"
 
@@ -105,3 +111,73 @@ def test_the_on_policy_distribution_is_figure_9_1s() -> None:
     assert abs(int(np.argmax(mu)) + 1 - 500) <= 2
     assert float(mu.max()) == pytest.approx(0.0137, abs=0.0001)
     assert float(mu[0]) == pytest.approx(0.000148, abs=1e-6)  # a hundredth of the peak at the ends
+
+
+def test_a_values_figure_draws_each_true_state_on_its_group_with_mu(tmp_path: Path) -> None:
+    """Figure 9.1's kind: x is the true state; V of its group (a staircase); mu shaded."""
+    study = write_yaml(
+        tmp_path / "values.yaml",
+        {
+            "name": "values",
+            "base": {
+                "env": {"id": WALK, "kwargs": {"groups": 10}},
+                "agent": {"algorithm": "mc_prediction", "gamma": 1.0, "alpha": 0.01},
+                "train": {"episodes": 20, "eval_every": 0, "checkpoint_every": 0},
+                "eval": {"episodes": 1},
+            },
+            "seeds": "0",
+            "grid": {"agent.alpha": [0.01]},
+            "figure": {"metric": "values", "distribution": True, "file": "v.png"},
+        },
+    )  # fmt: skip
+    done = invoke("sweep", study, "--out", tmp_path / "sweep", "-q")
+    assert done.exit_code == 0, done.output
+    rows = list(csv.DictReader((tmp_path / "sweep" / "v.csv").open(encoding="utf-8")))
+    series: dict[str, list[dict[str, str]]] = {}
+    for row in rows:
+        series.setdefault(row["series"], []).append(row)
+    mu_name = "on-policy distribution mu (shaded, right axis)"
+    assert set(series) == {mu_name, "initial values", "alpha 0.01", "true values"}
+    for found in series.values():
+        assert [float(row["x"]) for row in found] == [float(s) for s in range(1, 1001)]
+    mu = np.array([float(row["y"]) for row in series[mu_name]])
+    assert math.isclose(float(mu.sum()), 1.0, abs_tol=1e-9) and float(mu.max()) > 0.013
+    tables = np.load(tmp_path / "sweep" / "points" / "000" / "q_tables.npz")
+    v = tables[tables.files[0]].reshape(-1)
+    assert v.shape == (10,)
+    drawn = [float(row["y"]) for row in series["alpha 0.01"]]
+    assert drawn == [float(v[(s - 1) // 100]) for s in range(1, 1001)]  # the staircase
+
+
+def test_the_distribution_needs_the_values_figure(tmp_path: Path) -> None:
+    study = {
+        "name": "wrong",
+        "base": {"env": {"id": WALK, "kwargs": {"groups": 10}},
+                 "agent": {"algorithm": "td", "gamma": 1.0}, "train": {"episodes": 2}},
+        "seeds": "0",
+        "figure": {"metric": "rms_error", "distribution": True},
+    }  # fmt: skip
+    refused = invoke("sweep", write_yaml(tmp_path / "w.yaml", study), "--out", tmp_path / "s")
+    assert refused.exit_code == 2, refused.output
+    assert "figure.distribution" in refused.stderr and "Traceback" not in refused.output
+
+
+def test_an_interrupted_aggregated_run_resumes_byte_identically(tmp_path: Path) -> None:
+    overrides = {
+        "env.id": WALK, "env.kwargs.groups": 20, "engine": "numba", "agent.gamma": 1.0,
+        "agent.algorithm": "n_step_td", "agent.n": 4, "agent.alpha": 0.2,
+        "train.episodes": 40, "train.checkpoint_every": 10,
+    }  # fmt: skip
+    whole = train(load_config(overrides=overrides), final_eval=False)
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= 2)
+    assert outcome.result.interrupted
+    resumed = invoke("train", "--resume", str(run), "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert np.load(run / rundir.V_TABLE_FILE).tobytes() == whole.v_table.tobytes()
+    assert whole.v_table.shape == (20,)
+    loaded = rundir.load_run(run)
+    assert whole.errors is not None and loaded.errors is not None
+    assert loaded.errors.tolist() == whole.errors.tolist()

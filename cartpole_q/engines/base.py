@@ -23,7 +23,11 @@ from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
 from cartpole_q.rl.schedules import SCHEDULE_KINDS, schedule_value
-from cartpole_q.rl.value_iteration import evaluate_policy, reachable_states
+from cartpole_q.rl.value_iteration import (
+    evaluate_policy,
+    on_policy_distribution,
+    reachable_states,
+)
 
 
 def kernel_name(
@@ -329,6 +333,40 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     return Truth(
         rows.astype(np.int64), values[measured].astype(np.float64), states.astype(np.int64)
     )
+
+
+def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
+    """The evaluated policy's on-policy distribution ``mu`` on the measured states.
+
+    The fraction of an episode's time steps spent in each state of :func:`prediction_truth`'s
+    ``states``, in their order (Sutton & Barto eq. 9.3, from the world's model by
+    :func:`~cartpole_q.rl.value_iteration.on_policy_distribution`, renormalised over the
+    measured states): what Figure 9.1 shades.
+
+    Raises:
+        ConfigError: the world has no model, or the policy may never end an episode.
+    """
+    from cartpole_q.envs.models import EnvModel, env_model
+
+    truth = prediction_truth(config, env_info)
+    model = env_model(config.env, env_info.max_episode_steps)
+    if not truth.measured or not isinstance(model, EnvModel):
+        raise ConfigError(f"{config.env.id}: no model to compute the on-policy distribution from.")
+    rows_pi = policy_table(
+        MemoryContext(
+            math.prod(env_info.state_shape), env_info.n_actions, 0.0,
+            dict(config.agent.params), 0,
+        )
+    )  # fmt: skip
+    pi = rows_pi[model.row_of_state]
+    reachable = np.flatnonzero(reachable_states(model.model, pi))
+    try:
+        mu = on_policy_distribution(model.model, pi, reachable)
+    except ValueError as error:
+        raise ConfigError(f"agent.policy: no on-policy distribution ({error}).") from None
+    measured = mu[np.searchsorted(reachable, truth.states)]
+    distribution: np.ndarray = measured / measured.sum()
+    return distribution
 
 
 @dataclass
