@@ -24,6 +24,7 @@ from cartpole_q.engines.base import prediction_truth
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.models import EnvModel, env_model
 from cartpole_q.envs.registry import twin_settings
+from cartpole_q.envs.twins import transition_table
 from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.rl.value_iteration import on_policy_distribution, reachable_states
 from cartpole_q.store import rundir
@@ -98,6 +99,9 @@ def test_the_model_maps_each_state_to_its_group_and_the_twin_plays_it() -> None:
     assert not isinstance(settings, str)
     assert settings.twin.name == "aggregated_table"
     assert settings.params[-1].tolist() == model.row_of_state.tolist()
+    # The plain table twin would observe the states: it refuses a world that groups them.
+    refused = transition_table.twin_params({"groups": 20}, WALK)
+    assert isinstance(refused, str) and "observes groups of states" in refused
 
 
 def test_the_on_policy_distribution_is_figure_9_1s() -> None:
