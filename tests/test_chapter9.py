@@ -166,9 +166,12 @@ def test_the_distribution_needs_the_values_figure(tmp_path: Path) -> None:
     assert "figure.distribution" in refused.stderr and "Traceback" not in refused.output
 
 
-def test_an_interrupted_aggregated_run_resumes_byte_identically(tmp_path: Path) -> None:
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_an_interrupted_aggregated_run_resumes_byte_identically(
+    tmp_path: Path, engine: str
+) -> None:
     overrides = {
-        "env.id": WALK, "env.kwargs.groups": 20, "engine": "numba", "agent.gamma": 1.0,
+        "env.id": WALK, "env.kwargs.groups": 20, "engine": engine, "agent.gamma": 1.0,
         "agent.algorithm": "n_step_td", "agent.n": 4, "agent.alpha": 0.2,
         "train.episodes": 40, "train.checkpoint_every": 10,
     }  # fmt: skip

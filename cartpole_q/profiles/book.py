@@ -1,7 +1,8 @@
 """Sutton & Barto's worlds (:mod:`cartpole_q.worlds`).
 
-The windy gridworlds, the Dyna mazes, the maximization-bias MDP and the 19-state random
-walk. Each has a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
+The windy gridworlds, the Dyna mazes, the maximization-bias MDP, the 5- and 19-state
+random walks and the 1000-state walk (Example 9.1; observed in groups of states with
+``env.kwargs.groups``, its policy has no map). Each has a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
 exactly; the grid worlds and the walk draw their policy maps as grids. The maps are read
 from the environment (``env.unwrapped``), so a changed argument (``stay``, ``change_at``)
 shows.
