@@ -188,3 +188,44 @@ def test_an_interrupted_aggregated_run_resumes_byte_identically(
     loaded = rundir.load_run(run)
     assert whole.errors is not None and loaded.errors is not None
     assert loaded.errors.tolist() == whole.errors.tolist()
+
+
+def _asymptotes(groups: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """v_pi, mu, and the two fixed points of Section 9.4 with state aggregation, exact.
+
+    Gradient MC's is each group's mu-weighted mean of v_pi (the minimum of VE, eq. 9.1);
+    semi-gradient TD(0)'s solves ``A w = b`` (eq. 9.12), both from the walk's table.
+    """
+    model = env_model(_config().env)
+    assert isinstance(model, EnvModel)
+    pi = np.full((1002, 2), 0.5)
+    states = np.arange(1, 1001)
+    expected, matrix = model.model.stochastic_policy_matrix(pi)
+    p_pi, r_pi = matrix[np.ix_(states, states)], expected[states]
+    v = np.linalg.solve(np.eye(1000) - p_pi, r_pi)
+    mu = on_policy_distribution(model.model, pi, states)
+    features = np.zeros((1000, groups))
+    features[np.arange(1000), np.arange(1000) * groups // 1000] = 1.0
+    weighted = features.T * mu
+    mc = np.linalg.solve(weighted @ features, weighted @ v)
+    td = np.linalg.solve(weighted @ (features - p_pi @ features), weighted @ r_pi)
+    return v, mu, mc, td
+
+
+def test_gradient_mc_and_semi_gradient_td_approach_their_fixed_points() -> None:
+    """Section 9.4: MC towards the VE minimum, TD towards its fixed point, farther from v_pi."""
+    v, _, mc, td = _asymptotes(10)
+    group = (np.arange(1000) * 10) // 1000
+    assert np.sqrt(np.mean((mc[group] - v) ** 2)) == pytest.approx(0.0541, abs=1e-4)
+    assert np.sqrt(np.mean((td[group] - v) ** 2)) == pytest.approx(0.1325, abs=1e-4)
+    assert mc[0] > v[:100].mean() and td[0] > mc[0]  # the left end pulled up, TD the most
+    # MC's targets vary more (whole returns, one sign per episode): a smaller alpha.
+    for algorithm, alpha, target in (("mc_prediction", 1e-4, mc), ("td", 1e-3, td)):
+        config = load_config({
+            "seed": 0, "engine": "numba",
+            "env": {"id": WALK, "kwargs": {"groups": 10}},
+            "agent": {"algorithm": algorithm, "gamma": 1.0, "alpha": alpha, "q_init": 0.0},
+            "train": {"episodes": 30000, "eval_every": 0, "checkpoint_every": 0},
+        })  # fmt: skip
+        learned = train(config, final_eval=False).v_table
+        assert np.max(np.abs(learned - target)) < 0.06, (algorithm, learned, target)
