@@ -376,18 +376,31 @@ def summary_line_figure(
     title: str,
     log_y: bool = False,
     y_limits: tuple[float | None, float | None] = (None, None),
+    second: tuple[str, Sequence[float], np.ndarray] | None = None,
 ) -> DataFigure:
     """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
 
     Each line is ``(label, xs, centre, low, high)``; ``y_limits`` fixes either end of the y
     axis (the book's range: Figure 7.2's 0.25 to 0.55 leaves the large errors off the top).
+    Lines of more than 100 points are drawn without markers. ``second`` is ``(label, xs,
+    ys)``, drawn shaded on a second y axis at the right (Figure 9.1's on-policy distribution).
     """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
+    if second is not None:
+        label, xs, ys = second
+        right = axes.twinx()
+        right.fill_between(xs, 0.0, ys, color="0.6", alpha=0.35, linewidth=0, step="mid")
+        right.set_ylim(0.0, float(np.max(ys)) * 1.05)
+        right.set_ylabel(label)
+        axes.set_zorder(right.get_zorder() + 1)  # the lines above the shading
+        axes.patch.set_visible(False)
+        record.line(label, xs, ys)
     for (label, xs, centre, low, high), colour in zip(lines, _colours(len(lines)), strict=True):
         axes.fill_between(xs, low, high, color=colour, alpha=0.25, linewidth=0)
-        axes.plot(xs, centre, color=colour, linewidth=1.8, marker="o", markersize=3, label=label)
+        marker = {"marker": "o", "markersize": 3} if len(xs) <= 100 else {}
+        axes.plot(xs, centre, color=colour, linewidth=1.8, label=label, **marker)  # type: ignore[arg-type]
         record.line(label, xs, centre, low, high)
     if log_y:
         axes.set_yscale("log")

@@ -1108,6 +1108,11 @@ def true_values(
     ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; measured
     are the states reachable from the start distribution along outcomes that do not
     terminate, but the terminal ones (every outcome stays in the state, pays 0, terminates).
+
+    Returns:
+        The row each measured state is observed as (the state itself, or, where the world
+        aggregates states, ``observation_of_state[x]``: several states share a row), in
+        state order, and each state's value.
     """
     table = env.unwrapped.P  # type: ignore[attr-defined]
     states = len(table)
@@ -1139,11 +1144,16 @@ def true_values(
     system = np.eye(len(order)) - gamma * matrix[np.ix_(order, order)]
     values = dict(zip(order, np.linalg.solve(system, expected[order]), strict=True))
     measured = [x for x in order if not terminal[x]]
-    return measured, [float(values[x]) for x in measured]
+    observed = getattr(env.unwrapped, "observation_of_state", None)
+    rows = [x if observed is None else int(observed[x]) for x in measured]
+    return rows, [float(values[x]) for x in measured]
 
 
 def rms_error(agent: Prediction, measured: list[int], truth: list[float]) -> float:
-    """``math.sqrt(S / k)``, ``S`` the squared differences summed in state order from 0.0."""
+    """``math.sqrt(S / k)``, ``S`` the squared differences summed in state order from 0.0.
+
+    ``measured`` holds each measured state's row (a row once per state observed as it).
+    """
     total = 0.0
     for x, value in zip(measured, truth, strict=True):
         difference = agent.v(x) - value

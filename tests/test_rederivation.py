@@ -177,6 +177,14 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 40,
         "seed": 8,
     },
+    # Example 9.1's 1000-state walk observed in 20 groups of 50 states (state aggregation,
+    # Figure 9.2): V has 20 rows; the error is over the 1000 true states.
+    "walk1000": {
+        "env": {"id": "cartpole_q/RandomWalk1000-v0", "kwargs": {"groups": 20}},
+        "agent": {"gamma": 1.0, "alpha": 0.05, "epsilon": 0.1, "q_init": 0.0},
+        "episodes": 12,
+        "seed": 9,
+    },
     # The default config (log epsilon schedule); it solves near episode 180 and goes on.
     "cartpole": {
         "env": {"id": "CartPole-v1"},
@@ -329,7 +337,7 @@ CASES: dict[str, dict[str, Any]] = {
 }
 # Worlds with a compiled twin train on both engines.
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
-NUMBA_WORLDS |= {"walk5", "walk19"}
+NUMBA_WORLDS |= {"walk5", "walk19", "walk1000"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
 NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack"}
@@ -358,6 +366,8 @@ OTHER_TWIN_VARIANTS = {
         "off_policy_mc_prediction-weighted-stick_20",
     },
     "frozenlake": {"q_learning", "q_learning-random-ties"},  # the tie rule is no new loop
+    # Chapter 9's algorithms on the aggregated walk: gradient MC, semi-gradient TD(0), n-step.
+    "walk1000": {"td", "mc_prediction", "n_step_td"},
 }
 
 
@@ -467,10 +477,10 @@ def _params(worlds: list[str], variants: list[str], slow: str = "none") -> list[
 
 @pytest.mark.parametrize(
     ("world", "variant", "engine"),
-    _params(["walk5", "walk19", "frozenlake"], list(PREDICTION_VARIANTS)),
+    _params(["walk5", "walk19", "frozenlake", "walk1000"], list(PREDICTION_VARIANTS)),
 )
 def test_prediction(world: str, variant: str, engine: str) -> None:
-    """V of the random policy, and its RMS error after every episode, on three worlds."""
+    """V of the random policy, and its RMS error after every episode, on four worlds."""
     expected = _assert_same(world, variant, engine)
     assert expected.errors is not None and len(expected.errors) == CASES[world]["episodes"]
     assert expected.solved_episode is None

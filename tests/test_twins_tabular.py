@@ -80,6 +80,13 @@ SETTINGS: dict[str, tuple[str, dict[str, Any], float]] = {
     "windy-stochastic": ("cartpole_q/StochasticWindyGridworld-v0", {}, 0.5),
     "dyna-maze": ("cartpole_q/DynaMaze-v0", {"max_episode_steps": 30}, 0.5),
     "random-walk": ("cartpole_q/RandomWalk-v0", {}, 0.0),
+    # Example 9.1's walk, its states observed as themselves and in groups (aggregated_table)
+    "walk1000": ("cartpole_q/RandomWalk1000-v0", {}, 0.0),
+    "walk1000-groups": (
+        "cartpole_q/RandomWalk1000-v0",
+        {"groups": 20, "max_episode_steps": 60},
+        0.0,
+    ),
 }
 STEPS = 10_000
 

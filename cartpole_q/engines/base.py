@@ -23,7 +23,11 @@ from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
 from cartpole_q.rl.schedules import SCHEDULE_KINDS, schedule_value
-from cartpole_q.rl.value_iteration import evaluate_policy, reachable_states
+from cartpole_q.rl.value_iteration import (
+    evaluate_policy,
+    on_policy_distribution,
+    reachable_states,
+)
 
 
 def kernel_name(
@@ -101,18 +105,24 @@ class Truth(NamedTuple):
     """The true values a prediction run's ``V`` is measured against after every episode.
 
     Empty arrays for a control run, or where the values cannot be known (no model of the
-    world, tile coding): nothing is measured then.
+    world, tile coding): nothing is measured then. One entry per measured state of the
+    world's model; where the world aggregates states (state aggregation), several states
+    are observed as one row and each is measured against ``V`` of its row.
     """
 
     rows: np.ndarray
-    """int64: the table rows (states) measured, the world's non-terminal states in order"""
+    """int64: the table row each measured state is observed as, the states in order"""
     values: np.ndarray
     """float64: the evaluated policy's exact value of each"""
+    states: np.ndarray
+    """int64: the measured states of the world's model (its reachable non-terminal states),
+    in order: the x axis of a values figure"""
 
     @classmethod
     def none(cls) -> Truth:
         """Nothing to measure."""
-        return cls(np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.float64))
+        nothing = np.zeros(0, dtype=np.int64)
+        return cls(nothing, np.zeros(0, dtype=np.float64), nothing.copy())
 
     @property
     def measured(self) -> bool:
@@ -265,8 +275,10 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
 
     From the world's transition table, by
     :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
-    ``agent.gamma``; each model state is measured on the table row it is observed as.
-    Nothing is measured for a world without a model, or on tiles.
+    ``agent.gamma``; each model state is measured on the table row it is observed as
+    (several on one row only where the world aggregates states by design: Blackjack's
+    naturals, which share a row by accident, are not measured). Nothing is measured for a
+    world without a model, or on tiles.
     """
     tiled = config.discretization is not None and config.discretization.tilings > 1
     if tiled:
@@ -328,9 +340,45 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     measured = ~tabular.terminal_states()[reachable]
     states = reachable[measured]
     rows = row_of_state[states]
-    if len(np.unique(rows)) != len(rows):
-        return Truth.none()  # states observed alike: no one value per row
-    return Truth(rows.astype(np.int64), values[measured].astype(np.float64))
+    if not model.aggregates and len(np.unique(rows)) != len(rows):
+        return Truth.none()  # states observed alike by accident: no one value per row
+    return Truth(
+        rows.astype(np.int64), values[measured].astype(np.float64), states.astype(np.int64)
+    )
+
+
+def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
+    """The evaluated policy's on-policy distribution ``mu`` on the measured states.
+
+    The fraction of an episode's time steps spent in each state of :func:`prediction_truth`'s
+    ``states``, in their order (Sutton & Barto eq. 9.3, from the world's model by
+    :func:`~cartpole_q.rl.value_iteration.on_policy_distribution`, renormalised over the
+    measured states): what Figure 9.1 shades.
+
+    Raises:
+        ConfigError: the world has no model, or the policy may never end an episode.
+    """
+    from cartpole_q.envs.models import EnvModel, env_model
+
+    truth = prediction_truth(config, env_info)
+    model = env_model(config.env, env_info.max_episode_steps)
+    if not truth.measured or not isinstance(model, EnvModel):
+        raise ConfigError(f"{config.env.id}: no model to compute the on-policy distribution from.")
+    rows_pi = policy_table(
+        MemoryContext(
+            math.prod(env_info.state_shape), env_info.n_actions, 0.0,
+            dict(config.agent.params), 0,
+        )
+    )  # fmt: skip
+    pi = rows_pi[model.row_of_state]
+    reachable = np.flatnonzero(reachable_states(model.model, pi))
+    try:
+        mu = on_policy_distribution(model.model, pi, reachable)
+    except ValueError as error:
+        raise ConfigError(f"agent.policy: no on-policy distribution ({error}).") from None
+    measured = mu[np.searchsorted(reachable, truth.states)]
+    distribution: np.ndarray = measured / measured.sum()
+    return distribution
 
 
 @dataclass

@@ -48,6 +48,9 @@ class EnvModel:
     """where the model comes from, in a few words"""
     success_probability: bool
     """the return is 1 on success and 0 otherwise (FrozenLake): the value is a probability"""
+    aggregates: bool = False
+    """the world observes groups of states (its ``observation_of_state``: state aggregation),
+    so several states share a row by design"""
 
 
 def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | str:
@@ -81,10 +84,24 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
         if getattr(unwrapped, "fickle_passenger", False):
             return "Taxi's fickle_passenger changes destinations outside its transition table"
         space = made.observation_space
-        if getattr(space, "n", None) != len(transitions) or getattr(space, "start", 0) != 0:
+        observed = getattr(unwrapped, "observation_of_state", None)
+        if observed is not None:
+            rows = np.asarray(observed)
+            n = getattr(space, "n", None)
+            if (
+                rows.shape != (len(transitions),) or rows.dtype.kind not in "iu" or n is None
+                or getattr(space, "start", 0) != 0 or rows.min() < 0 or rows.max() >= n
+            ):  # fmt: skip
+                return f"{env.id!r}: its observation_of_state does not map its states onto its observations"
+        elif getattr(space, "n", None) != len(transitions) or getattr(space, "start", 0) != 0:
             return f"{env.id!r}: its observations are not the states of its transition table"
         model = TabularModel.from_transitions(transitions, initial, int(made.action_space.n))
         success = _pays_only_success(model)
+        if observed is not None:
+            where = "env.unwrapped.P, observed in groups of states (observation_of_state)"
+            return EnvModel(
+                model, rows.astype(np.int64), horizon, limit, where, success, aggregates=True
+            )
         return EnvModel(
             model, np.arange(model.n_states), horizon, limit, "env.unwrapped.P", success
         )

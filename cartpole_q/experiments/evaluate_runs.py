@@ -391,5 +391,7 @@ def policy_values(
             "env.unwrapped.P: FrozenLake, Taxi, CliffWalking, the book's worlds; or "
             "Blackjack's rules)."
         )
-    values = {int(row): float(value) for row, value in zip(truth.rows, truth.values, strict=True)}
+    values = {
+        int(state): float(value) for state, value in zip(truth.states, truth.values, strict=True)
+    }
     return PolicyValues(env_id, dict(config.env.kwargs), policy, gamma, values)

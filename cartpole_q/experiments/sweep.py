@@ -438,9 +438,11 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     One line per point (the mean of its seeds' ``V`` on the measured states, a 95% bootstrap
     interval over seeds), the evaluated policy's true values, and the values every run
     started from (``agent.q_init``, when the points share it): Sutton & Barto Example 6.2's
-    left panel.
+    left panel. The x axis is the world's true state (:attr:`Truth.states`): where the world
+    aggregates states, each state shows ``V`` of its group (Figures 9.1, 9.2), a staircase.
+    With ``figure.distribution`` the on-policy distribution is shaded on a second axis.
     """
-    from cartpole_q.engines.base import prediction_truth
+    from cartpole_q.engines.base import prediction_distribution, prediction_truth
     from cartpole_q.envs.gym import inspect_env
 
     figure = spec.figure
@@ -460,7 +462,11 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
             f"figure.metric: values draws V beside the true values, but {first.env.id} has no "
             "model to compute them from (a world with a transition table has one)."
         )
-    states = [float(row) for row in truth.rows]
+    states = [float(state) for state in truth.states]
+    second = None
+    if figure.distribution:
+        mu = prediction_distribution(first, info)
+        second = ("on-policy distribution mu (shaded, right axis)", states, mu)
     rng = np.random.default_rng(0)
     lines = []
     starts = {point.config.agent.q_init for point in spec.points}
@@ -475,7 +481,7 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     lines.append(("true values", states, truth.values, truth.values, truth.values))
     drawn = summary_line_figure(
         lines, "state", figure.y_label or "estimated value", figure.title or spec.name,
-        figure.log_y, (figure.y_min, figure.y_max),
+        figure.log_y, (figure.y_min, figure.y_max), second,
     )  # fmt: skip
     return write_figure(out, drawn)
 

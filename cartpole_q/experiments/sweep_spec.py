@@ -54,6 +54,7 @@ class Point:
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "log_x", "title", "y_label", "offset", "scale",
     "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
+    "distribution",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -108,6 +109,10 @@ class FigureSpec:
     bootstrap interval over seeds (S&B Fig. 12.10); ``None``: learning curves"""
     first: int | None = None
     """with ``against``: the episodes averaged (default: all)"""
+    distribution: bool = False
+    """with ``values``: also draw the evaluated policy's on-policy distribution ``mu`` (the
+    fraction of time steps spent in each state, from the world's model) on a second y axis
+    (Sutton & Barto Figure 9.1)"""
 
     def to_dict(self) -> dict[str, Any]:
         """The section as the resolved ``sweep.yaml`` holds it (every key)."""
@@ -321,6 +326,11 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             )
     if problem is not None:
         raise ConfigError(f"{where}: figure.metric: {shown_value(metric)} is {problem}.")
+    if values.get("distribution") and metric != VALUES_FIGURE:
+        raise ConfigError(
+            f"{where}: figure.distribution: draws the on-policy distribution beside the values "
+            "of the states; it needs metric: values."
+        )
     for key, allowed in choices.items():
         if key in values and values[key] not in allowed:
             raise ConfigError(
@@ -332,6 +342,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
         "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),
+        "distribution": (bool,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)

@@ -88,6 +88,7 @@ for _profile in (
     cartpole.PROFILE, mountaincar.PROFILE, acrobot.PROFILE, toy_text.FROZENLAKE,
     toy_text.TAXI, toy_text.CLIFFWALKING, toy_text.BLACKJACK, book.WINDY_GRIDWORLD,
     book.KINGS_WINDY_GRIDWORLD, book.DYNA_MAZE, book.MAXIMIZATION_BIAS, book.RANDOM_WALK,
-    book.ONE_STATE, planning.GRIDWORLDS, planning.GAMBLER, planning.CAR_RENTAL,
+    book.RANDOM_WALK_1000, book.ONE_STATE, planning.GRIDWORLDS, planning.GAMBLER,
+    planning.CAR_RENTAL,
 ):  # fmt: skip
     register_profile(_profile)

@@ -1,7 +1,8 @@
 """Sutton & Barto's worlds (:mod:`cartpole_q.worlds`).
 
-The windy gridworlds, the Dyna mazes, the maximization-bias MDP and the 19-state random
-walk. Each has a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
+The windy gridworlds, the Dyna mazes, the maximization-bias MDP, the 5- and 19-state
+random walks and the 1000-state walk (Example 9.1; observed in groups of states with
+``env.kwargs.groups``, its policy has no map). Each has a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
 exactly; the grid worlds and the walk draw their policy maps as grids. The maps are read
 from the environment (``env.unwrapped``), so a changed argument (``stay``, ``change_at``)
 shows.
@@ -120,4 +121,15 @@ RANDOM_WALK = EnvProfile(
     grid=random_walk_grid,
     model="transition_table",
     twin="cartpole_q.envs.twins.transition_table",
+)
+
+RANDOM_WALK_1000 = EnvProfile(
+    name="RandomWalk1000",
+    description="Example 9.1's walk of 1000 states, jumps of up to 100 either way, -1 and +1 "
+    "ends; env.kwargs.groups aggregates the states (Figures 9.1, 9.2)",
+    ids=("cartpole_q/RandomWalk1000-v0",),
+    entry_points=("cartpole_q.worlds.random_walk:JumpingWalkEnv",),
+    action_names=("left", "right"),
+    model="transition_table",
+    twin="cartpole_q.envs.twins.aggregated_table",
 )

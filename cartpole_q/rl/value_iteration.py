@@ -238,6 +238,40 @@ def evaluate_policy(
     return values
 
 
+def on_policy_distribution(model: TabularModel, pi: np.ndarray, states: np.ndarray) -> np.ndarray:
+    """The on-policy distribution ``mu`` of an episodic task (Sutton & Barto 9.2, eq. 9.2-9.3).
+
+    ``eta(s) = h(s) + sum over s' of eta(s') * P_pi(s', s)``, the expected visits to ``s``
+    in an episode (``h`` the start distribution, ``P_pi`` the continuing, undiscounted
+    transitions), solved on ``states`` (closed under the policy's continuing outcomes, as
+    :func:`reachable_states` are), then ``mu = eta / sum(eta)``: the fraction of the time
+    steps spent in each state. On the 5-state walk the middle is visited most:
+
+    >>> P = {s: {a: [(1.0, s + (1 if a else -1), 0.0, s + (1 if a else -1) in (0, 6))]
+    ...          for a in (0, 1)} for s in range(1, 6)}
+    >>> P = {s: (P.get(s) or {a: [(1.0, s, 0.0, True)] for a in (0, 1)}) for s in range(7)}
+    >>> model = TabularModel.from_transitions(P, initial=[0, 0, 0, 1, 0, 0, 0])
+    >>> mu = on_policy_distribution(model, np.full((7, 2), 0.5), np.arange(1, 6))
+    >>> [round(float(m) * 9, 12) for m in mu]
+    [1.0, 2.0, 3.0, 2.0, 1.0]
+
+    Returns:
+        ``mu`` on ``states``, in order (float64, summing to 1).
+
+    Raises:
+        ValueError: the policy may never end an episode from one of ``states``.
+    """
+    chosen = np.asarray(states, dtype=np.int64)
+    stuck = _never_ending(model, pi, chosen)
+    if stuck is not None:
+        raise ValueError(f"from state {stuck} the policy may never end an episode")
+    _, matrix = model.stochastic_policy_matrix(np.asarray(pi, dtype=np.float64))
+    system = np.eye(len(chosen)) - matrix[np.ix_(chosen, chosen)]
+    visits: np.ndarray = np.linalg.solve(system.T, model.initial[chosen])
+    distribution: np.ndarray = visits / visits.sum()
+    return distribution
+
+
 def _never_ending(model: TabularModel, pi: np.ndarray, states: np.ndarray) -> int | None:
     """A state of ``states`` from which no outcome of positive probability ends the episode."""
     weight = pi[model.state, model.action] * model.probability

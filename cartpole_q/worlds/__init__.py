@@ -13,6 +13,7 @@ id                                         world
 ``cartpole_q/OneState-v0``                 Example 5.5, Figure 5.4 (:mod:`~cartpole_q.worlds.one_state`)
 ``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.worlds.random_walk`)
 ``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
+``cartpole_q/RandomWalk1000-v0``           Example 9.1, Figures 9.1, 9.2: 1000 states, jumps of up to 100 (``groups``: state aggregation)
 =========================================  ==================================================
 
 The worlds of dynamic programming (chapters 3-4, ``cartpole-q dp``), :data:`PLANNING_WORLDS`:
@@ -36,8 +37,10 @@ too: Gymnasium imports the module before the ``:``.
 **Time limits.** The book gives none; the tool needs episodes to end (a greedy policy can
 walk in circles), so each id has a generous one, far above what any episode of the book's
 experiments takes: 10,000 steps in the grid worlds, 1,000 in the random walk (a random
-walk lasts 100 steps on average and more than 1,000 about once in 170,000 episodes). The
-maximization-bias world needs none: every episode ends within two steps.
+walk lasts 100 steps on average and more than 1,000 about once in 170,000 episodes), and
+10,000 in the 1000-state walk (83 steps on average; more than 1,000 about once in 2.3
+million episodes, more than 2,000 about once in 7 * 10^12). The maximization-bias world
+needs none: every episode ends within two steps.
 ``env.kwargs.max_episode_steps`` changes them.
 """
 
@@ -74,6 +77,9 @@ GRID_TIME_LIMIT = 10_000
 """steps before a grid world's episode is truncated"""
 WALK_TIME_LIMIT = 1_000
 """steps before a random walk's episode is truncated"""
+JUMPING_WALK_TIME_LIMIT = 10_000
+"""steps before an episode of the 1000-state walk is truncated (Figure 9.1 plays 100,000
+episodes: with 1,000 steps one of them might be cut)"""
 
 WORLDS: Sequence[World] = (
     World(f"{NAMESPACE}/WindyGridworld-v0", f"{_GRIDS}:WindyGridworldEnv", GRID_TIME_LIMIT),
@@ -98,6 +104,11 @@ WORLDS: Sequence[World] = (
     ),
     World(
         f"{NAMESPACE}/RandomWalk-v0", "cartpole_q.worlds.random_walk:RandomWalkEnv", WALK_TIME_LIMIT
+    ),
+    World(
+        f"{NAMESPACE}/RandomWalk1000-v0",
+        "cartpole_q.worlds.random_walk:JumpingWalkEnv",
+        JUMPING_WALK_TIME_LIMIT,
     ),
 )
 """every world this package registers, with :data:`PLANNING_WORLDS`"""

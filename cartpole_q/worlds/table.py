@@ -28,13 +28,19 @@ class TableWorld(gymnasium.Env[Any, Any]):
     """A world of ``n_states`` states and ``n_actions`` actions played from its table ``P``.
 
     Observations and actions are plain integers. Subclasses build ``P``; ``step`` reports the outcome's
-    probability in ``info["prob"]``, as the toy-text worlds do.
+    probability in ``info["prob"]``, as the toy-text worlds do. The observation is the state,
+    unless the world sets :attr:`observation_of_state` (state aggregation: the observation
+    is a group of states).
     """
 
     metadata = {"render_modes": [], "render_fps": 4}  # noqa: RUF012 - gymnasium.Env declares it
     plays_its_table = True
     """every step is one draw of ``P`` as it was when the environment was made; a compiled
     twin baked from ``P`` then plays it exactly (see ``envs/twins/transition_table.py``)"""
+    observation_of_state: np.ndarray | None = None
+    """int64, one per state of ``P``: the observation a state is seen as (``None``: the state
+    itself); a world that sets it aggregates states, and its compiled twin is
+    ``envs/twins/aggregated_table.py``"""
 
     def __init__(self, n_states: int, n_actions: int, start: int) -> None:
         self.observation_space = spaces.Discrete(n_states)
@@ -50,7 +56,7 @@ class TableWorld(gymnasium.Env[Any, Any]):
         """Start an episode: the start state, drawn as the toy-text worlds draw it."""
         super().reset(seed=seed)
         self.s = int(categorical_sample(self.initial_state_distrib, self.np_random))
-        return self.s, {"prob": 1.0}
+        return self.observe(self.s), {"prob": 1.0}
 
     def step(self, action: int) -> tuple[int, float, bool, bool, dict[str, Any]]:
         """Take ``action``: one outcome of ``P[s][action]``, drawn with ``np_random``."""
@@ -58,4 +64,10 @@ class TableWorld(gymnasium.Env[Any, Any]):
         chosen = int(categorical_sample([outcome[0] for outcome in outcomes], self.np_random))
         probability, following, reward, terminated = outcomes[chosen]
         self.s = following
-        return following, reward, terminated, False, {"prob": probability}
+        return self.observe(following), reward, terminated, False, {"prob": probability}
+
+    def observe(self, state: int) -> int:
+        """The observation of ``state``: the state, or its group where the world aggregates."""
+        if self.observation_of_state is None:
+            return state
+        return int(self.observation_of_state[state])

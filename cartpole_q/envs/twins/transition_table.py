@@ -153,8 +153,15 @@ def read_environment(
     return found
 
 
-def table_params(env: Any) -> tuple[np.ndarray, ...] | str:
-    """The arrays of :data:`PARAM_NAMES` of an unwrapped environment, or why there are none."""
+def table_params(env: Any, aggregated: bool = False) -> tuple[np.ndarray, ...] | str:
+    """The arrays of :data:`PARAM_NAMES` of an unwrapped environment, or why there are none.
+
+    Args:
+        env: the unwrapped environment.
+        aggregated: its observations are groups of states (``observation_of_state``), which
+            the caller checks (:mod:`~cartpole_q.envs.twins.aggregated_table`); else they
+            must be the states.
+    """
     if not getattr(env, "plays_its_table", True):
         return (
             "the environment does not play its transition table as made (its table changes "
@@ -166,7 +173,11 @@ def table_params(env: Any) -> tuple[np.ndarray, ...] | str:
         return "the environment has no transition table (P and initial_state_distrib)"
     n_states = len(transitions)
     space = env.observation_space
-    if getattr(space, "n", None) != n_states or getattr(space, "start", None) != 0:
+    if not aggregated and getattr(env, "observation_of_state", None) is not None:
+        return "the environment observes groups of states (observation_of_state)"
+    if not aggregated and (
+        getattr(space, "n", None) != n_states or getattr(space, "start", None) != 0
+    ):
         return "the environment's observations are not the states of its transition table"
     if sorted(transitions) != list(range(n_states)):
         return "the transition table's states are not 0, 1, ..., n - 1"
