@@ -449,3 +449,25 @@ def test_the_one_state_mdp_and_importance_sampling() -> None:
         load_config(overrides={**overrides, "agent.sampling": "ordinary"}), final_eval=False
     )
     assert ordinary.errors is not None and len(set(ordinary.errors.tolist())) > 20
+
+
+def test_blackjacks_named_policy_is_evaluated_exactly() -> None:
+    """optimum --policy stick_20: Figure 5.3's state (13, usable ace, dealer 2) is -0.2772.
+
+    The book gives -0.27726 from 100 million simulated episodes; the rules' exact value is
+    -0.277204. A natural 21 is a model state of its own (it wins unless the dealer has one).
+    A prediction run on Blackjack measures no error (the natural shares a row).
+    """
+    import json
+
+    shown = invoke("optimum", "Blackjack-v1", "--policy", "stick_20")
+    assert shown.exit_code == 0, shown.output
+    assert "  13 with a usable ace, dealer 2: -0.277204\n" in shown.stdout
+    assert "  a natural 21, dealer 5: 1\n" in shown.stdout
+    listed = json.loads(invoke("optimum", "Blackjack-v1", "--policy", "stick_20", "--json").stdout)
+    values = {int(state): value for state, value in listed["values"].items()}
+    assert values[(13 * 11 + 2) * 2 + 1] == pytest.approx(-0.27726, abs=1e-4)
+    config = load_config(
+        overrides={"env.id": "Blackjack-v1", "agent.algorithm": "td", "agent.policy": "stick_20"}
+    )
+    assert not prediction_truth(config, inspect_env(config)).measured

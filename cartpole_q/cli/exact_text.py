@@ -80,3 +80,24 @@ def policy_grid(
             cells.append(marks.get(state, arrows[policy[state]]))
         lines.append(" ".join(cells))
     return "\n".join(lines)
+
+
+def state_label(blackjack: bool, state: int) -> str:
+    """A model state as ``optimum --policy`` lists it: its number, Blackjack's in words.
+
+    Blackjack's model states are its table rows (player sum, dealer's card, usable ace, in C
+    order over (32, 11, 2)), then one natural 21 per dealer card (704 + card - 1).
+
+    >>> state_label(True, (13 * 11 + 2) * 2 + 1), state_label(True, 704), state_label(False, 7)
+    ('13 with a usable ace, dealer 2', 'a natural 21, dealer A', '7')
+    """
+    if not blackjack:
+        return str(state)
+    cards = ["A", *map(str, range(2, 11))]
+    rows = 32 * 11 * 2
+    if state >= rows:
+        return f"a natural 21, dealer {cards[state - rows]}"
+    player, rest = divmod(state, 11 * 2)
+    dealer, usable = divmod(rest, 2)
+    ace = "with a usable ace" if usable else "without a usable ace"
+    return f"{player} {ace}, dealer {cards[dealer - 1] if dealer else '0'}"

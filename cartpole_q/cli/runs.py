@@ -427,9 +427,10 @@ def optimum_command(
 ) -> None:
     """The best expected return from the start, by value iteration on the environment's model."""
     with exit_codes():
-        from cartpole_q.cli.exact_text import exact_lines, policy_grid
+        from cartpole_q.cli.exact_text import exact_lines, policy_grid, state_label
         from cartpole_q.config import parse_assignment
         from cartpole_q.experiments.evaluate_runs import optimum, policy_values
+        from cartpole_q.profiles import profile_for
 
         assignments = [parse_assignment(text) for text in set_values or []]
         if policy is not None:
@@ -439,8 +440,9 @@ def optimum_command(
                 return
             typer.echo(f"{env_id} {json.dumps(values.kwargs)}")
             typer.echo(f"values of the {policy} policy (gamma {values.gamma:g}), by state:")
+            blackjack = profile_for(env_id).model == "blackjack"
             for state, value in values.values.items():
-                typer.echo(f"  {state}: {value:.6g}")
+                typer.echo(f"  {state_label(blackjack, state)}: {value:.6g}")
             return
         found = optimum(env_id, assignments, gamma)
         if json_output:

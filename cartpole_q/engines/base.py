@@ -315,11 +315,24 @@ def named_policy(config: Config, env_info: EnvInfo) -> list[int] | None:
 
 def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     """:func:`prediction_truth`, solved (see there)."""
+    if profile_for(config.env.id).model == "blackjack":
+        return Truth.none()  # (Blackjack's naturals share a row with another state)
+    return exact_values(config, env_info, measure_shared_rows=False)
+
+
+def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = True) -> Truth:
+    """The evaluated policy's exact values on every reachable non-terminal model state.
+
+    As :func:`prediction_truth` (``cartpole-q optimum --policy`` prints them), but Blackjack's
+    too: its natural 21s are model states of their own, on the row of a 21 with a usable ace
+    (``measure_shared_rows``: keep such states; else nothing is measured where two states
+    share a row and the world does not aggregate by design).
+    """
     from cartpole_q.envs.models import EnvModel, env_model
 
     model = env_model(config.env, env_info.max_episode_steps)
-    if not isinstance(model, EnvModel) or profile_for(config.env.id).model == "blackjack":
-        return Truth.none()  # (Blackjack's naturals share a row with another state)
+    if not isinstance(model, EnvModel):
+        return Truth.none()
     tabular, row_of_state = model.model, model.row_of_state
     rows_pi = policy_table(
         MemoryContext(
@@ -340,7 +353,8 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     measured = ~tabular.terminal_states()[reachable]
     states = reachable[measured]
     rows = row_of_state[states]
-    if not model.aggregates and len(np.unique(rows)) != len(rows):
+    shared = len(np.unique(rows)) != len(rows)
+    if shared and not (model.aggregates or measure_shared_rows):
         return Truth.none()  # states observed alike by accident: no one value per row
     return Truth(
         rows.astype(np.int64), values[measured].astype(np.float64), states.astype(np.int64)
@@ -367,7 +381,7 @@ def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
     rows_pi = policy_table(
         MemoryContext(
             math.prod(env_info.state_shape), env_info.n_actions, 0.0,
-            dict(config.agent.params), 0,
+            dict(config.agent.params), 0, policy=named_policy(config, env_info),
         )
     )  # fmt: skip
     pi = rows_pi[model.row_of_state]

@@ -370,7 +370,7 @@ def policy_values(
             are not defined (it never ends an episode and ``gamma`` is 1).
         ConfigError: the id, an argument or the policy is unknown.
     """
-    from cartpole_q.engines.base import prediction_truth
+    from cartpole_q.engines.base import exact_values
     from cartpole_q.envs.gym import inspect_env
 
     overrides: dict[str, Any] = {"env.id": env_id}
@@ -382,7 +382,7 @@ def policy_values(
     config = load_config(overrides=overrides, override_source=COMMAND_LINE)
     info = inspect_env(config)
     try:
-        truth = prediction_truth(config, info)
+        truth = exact_values(config, info)
     except ValueError as error:
         raise UserError(f"{env_id}: the {policy} policy's values: {error}.") from None
     if not truth.measured:
