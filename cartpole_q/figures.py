@@ -22,7 +22,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
-from cartpole_q.learning_curves import aggregate_band, smooth
+from cartpole_q.learning_curves import AGGREGATE_NAMES, aggregate_band, smooth
 from cartpole_q.profiles import profile_for
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
@@ -347,7 +347,7 @@ def metric_curve_figure(
                 axes.plot(band.x, row, color=colour, alpha=0.12, linewidth=0.6)
                 record.line(f"{band.label}: {name}", band.x, row)
         axes.fill_between(band.x, band.low, band.high, color=colour, alpha=0.3, linewidth=0)
-        name = "mean" if band.aggregate == "mean" else "IQM"
+        name = AGGREGATE_NAMES[band.aggregate]
         axes.plot(band.x, band.centre, color=colour, linewidth=2.0,
                   label=f"{band.label}: {name} of {seeds} seeds, 95% CI")  # fmt: skip
         record.line(f"{band.label}: {name}", band.x, band.centre, band.low, band.high)

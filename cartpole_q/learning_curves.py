@@ -33,9 +33,12 @@ INFO_KEY_PATTERN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,63}$")
 digits or ``_``; at most 64 (it names a ``metrics.csv`` column and an array)"""
 X_AXES = ("episode", "env-steps")
 """what ``plot --x`` draws against: training episodes, or training env steps"""
-AGGREGATES = ("mean", "iqm")
-"""how the seeds are combined: the mean, or the interquartile mean (the mean of the middle
-50%, robust to a few outlying seeds)"""
+AGGREGATES = ("mean", "iqm", "mean_square")
+"""how the seeds are combined: the mean, the interquartile mean (the mean of the middle
+50%, robust to a few outlying seeds), or the mean of the squares (of a one-state error:
+the mean square error, S&B Figure 5.3)"""
+AGGREGATE_NAMES = {"mean": "mean", "iqm": "IQM", "mean_square": "mean square"}
+"""each aggregate as a legend says it"""
 STEP_POINTS = 400
 """points of the common env-steps grid"""
 
@@ -262,7 +265,7 @@ def aggregate_band(
 
     Args:
         curves: ``(seeds, points)``; NaN where a seed has no value.
-        aggregate: ``mean`` or ``iqm``.
+        aggregate: ``mean``, ``iqm`` or ``mean_square``.
         rng: Draws the resamples (seeds resampled with replacement).
         resamples: Bootstrap resamples (the IQM's are computed in chunks).
 
@@ -273,6 +276,8 @@ def aggregate_band(
     n_seeds = curves.shape[0]
     centre = statistic(curves)
     picks = rng.integers(0, n_seeds, size=(resamples, n_seeds))
+    if aggregate == "mean_square":  # the mean of the squares, resampled as a mean
+        return aggregate_band(curves * curves, "mean", rng, resamples)
     if aggregate == "mean":
         # A resample's mean is (how often each seed was picked) @ (the seeds' values).
         counts = np.zeros((resamples, n_seeds))
@@ -296,6 +301,8 @@ def _statistic(aggregate: str) -> Callable[[np.ndarray], np.ndarray]:
         return lambda curves: np.asarray(_nanmean(curves))
     if aggregate == "iqm":
         return lambda curves: interquartile_mean(curves, axis=0)
+    if aggregate == "mean_square":
+        return lambda curves: np.asarray(_nanmean(curves * curves))
     raise ValueError(f"unknown aggregate {aggregate!r}; one of {', '.join(AGGREGATES)}")
 
 

@@ -471,3 +471,37 @@ def test_blackjacks_named_policy_is_evaluated_exactly() -> None:
         overrides={"env.id": "Blackjack-v1", "agent.algorithm": "td", "agent.policy": "stick_20"}
     )
     assert not prediction_truth(config, inspect_env(config)).measured
+
+
+def test_blackjack_dealt_one_hand_measures_that_state() -> None:
+    """Example 5.4: every episode is 13 with a usable ace against a 2; its error alone."""
+    import gymnasium
+    from gymnasium.utils.env_checker import check_env
+
+    env = gymnasium.make("cartpole_q/BlackjackDealt-v0")
+    check_env(env.unwrapped)
+    starts = {env.reset(seed=seed)[0] for seed in range(20)}
+    assert starts == {(13, 2, 1)}
+    config = load_config(
+        overrides={
+            "env.id": "cartpole_q/BlackjackDealt-v0", "agent.algorithm": "off_policy_mc_prediction",
+            "agent.policy": "stick_20", "agent.sampling": "ordinary", "agent.visits": "first",
+            "agent.q_init": 0.0, "agent.gamma": 1.0, "train.episodes": 300, "seed": 1,
+        }
+    )  # fmt: skip
+    truth = prediction_truth(config, inspect_env(config))
+    assert truth.rows.tolist() == [(13 * 11 + 2) * 2 + 1]
+    assert truth.values[0] == pytest.approx(-0.277204, abs=1e-6)
+    result = train(config, final_eval=False)
+    assert result.errors is not None
+    v = result.v_table[13, 2, 1]
+    assert result.errors[-1] == pytest.approx(abs(v - truth.values[0]), abs=1e-15)
+
+
+def test_the_mean_square_aggregate_is_the_mean_of_squares() -> None:
+    from cartpole_q.learning_curves import aggregate_band
+
+    curves = np.array([[1.0, -2.0], [3.0, 0.0], [np.nan, 2.0]])
+    centre, low, high = aggregate_band(curves, "mean_square", np.random.default_rng(0))
+    assert centre.tolist() == [5.0, 8.0 / 3.0]  # (1 + 9) / 2 (a NaN is no seed); (4 + 0 + 4) / 3
+    assert (low <= centre).all() and (centre <= high).all()

@@ -200,7 +200,8 @@ def plot(
         str,
         typer.Option(
             metavar="AGG",
-            help="With --metric: combine seeds by their mean or iqm (interquartile mean).",
+            help="With --metric: combine seeds by their mean, iqm (interquartile mean) or "
+            "mean_square (the mean of their squares: a one-state error's mean square error).",
         ),
     ] = "mean",
     smooth: Annotated[

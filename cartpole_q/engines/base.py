@@ -276,9 +276,10 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     From the world's transition table, by
     :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
     ``agent.gamma``; each model state is measured on the table row it is observed as
-    (several on one row only where the world aggregates states by design: Blackjack's
-    naturals, which share a row by accident, are not measured). Nothing is measured for a
-    world without a model, or on tiles.
+    (several on one row only where the world aggregates states by design: where two share a
+    row by accident, as Blackjack's natural 21 and a 21 with a usable ace, nothing is
+    measured), or only the states the world names (Blackjack dealt one hand). Nothing is
+    measured for a world without a model, or on tiles.
     """
     tiled = config.discretization is not None and config.discretization.tilings > 1
     if tiled:
@@ -315,8 +316,6 @@ def named_policy(config: Config, env_info: EnvInfo) -> list[int] | None:
 
 def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     """:func:`prediction_truth`, solved (see there)."""
-    if profile_for(config.env.id).model == "blackjack":
-        return Truth.none()  # (Blackjack's naturals share a row with another state)
     return exact_values(config, env_info, measure_shared_rows=False)
 
 
@@ -351,6 +350,8 @@ def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = 
             "give agent.gamma below 1."
         ) from None
     measured = ~tabular.terminal_states()[reachable]
+    if model.measured is not None:  # the world measures these states only
+        measured &= np.isin(reachable, model.measured)
     states = reachable[measured]
     rows = row_of_state[states]
     shared = len(np.unique(rows)) != len(rows)

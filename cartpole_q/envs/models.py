@@ -17,7 +17,7 @@ says why there is none.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from typing import Any
 
@@ -51,6 +51,10 @@ class EnvModel:
     aggregates: bool = False
     """the world observes groups of states (its ``observation_of_state``: state aggregation),
     so several states share a row by design"""
+    measured: np.ndarray | None = None
+    """int64: the only model states a prediction run's error is measured on, where the world
+    says so (its ``measured_states``: Blackjack dealt one hand); ``None``: every reachable
+    non-terminal state"""
 
 
 def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | str:
@@ -76,7 +80,15 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
             if unsupported:
                 return f"env.kwargs key {unsupported[0]!r} is not in the Blackjack model"
             model, rows = blackjack_model(bool(unwrapped.sab), bool(unwrapped.natural))
-            return EnvModel(model, rows, horizon, limit, "the rules of Blackjack", False)
+            measured = getattr(unwrapped, "measured_states", None)
+            if measured is not None:  # dealt one hand (Example 5.4): it starts there
+                dealt = np.zeros(model.n_states)
+                dealt[list(measured)] = 1.0 / len(measured)
+                model = replace(model, initial=dealt)
+                measured = np.asarray(measured, dtype=np.int64)
+            return EnvModel(
+                model, rows, horizon, limit, "the rules of Blackjack", False, measured=measured
+            )
         transitions = getattr(unwrapped, "P", None)
         initial = getattr(unwrapped, "initial_state_distrib", None)
         if not isinstance(transitions, Mapping) or initial is None:
@@ -115,7 +127,10 @@ def _pays_only_success(model: TabularModel) -> bool:
     return bool(np.all(model.reward[paid] == 1.0) and np.all(model.terminated[paid]))
 
 
-_BLACKJACK_KWARGS = ("sab", "natural", "render_mode", "max_episode_steps")
+_BLACKJACK_KWARGS = (
+    "sab", "natural", "render_mode", "max_episode_steps", "player_sum", "usable_ace", "dealer",
+)  # fmt: skip
+"""what the rules' model covers (the last three: the hand ``BlackjackDealt-v0`` deals)"""
 _CARD_PROBABILITIES = {**{card: 1 / 13 for card in range(1, 10)}, 10: 4 / 13}
 BLACKJACK_SHAPE = (32, 11, 2)
 """the sizes of Blackjack-v1's observation components (player sum, dealer card, usable ace)"""

@@ -98,3 +98,16 @@ BLACKJACK = EnvProfile(
     twin="cartpole_q.envs.twins.blackjack",
     policies=MappingProxyType({"stick_20": stick_on_20}),
 )
+
+BLACKJACK_DEALT = EnvProfile(
+    name="BlackjackDealt",
+    description="Blackjack dealt one hand every episode, 13 with a usable ace against a 2 "
+    "(Sutton & Barto's Example 5.4)",
+    ids=("cartpole_q/BlackjackDealt-v0",),
+    entry_points=("cartpole_q.worlds.blackjack_dealt:BlackjackDealtEnv",),
+    observation_names=("player sum", "dealer card", "usable ace"),
+    action_names=("stick", "hit"),
+    policy_map="blackjack",
+    model="blackjack",
+    policies=MappingProxyType({"stick_20": stick_on_20}),
+)

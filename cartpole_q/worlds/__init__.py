@@ -27,6 +27,15 @@ id                                         world
 ``cartpole_q/Gambler-v0``                  Example 4.3, Figure 4.3 (:mod:`~cartpole_q.worlds.gambler`)
 =========================================  ==================================================
 
+Blackjack dealt one hand (chapter 5), :data:`BLACKJACK_WORLDS` (a ``Tuple`` observation,
+Gymnasium's ``Blackjack-v1`` after the deal; no transition table, a model from the rules):
+
+=========================================  ==================================================
+id                                         world
+=========================================  ==================================================
+``cartpole_q/BlackjackDealt-v0``           Example 5.4, Figure 5.3: 13 with a usable ace against a 2 (:mod:`~cartpole_q.worlds.blackjack_dealt`)
+=========================================  ==================================================
+
 **Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
 in 1.0), so the ids are registered by this package: importing ``cartpole_q`` (which the
 command line does) registers them as soon as Gymnasium is imported, before or after, and
@@ -113,6 +122,15 @@ WORLDS: Sequence[World] = (
 )
 """every world this package registers, with :data:`PLANNING_WORLDS`"""
 
+BLACKJACK_WORLDS: Sequence[World] = (
+    World(
+        f"{NAMESPACE}/BlackjackDealt-v0",
+        "cartpole_q.worlds.blackjack_dealt:BlackjackDealtEnv",
+        None,
+    ),
+)
+"""Blackjack dealt one hand: every episode ends within a few cards, as Blackjack-v1's"""
+
 PLANNING_TIME_LIMIT = 1_000
 """steps before an episode of the gridworlds or the car rental is truncated (Example 3.5's
 gridworld and the car rental never end; the 4 x 4 gridworld's random episodes take some
@@ -145,7 +163,7 @@ def register_worlds() -> None:
     """Register every world with Gymnasium (an id registered already is left as it is)."""
     import gymnasium
 
-    for world in (*WORLDS, *PLANNING_WORLDS):
+    for world in (*WORLDS, *PLANNING_WORLDS, *BLACKJACK_WORLDS):
         if world.id not in gymnasium.registry:
             gymnasium.register(
                 world.id,
