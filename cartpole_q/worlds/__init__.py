@@ -25,6 +25,14 @@ id                                         world
 ``cartpole_q/Gambler-v0``                  Example 4.3, Figure 4.3 (:mod:`~cartpole_q.worlds.gambler`)
 =========================================  ==================================================
 
+The bandit of chapter 2 (``cartpole-q bandit``), :data:`BANDIT_WORLDS`:
+
+=========================================  ==================================================
+id                                         world
+=========================================  ==================================================
+``cartpole_q/Bandit-v0``                   the 10-armed testbed, Figures 2.2-2.6 (:mod:`~cartpole_q.worlds.bandit`)
+=========================================  ==================================================
+
 **Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
 in 1.0), so the ids are registered by this package: importing ``cartpole_q`` (which the
 command line does) registers them as soon as Gymnasium is imported, before or after, and
@@ -128,11 +136,18 @@ the gambler's time limit is the grid worlds' 10,000 steps (with stakes of 1 an e
 be long)"""
 
 
+BANDIT_WORLDS: Sequence[World] = (
+    World(f"{NAMESPACE}/Bandit-v0", "cartpole_q.worlds.bandit:BanditEnv", None),
+)
+"""the k-armed testbed of chapter 2 (``cartpole-q bandit``); no time limit: a bandit's run
+is as long as the study makes it"""
+
+
 def register_worlds() -> None:
     """Register every world with Gymnasium (an id registered already is left as it is)."""
     import gymnasium
 
-    for world in (*WORLDS, *PLANNING_WORLDS):
+    for world in (*WORLDS, *PLANNING_WORLDS, *BANDIT_WORLDS):
         if world.id not in gymnasium.registry:
             gymnasium.register(
                 world.id,
