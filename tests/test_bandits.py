@@ -7,9 +7,14 @@ on the numba engine (the compiled twin) and on the gymnasium engine (``gymnasium
 
 from __future__ import annotations
 
+import csv
+from pathlib import Path
+from typing import Any
+
 import gymnasium
 import numpy as np
 import pytest
+import yaml
 from gymnasium.utils.env_checker import check_env
 
 import cartpole_q  # noqa: F401  (registers the worlds)
@@ -22,6 +27,7 @@ from cartpole_q.engines.bandit import (
 )
 from cartpole_q.envs.twins.bandit import ArmedTestbed, reset_testbed, step_testbed
 from cartpole_q.rl.bandits import RULES, BanditAgent
+from tests.conftest import REPO, invoke, write_yaml
 from tests.reference_bandits import Learner, reference_run
 
 STEPS = 150
@@ -140,3 +146,90 @@ def test_run_seeds_follow_the_package_convention() -> None:
     agent_seq, env_seq = np.random.SeedSequence(0).spawn(2)
     assert agent_rng.random() == np.random.Generator(np.random.PCG64(agent_seq)).random()
     assert env_seed == int(env_seq.generate_state(1, dtype=np.uint32)[0])
+
+
+# -- cartpole-q bandit --------------------------------------------------------------------------
+
+BOOK = REPO / "examples" / "book"
+
+
+def small_study(tmp_path: Path, name: str, **change: Any) -> Path:
+    """A shipped study file on few runs and steps (its curves, figure and book kept)."""
+    study = yaml.safe_load((BOOK / f"{name}.yaml").read_text(encoding="utf-8"))
+    study.update({"seeds": "0-19", "steps": 100})
+    for entry in study.get("book", []):
+        entry.pop("step", None)
+        entry.pop("steps", None)
+    study.update(change)
+    return write_yaml(tmp_path / f"{name}.yaml", study)
+
+
+def test_bandit_draws_a_figure_with_its_data_and_prints_the_books_numbers(tmp_path: Path) -> None:
+    out = tmp_path / "fig2_2.png"
+    path = small_study(tmp_path, "fig2_2_epsilon_greedy")
+    result = invoke("bandit", path, "--out", out)
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert lines[0].startswith("fig2_2_epsilon_greedy: 20 runs x 100 steps on the 10-armed")
+    assert any(line.startswith("  ε = 0.1, average reward at step 1,000: book ~1.35, ours ")
+               for line in lines)  # fmt: skip
+    assert lines[-1] == str(out) and out.read_bytes().startswith(b"\x89PNG")
+    rows = list(csv.DictReader((tmp_path / "fig2_2.csv").read_text(encoding="utf-8").splitlines()))
+    curve = [
+        row for row in rows if row["panel"] == "% Optimal action" and row["series"] == "ε = 0.1"
+    ]
+    assert [int(row["x"]) for row in curve] == list(range(1, 101))
+    # The plotted numbers are the engines' averages, exactly (20 runs: multiples of 5%).
+    expected = play_curve(agent_of(LEARNERS["epsilon 0.1"]), TESTBEDS["stationary"],
+                          list(range(20)), 100)  # fmt: skip
+    assert [float(row["y"]) for row in curve] == expected.optimal_percent.tolist()
+    # The gymnasium engine writes the same data.
+    other = tmp_path / "other.png"
+    assert invoke("bandit", path, "--out", other, "--engine", "gymnasium").exit_code == 0
+    assert (tmp_path / "other.csv").read_bytes() == (tmp_path / "fig2_2.csv").read_bytes()
+    again = invoke("bandit", path, "--out", out)
+    assert again.exit_code == 2 and "already exists; pass --force" in again.stderr
+    assert invoke("bandit", path, "--out", out, "--force").exit_code == 0
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"stesp": 10}, "unknown key 'stesp'; did you mean 'steps'?"),
+        ({"steps": 0}, "steps: must be a whole number >= 1"),
+        ({"seeds": "x"}, "seeds:"),
+        ({"testbed": {"k": 0}}, "testbed: k: must be a whole number >= 1"),
+        ({"testbed": {"walk": -1}}, "testbed.spread and testbed.walk must not be negative"),
+        ({"curves": []}, "curves: must be a list of learners"),
+        ({"curves": [{"method": "softmax"}]}, "curves[0].method: must be one of epsilon_greedy"),
+        ({"curves": [{"method": "ucb", "epsilon": 0.1}]}, "curves[0].epsilon: ucb takes no"),
+        ({"curves": [{"method": "gradient"}]}, "curves[0].alpha: the gradient bandit needs"),
+        ({"curves": [{"method": "epsilon_greedy", "epsilon": 2}]}, "epsilon must be in [0, 1]"),
+        ({"curves": [{"method": "epsilon_greedy", "alpha": 0}]}, "alpha: must be positive"),
+        ({"curves": [{"method": "ucb", "vary": "c", "values": [1]}]}, "only a parameter study"),
+        ({"figure": {"kind": "pie"}}, "figure.kind: must be one of curves, parameter_study"),
+        ({"figure": {"kind": "curves", "metrics": ["regret"]}}, "figure.metrics: a list of"),
+        ({"book": [{"label": "x", "value": 1, "curve": 7}]}, "book[0].curve: the curve's index"),
+        ({"book": [{"label": "x", "value": 1, "curve": 0, "step": 101}]}, "book[0].step: 101"),
+        ({"book": [{"label": "x", "value": 1, "curve": 0, "of": "peak"}]}, "book[0].of: must be"),
+    ],
+)
+def test_bandit_refuses_bad_study_files_with_exit_code_2(
+    tmp_path: Path, change: dict[str, Any], message: str
+) -> None:
+    path = small_study(tmp_path, "fig2_2_epsilon_greedy", **change)
+    result = invoke("bandit", path, "--out", tmp_path / "figure.png")
+    assert result.exit_code == 2, result.output
+    assert message in result.stderr, result.stderr
+    assert result.stderr.startswith(f"error: {path}") and "Traceback" not in result.stderr
+    assert not (tmp_path / "figure.png").exists()
+
+
+def test_bandit_refuses_a_missing_file_a_bad_out_and_a_bad_engine(tmp_path: Path) -> None:
+    result = invoke("bandit", tmp_path / "nope.yaml")
+    assert result.exit_code == 2 and "study file not found" in result.stderr
+    study = BOOK / "fig2_2_epsilon_greedy.yaml"
+    result = invoke("bandit", study, "--out", tmp_path / "f.txt")
+    assert result.exit_code == 2 and "--out cannot write files ending in .txt" in result.stderr
+    result = invoke("bandit", study, "--engine", "jax")
+    assert result.exit_code == 2 and "--engine: must be one of numba, gymnasium" in result.stderr
