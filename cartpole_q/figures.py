@@ -1418,7 +1418,7 @@ def step_curves_figure(
         axes.legend(loc="lower right", fontsize="small")
         axes.grid(alpha=0.3)
     axes_list[-1].set_xlabel("Steps")
-    figure.suptitle(title)
+    figure.suptitle(title, fontsize="medium")
     return figure
 
 

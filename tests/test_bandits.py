@@ -233,3 +233,56 @@ def test_bandit_refuses_a_missing_file_a_bad_out_and_a_bad_engine(tmp_path: Path
     assert result.exit_code == 2 and "--out cannot write files ending in .txt" in result.stderr
     result = invoke("bandit", study, "--engine", "jax")
     assert result.exit_code == 2 and "--engine: must be one of numba, gymnasium" in result.stderr
+
+
+# -- the book's figures ---------------------------------------------------------------------------
+
+BOOK_DATA = REPO / "docs" / "book"
+
+
+@pytest.mark.parametrize("study", sorted(BOOK.glob("fig2_*.yaml")), ids=lambda path: path.stem)
+def test_each_shipped_study_runs_on_few_runs(tmp_path: Path, study: Path) -> None:
+    data = yaml.safe_load(study.read_text(encoding="utf-8"))
+    assert data["seeds"] == "0-1999" and data["steps"] == 1000  # the book's 2,000 x 1,000
+    path = small_study(tmp_path, study.stem, seeds="0-1", steps=20)
+    out = tmp_path / "figure.png"
+    result = invoke("bandit", path, "--out", out)
+    assert result.exit_code == 0, result.output
+    assert out.is_file() and (tmp_path / "figure.csv").is_file()
+    assert (BOOK_DATA / data["figure"]["file"]).is_file()
+
+
+def curves_of(figure: str, panel: str) -> dict[str, list[float]]:
+    """The shipped data's curves of one panel, by series."""
+    text = (BOOK_DATA / f"{figure}.csv").read_text(encoding="utf-8").splitlines()
+    curves: dict[str, list[float]] = {}
+    for row in csv.DictReader(text):
+        if row["panel"] == panel:
+            curves.setdefault(row["series"], []).append(float(row["y"]))
+    return curves
+
+
+def from_step(upper: list[float], lower: list[float]) -> int:
+    """The step from which ``upper`` stays above ``lower`` to the end."""
+    below = [step for step, (a, b) in enumerate(zip(upper, lower, strict=True), 1) if a <= b]
+    return below[-1] + 1 if below else 1
+
+
+def test_the_shipped_figures_show_what_the_book_shows() -> None:
+    reward = curves_of("fig2_2_epsilon_greedy", "Average reward")
+    optimal = curves_of("fig2_2_epsilon_greedy", "% Optimal action")
+    assert 1.30 <= reward["ε = 0.1"][-1] <= 1.40 and 77 <= optimal["ε = 0.1"][-1] <= 83
+    assert (
+        0.95 <= reward["ε = 0 (greedy)"][-1] <= 1.10 and 32 <= optimal["ε = 0 (greedy)"][-1] <= 40
+    )
+    assert optimal["ε = 0.01"][999] > optimal["ε = 0.01"][499] > optimal["ε = 0 (greedy)"][-1]
+    optimistic = curves_of("fig2_3_optimistic", "% Optimal action")
+    upper, lower = optimistic.values()
+    assert from_step(upper, lower) <= 200 and upper[10] > 40  # the spike at step 11
+    ucb = curves_of("fig2_4_ucb", "Average reward")
+    assert from_step(ucb["UCB c = 2"], ucb["ε-greedy ε = 0.1"]) <= 60
+    gradient = curves_of("fig2_5_gradient", "% Optimal action")
+    for alpha in ("0.1", "0.4"):
+        with_baseline = gradient[f"\N{GREEK SMALL LETTER ALPHA} = {alpha}, with baseline"][499:]
+        without = gradient[f"\N{GREEK SMALL LETTER ALPHA} = {alpha}, without baseline"][499:]
+        assert min(a - b for a, b in zip(with_baseline, without, strict=True)) > 20

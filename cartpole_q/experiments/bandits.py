@@ -46,10 +46,11 @@ FIGURE_KINDS = ("curves", "parameter_study")
 FIGURE_KEYS = ("kind", "file", "title", "metrics")
 METRICS = {"average_reward": "Average reward", "optimal_percent": "% Optimal action"}
 """a curve's per-step metrics and their axis labels (the book's)"""
-BOOK_KEYS = ("label", "value", "curve", "of", "step", "steps")
+BOOK_KEYS = ("label", "value", "curve", "above", "of", "step", "steps")
 BOOK_OF = ("average_reward", "optimal_percent", "peak")
 """what a ``book`` entry compares: a metric at a step (or averaged over steps), or a
-parameter study line's best point"""
+parameter study line's best point; with ``above``, the book's claim that one curve lies above
+another over some steps (no value: ours is counted)"""
 ENGINES = ("numba", "gymnasium")
 
 
@@ -89,13 +90,16 @@ class BookNumber:
     """A number the book shows (read off its figure), compared with ours."""
 
     label: str
-    value: float
+    value: float | None
+    """``None``: a claim that ``curve`` lies above ``above``"""
     curve: int
     of: str
     steps: tuple[int, int]
     """the steps (1-based, inclusive) the metric is averaged over"""
     decimals: int
     """the decimals the book's value is given with (ours is printed with one more)"""
+    above: int | None = None
+    """the curve the book shows ``curve`` above (over ``steps``), or ``None``"""
 
 
 @dataclass(frozen=True)
@@ -362,14 +366,24 @@ def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) 
             f"{here}: must be a mapping {{label, value, curve, ...}}, got {shown_value(raw)}."
         )
     check_top_keys(raw, BOOK_KEYS, here)
-    label, value = raw.get("label"), raw.get("value")
-    if not isinstance(label, str) or isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigError(f"{here}: needs a label (text) and the book's value (a number).")
-    curve = raw.get("curve")
-    if isinstance(curve, bool) or not isinstance(curve, int) or not 0 <= curve < curves:
-        raise ConfigError(
-            f"{here}.curve: the curve's index in `curves` (0 to {curves - 1}), got {shown_value(curve)}."
-        )
+    label, value, above = raw.get("label"), raw.get("value"), raw.get("above")
+    if not isinstance(label, str):
+        raise ConfigError(f"{here}.label: must be text, got {shown_value(label)}.")
+    if above is None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+        raise ConfigError(f"{here}.value: the book's value, a number, got {shown_value(value)}.")
+    if above is not None and value is not None:
+        raise ConfigError(f"{here}: give the book's `value` or the curve it is `above`, not both.")
+    for key, given in (("curve", raw.get("curve")), ("above", above)):
+        if key == "above" and given is None:
+            continue
+        if isinstance(given, bool) or not isinstance(given, int) or not 0 <= given < curves:
+            raise ConfigError(
+                f"{here}.{key}: a curve's index in `curves` (0 to {curves - 1}), got "
+                f"{shown_value(given)}."
+            )
+    curve = raw["curve"]
+    if above is not None and kind == "parameter_study":
+        raise ConfigError(f"{here}.above: compares the curves of a curves figure.")
     of = raw.get("of", "average_reward")
     if of not in BOOK_OF or (of == "peak") != (kind == "parameter_study"):
         allowed = "peak" if kind == "parameter_study" else "average_reward, optimal_percent"
@@ -392,6 +406,8 @@ def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) 
         first = last = _whole(raw, "step", steps, here)
         if last > steps:
             raise ConfigError(f"{here}.step: {last}, but the runs have {steps} steps.")
+    if value is None:
+        return BookNumber(label, None, curve, str(of), (first, last), 0, above)
     text = repr(float(value))
     decimals = 0 if isinstance(value, int) or "e" in text else len(text.partition(".")[2])
     return BookNumber(label, float(value), curve, str(of), (first, last), decimals)
@@ -467,13 +483,36 @@ class BookRow:
         return f"{self.label}: book ~{book}, ours {ours} ({self.where})"
 
 
-def book_rows(study: Study, outcome: Outcome) -> list[BookRow]:
+@dataclass(frozen=True)
+class AboveRow:
+    """The book's claim that one curve lies above another, and how often ours does."""
+
+    label: str
+    steps: tuple[int, int]
+    above_count: int
+    """the steps where ours is strictly above"""
+    means: tuple[float, float]
+    """each curve's mean over the steps"""
+    from_step: int | None
+    """the step from which ours stays above to the last step (``None``: not above at the last)"""
+
+    def text(self) -> str:
+        """``UCB above epsilon-greedy: book above; ours above at 985 of 990 steps (...)``."""
+        first, last = self.steps
+        since = "" if self.from_step is None else f", and at every step from {self.from_step} on"
+        return (
+            f"{self.label}: book above; ours above at {self.above_count} of {last - first + 1} "
+            f"steps {first}-{last} (means {self.means[0]:.3f} and {self.means[1]:.3f}){since}"
+        )
+
+
+def book_rows(study: Study, outcome: Outcome) -> list[BookRow | AboveRow]:
     """The book's numbers beside ours."""
-    rows = []
+    rows: list[BookRow | AboveRow] = []
     points = study_points(study, outcome) if study.kind == "parameter_study" else []
     for number in study.book:
         curve = study.curves[number.curve]
-        if number.of == "peak":
+        if number.of == "peak" and number.value is not None:
             best = int(np.argmax(points[number.curve]))
             rows.append(BookRow(
                 number.label, number.value, float(points[number.curve][best]),
@@ -485,6 +524,15 @@ def book_rows(study: Study, outcome: Outcome) -> list[BookRow]:
         )
         first, last = number.steps
         ours = mean_over_steps(metric[number.curve][0], first, last)
+        if number.above is not None or number.value is None:
+            below = metric[number.above or 0][0]
+            count = int(np.sum(metric[number.curve][0][first - 1 : last] > below[first - 1 : last]))
+            means = (ours, mean_over_steps(below, first, last))
+            not_above = np.flatnonzero(~(metric[number.curve][0] > below))
+            since = int(not_above[-1]) + 2 if not_above.size else 1
+            from_step = None if since > study.steps else since
+            rows.append(AboveRow(number.label, number.steps, count, means, from_step))
+            continue
         span = f"step {first}" if first == last else f"mean over steps {first}-{last}"
         rows.append(BookRow(number.label, number.value, ours, span, number.decimals))
     return rows
