@@ -1446,7 +1446,7 @@ def _power_label(value: float) -> str:
 
 def parameter_study_figure(lines: Sequence[ParameterLine], y_label: str, title: str) -> DataFigure:
     """Figure 2.6: each method's measure against its parameter, the x axis in powers of 2."""
-    figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
+    figure = DataFigure(figsize=(8.0, 5.2), dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
     names = {"epsilon": "ε", "alpha": ALPHA, "c": "c", "q_init": "Q₀"}
@@ -1461,7 +1461,7 @@ def parameter_study_figure(lines: Sequence[ParameterLine], y_label: str, title: 
     axes.set_xticks(ticks, [_power_label(t) for t in ticks])
     axes.set_xlabel(f"ε   {ALPHA}   c   Q₀")
     axes.set_ylabel(y_label)
-    axes.legend(loc="lower center", fontsize="small")
+    axes.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize="small")
     axes.grid(alpha=0.3)
     axes.set_title(title)
     return figure

@@ -286,3 +286,38 @@ def test_the_shipped_figures_show_what_the_book_shows() -> None:
         with_baseline = gradient[f"\N{GREEK SMALL LETTER ALPHA} = {alpha}, with baseline"][499:]
         without = gradient[f"\N{GREEK SMALL LETTER ALPHA} = {alpha}, without baseline"][499:]
         assert min(a - b for a, b in zip(with_baseline, without, strict=True)) > 20
+
+
+def test_the_shipped_parameter_study_shows_inverted_us_and_ucb_best() -> None:
+    lines = curves_of("fig2_6_parameter_study", "")
+    assert len(lines) == 4
+    for label, points in lines.items():
+        peak = points.index(max(points))
+        assert 0 < peak < len(points) - 1, label  # an inverted U: the best value inside
+    best = {label: max(points) for label, points in lines.items()}
+    assert max(best, key=best.__getitem__).startswith("UCB") and 1.44 <= best["UCB (c)"] <= 1.52
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_study_within_seconds_with_exit_code_130(tmp_path: Path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "figure.png"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "cartpole_q", "bandit", str(BOOK / "fig2_6_parameter_study.yaml"),
+         "--out", str(out), "--engine", "gymnasium"],
+        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    time.sleep(4.0)
+    process.send_signal(signal.SIGINT)
+    sent = time.monotonic()
+    _, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130, stderr
+    assert time.monotonic() - sent < 5.0
+    assert b"interrupted" in stderr and b"Traceback" not in stderr
+    assert not out.exists()

@@ -590,7 +590,7 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
             for curve, points in zip(study.curves, study_points(study, outcome), strict=True)
         ]
         return figures.parameter_study_figure(
-            lines, f"Average reward over first {study.steps} steps", study.title
+            lines, f"Average reward over first {study.steps:,} steps", study.title
         )
     panels = []
     for metric in study.metrics:
