@@ -209,9 +209,15 @@ def test_bandit_draws_a_figure_with_its_data_and_prints_the_books_numbers(tmp_pa
         ({"curves": [{"method": "ucb", "vary": "c", "values": [1]}]}, "only a parameter study"),
         ({"figure": {"kind": "pie"}}, "figure.kind: must be one of curves, parameter_study"),
         ({"figure": {"kind": "curves", "metrics": ["regret"]}}, "figure.metrics: a list of"),
-        ({"book": [{"label": "x", "value": 1, "curve": 7}]}, "book[0].curve: the curve's index"),
+        (
+            {"book": [{"label": "x", "value": 1, "curve": 7}]},
+            "book[0].curve: a curve's index in `curves` (0 to 2), got 7",
+        ),
         ({"book": [{"label": "x", "value": 1, "curve": 0, "step": 101}]}, "book[0].step: 101"),
         ({"book": [{"label": "x", "value": 1, "curve": 0, "of": "peak"}]}, "book[0].of: must be"),
+        ({"book": [{"label": "x", "curve": 0, "above": 3}]}, "book[0].above: a curve's index"),
+        ({"book": [{"label": "x", "curve": 0, "above": 1, "value": 2}]}, "not both"),
+        ({"book": [{"label": "x", "curve": 0}]}, "book[0].value: the book's value, a number"),
     ],
 )
 def test_bandit_refuses_bad_study_files_with_exit_code_2(
@@ -319,5 +325,9 @@ def test_ctrl_c_stops_a_study_within_seconds_with_exit_code_130(tmp_path: Path) 
     _, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr
     assert time.monotonic() - sent < 5.0
-    assert b"interrupted" in stderr and b"Traceback" not in stderr
+    assert (
+        b"stopping after the current run" in stderr
+        and b"interrupted: nothing was written" in stderr
+    )
+    assert b"Traceback" not in stderr
     assert not out.exists()

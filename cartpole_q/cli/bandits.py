@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from cartpole_q.cli.base import Command, app, exit_codes
+from cartpole_q.cli.base import Command, app, exit_codes, exit_interrupted
 
 
 @app.command("bandit", cls=Command)
@@ -54,7 +54,22 @@ def bandit_command(
         study = bandits.load_study(study_file)
         path = out or bandits.default_out(study)
         bandits.check_outputs(path, force)
-        outcome = bandits.run_study(study, engine)
+        from cartpole_q.engines.bandit import compile_notice
+
+        notice = compile_notice(engine)
+        if notice is not None:
+            typer.echo(notice, err=True)
+        from cartpole_q.experiments.run import StopRequest
+
+        def announce(message: str) -> None:
+            signal = message.partition(":")[0]
+            typer.echo(f"{signal}: stopping after the current run (send it again to stop at once)",
+                       err=True)  # fmt: skip
+
+        with StopRequest(announce) as stop:
+            outcome = bandits.run_study(study, engine, stop.is_set)
+        if outcome is None:
+            exit_interrupted("interrupted: nothing was written; run it again to draw the figure")
         for line in bandits.summary(study, outcome):
             typer.echo(line)
         rows = bandits.book_rows(study, outcome)

@@ -26,6 +26,7 @@ divided by the number of runs; % optimal is ``100.0 * count / runs``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,6 +67,18 @@ def _play_run(
 
 
 _compiled: dict[str, Any] = {}
+
+LOOP_NAMES = {"numba": ("bandit_play_run",), "gymnasium": ("bandit_choose", "bandit_learn")}
+"""the compiled functions each engine runs, by their cache names"""
+
+
+def compile_notice(engine: str) -> str | None:
+    """A sentence when ``engine``'s functions are not compiled yet (the first run), else ``None``."""
+    from cartpole_q.numba_cache import is_cached
+
+    if all(is_cached(name) for name in LOOP_NAMES[engine]):
+        return None
+    return f"compiling the bandit loop ({engine} engine): once per machine and version, a few seconds..."
 
 
 def _function(name: str, template: Any) -> Any:
@@ -139,14 +152,21 @@ def play_curve(
     steps: int,
     engine: str = "numba",
     keep_runs: bool = False,
-) -> CurveResult:
-    """Play one run per seed, in order, and average each step over the runs."""
+    stop: Callable[[], bool] | None = None,
+) -> CurveResult | None:
+    """Play one run per seed, in order, and average each step over the runs.
+
+    ``stop`` is asked before each run; when it says so, nothing more is played and the
+    result is ``None``.
+    """
     reward_total = np.zeros(steps)
     optimal_count = np.zeros(steps, dtype=np.int64)
     kept_rewards = np.empty((len(seeds), steps)) if keep_runs else None
     kept_optimal = np.empty((len(seeds), steps), dtype=np.bool_) if keep_runs else None
     env = make_env(testbed) if engine == "gymnasium" else None
     for index, seed in enumerate(seeds):
+        if stop is not None and stop():
+            return None
         if engine == "gymnasium":
             rewards, optimal = play_run_gymnasium(agent, testbed, seed, steps, env)
         else:

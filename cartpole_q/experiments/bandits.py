@@ -26,7 +26,7 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
 from cartpole_q.experiments.sweep_spec import check_top_keys, checked_name, safe_name
-from cartpole_q.rl.bandits import GRADIENT, RULES, BanditAgent
+from cartpole_q.rl.bandits import RULES, BanditAgent
 
 STUDY_KEYS = ("name", "testbed", "seeds", "steps", "curves", "figure", "book")
 """the keys a study file may have"""
@@ -414,11 +414,12 @@ def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) 
 
 
 def run_study(
-    study: Study,
-    engine: str = "numba",
-    progress: Callable[[str], None] | None = None,
-) -> Outcome:
-    """Play every curve's learners, one run per seed each."""
+    study: Study, engine: str = "numba", stop: Callable[[], bool] | None = None
+) -> Outcome | None:
+    """Play every curve's learners, one run per seed each.
+
+    ``stop`` is asked before every run; when it says so the study ends, returning ``None``.
+    """
     import time
 
     from cartpole_q.engines.bandit import play_curve
@@ -431,22 +432,13 @@ def run_study(
     for curve in study.curves:
         results = []
         for agent in curve.agents():
-            results.append(play_curve(agent, testbed, seeds, study.steps, engine))
-            if progress is not None:
-                progress(f"{curve.label}: {_agent_text(agent)} done")
+            result = play_curve(agent, testbed, seeds, study.steps, engine, stop=stop)
+            if result is None:
+                return None
+            results.append(result)
         rewards.append(np.array([result.average_reward for result in results]))
         optimal.append(np.array([result.optimal_percent for result in results]))
     return Outcome(rewards, optimal, engine, time.perf_counter() - start)
-
-
-def _agent_text(agent: BanditAgent) -> str:
-    parts = {
-        0: f"epsilon {agent.epsilon:g}",
-        1: f"c {agent.c:g}",
-        GRADIENT: f"baseline {'on' if agent.baseline else 'off'}",
-    }[agent.rule]
-    alpha = "sample averages" if agent.alpha == 0.0 else f"alpha {agent.alpha:g}"
-    return f"{parts}, {alpha}, q_init {agent.q_init:g}"
 
 
 def mean_over_steps(curve: np.ndarray, first: int = 1, last: int | None = None) -> float:
