@@ -65,7 +65,7 @@ def test_the_testbed_is_registered_and_passes_check_env() -> None:
     check_env(env.unwrapped)
     assert env.action_space == gymnasium.spaces.Discrete(10)
     assert env.observation_space == gymnasium.spaces.Discrete(1)
-    assert env.spec is not None and env.spec.max_episode_steps is None
+    assert env.spec is not None and env.spec.max_episode_steps == 1000  # the book's runs
 
 
 def test_reset_draws_the_true_values_in_arm_order_from_the_envs_generator() -> None:
@@ -122,6 +122,20 @@ def test_the_walk_and_other_arm_counts_equal_the_rederivation(testbed_name: str)
             got = play(agent_of(learner), testbed, 5, STEPS)
             assert got[0].tobytes() == np.array(rewards).tobytes()
             assert got[1].tobytes() == np.array(optimal).tobytes()
+
+
+def test_a_run_longer_than_the_registered_time_limit_plays_on() -> None:
+    agent, testbed = agent_of(LEARNERS["ucb c 2"]), TESTBEDS["walk"]
+    numba_run = play_run_numba(agent, testbed, 3, 1_200)
+    gymnasium_run = play_run_gymnasium(agent, testbed, 3, 1_200)
+    assert numba_run[0].tobytes() == gymnasium_run[0].tobytes()
+    assert numba_run[1].tobytes() == gymnasium_run[1].tobytes()
+
+
+def test_bad_testbed_arguments_are_refused_by_the_environment() -> None:
+    for kwargs in ({"k": 0}, {"spread": -1.0}, {"walk": float("nan")}, {"mean": "4"}):
+        with pytest.raises(ValueError, match="must be"):
+            gymnasium.make("cartpole_q/Bandit-v0", **kwargs)
 
 
 def test_a_curve_averages_each_step_over_the_runs_in_seed_order() -> None:

@@ -104,7 +104,7 @@ def play_run_gymnasium(
 ) -> tuple[np.ndarray, np.ndarray]:
     """One run on ``gymnasium.make(BANDIT_ID, ...)`` (or ``env``, made so): as :func:`play_run_numba`."""
     if env is None:
-        env = make_env(testbed)
+        env = make_env(testbed, steps)
     agent_rng, env_seed = run_generators(seed)
     choose_arm, learn_from = _function("bandit_choose", choose), _function("bandit_learn", learn)
     env.reset(seed=env_seed)
@@ -120,15 +120,19 @@ def play_run_gymnasium(
     return rewards, optimal
 
 
-def make_env(testbed: ArmedTestbed) -> Any:
-    """``gymnasium.make("cartpole_q/Bandit-v0")`` with the testbed's arguments."""
+def make_env(testbed: ArmedTestbed, steps: int | None = None) -> Any:
+    """``gymnasium.make("cartpole_q/Bandit-v0")`` with the testbed's arguments.
+
+    ``steps``: the run's length as its time limit (else the registered 1,000).
+    """
     import gymnasium
 
     import cartpole_q.worlds  # noqa: F401  (the ids are registered with the package)
 
     return gymnasium.make(
-        BANDIT_ID, k=testbed.k, mean=testbed.mean, spread=testbed.spread, walk=testbed.walk
-    )
+        BANDIT_ID, max_episode_steps=steps, k=testbed.k, mean=testbed.mean,
+        spread=testbed.spread, walk=testbed.walk,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -163,7 +167,7 @@ def play_curve(
     optimal_count = np.zeros(steps, dtype=np.int64)
     kept_rewards = np.empty((len(seeds), steps)) if keep_runs else None
     kept_optimal = np.empty((len(seeds), steps), dtype=np.bool_) if keep_runs else None
-    env = make_env(testbed) if engine == "gymnasium" else None
+    env = make_env(testbed, steps) if engine == "gymnasium" else None
     for index, seed in enumerate(seeds):
         if stop is not None and stop():
             return None

@@ -136,11 +136,14 @@ the gambler's time limit is the grid worlds' 10,000 steps (with stakes of 1 an e
 be long)"""
 
 
+BANDIT_TIME_LIMIT = 1_000
+"""steps before a bandit's episode is truncated: the book's run length (the testbed never
+ends an episode itself; ``cartpole-q bandit`` makes it with its study's ``steps``)"""
+
 BANDIT_WORLDS: Sequence[World] = (
-    World(f"{NAMESPACE}/Bandit-v0", "cartpole_q.worlds.bandit:BanditEnv", None),
+    World(f"{NAMESPACE}/Bandit-v0", "cartpole_q.worlds.bandit:BanditEnv", BANDIT_TIME_LIMIT),
 )
-"""the k-armed testbed of chapter 2 (``cartpole-q bandit``); no time limit: a bandit's run
-is as long as the study makes it"""
+"""the k-armed testbed of chapter 2 (``cartpole-q bandit``)"""
 
 
 def register_worlds() -> None:

@@ -18,7 +18,8 @@ scalar ``np_random.normal(loc, scale)``:
 ``info["optimal"]`` says whether the arm played has the largest true value at that step
 (before the step's walk; ties: every arm with the largest value is optimal);
 ``info["q_star"]`` is a copy of the true values it was played against. The observation is
-always 0; an episode never ends (the experiments step a run as long as they need).
+always 0; the testbed never ends an episode itself (registered with the book's 1,000 steps as
+its time limit; ``cartpole-q bandit`` makes it with its study's ``steps``).
 A compiled twin that draws the same numbers from a generator seeded the same way is
 :mod:`cartpole_q.envs.twins.bandit`.
 
