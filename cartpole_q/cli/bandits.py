@@ -45,7 +45,9 @@ def bandit_command(
     """Play the k-armed testbed; draw the figure, print the book's numbers beside ours."""
     with exit_codes():
         from cartpole_q.config import ConfigError
+        from cartpole_q.engines.bandit import compile_notice
         from cartpole_q.experiments import bandits
+        from cartpole_q.experiments.run import StopRequest
 
         if engine not in bandits.ENGINES:
             raise ConfigError(
@@ -54,12 +56,9 @@ def bandit_command(
         study = bandits.load_study(study_file)
         path = out or bandits.default_out(study)
         bandits.check_outputs(path, force)
-        from cartpole_q.engines.bandit import compile_notice
-
         notice = compile_notice(engine)
         if notice is not None:
             typer.echo(notice, err=True)
-        from cartpole_q.experiments.run import StopRequest
 
         def announce(message: str) -> None:
             signal = message.partition(":")[0]

@@ -283,7 +283,7 @@ def _curve(raw: Any, index: int, where: str) -> Curve:
         if any(v <= 0 for v in numbers):
             raise ConfigError(f"{here}.values: must be positive (the axis is log2).")
         for number in numbers:
-            _check_range(str(vary), number, str(method), f"{here}.values")
+            _check_range(str(vary), number, f"{here}.values")
     elif values is not None:
         raise ConfigError(f"{here}.values: give `vary` too (the parameter the values are of).")
     else:
@@ -292,14 +292,15 @@ def _curve(raw: Any, index: int, where: str) -> Curve:
         raise ConfigError(f"{here}.alpha: the gradient bandit needs a step size.")
     for key, number in settings.items():
         if key in PARAMETERS and isinstance(number, float):
-            _check_range(key, number, str(method), f"{here}.{key}")
+            _check_range(key, number, f"{here}.{key}")
     label = raw.get("label", _default_label(str(method), settings))
     if not isinstance(label, str) or not label:
         raise ConfigError(f"{here}.label: must be text, got {shown_value(label)}.")
     return Curve(label, str(method), settings, None if vary is None else str(vary), numbers)
 
 
-def _check_range(key: str, value: float, method: str, where: str) -> None:
+def _check_range(key: str, value: float, where: str) -> None:
+    """Refuse a parameter outside its range (epsilon in [0, 1], c and alpha not negative)."""
     if key == "epsilon" and not 0.0 <= value <= 1.0:
         raise ConfigError(f"{where}: epsilon must be in [0, 1], got {value:g}.")
     if key == "c" and value < 0.0:
