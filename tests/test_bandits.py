@@ -360,3 +360,33 @@ def test_ctrl_c_stops_a_study_within_seconds_with_exit_code_130(tmp_path: Path) 
     )
     assert b"Traceback" not in stderr
     assert not out.exists()
+
+
+def test_a_study_reads_fractions_defaults_and_sample_averages(tmp_path: Path) -> None:
+    from cartpole_q.experiments.bandits import load_study
+
+    path = write_yaml(
+        tmp_path / "study.yaml",
+        {
+            "seeds": "0-9",
+            "curves": [
+                {"method": "ucb", "vary": "c", "values": ["1/16", 0.5, "2"]},
+                {"method": "epsilon_greedy", "alpha": "sample_average", "vary": "epsilon",
+                 "values": ["1/128", "1e-2"]},
+                {"method": "gradient", "baseline": True, "vary": "alpha", "values": [0.25]},
+            ],
+            "figure": {"kind": "parameter_study"},
+        },
+    )  # fmt: skip
+    study = load_study(path)
+    assert study.name == "study" and study.steps == 1000 and study.testbed == (10, 0.0, 1.0, 0.0)
+    assert study.seeds == tuple(range(10)) and study.file == "study.png"
+    assert [curve.values for curve in study.curves] == [
+        (0.0625, 0.5, 2.0),
+        (0.0078125, 0.01),
+        (0.25,),
+    ]
+    ucb, greedy, gradient = (curve.agents() for curve in study.curves)
+    assert [agent.c for agent in ucb] == [0.0625, 0.5, 2.0] and ucb[0].alpha == 0.0
+    assert [agent.epsilon for agent in greedy] == [0.0078125, 0.01]
+    assert gradient[0].alpha == 0.25 and gradient[0].baseline
