@@ -36,6 +36,14 @@ id                                         world
 ``cartpole_q/BlackjackDealt-v0``           Example 5.4, Figure 5.3: 13 with a usable ace against a 2 (:mod:`~cartpole_q.worlds.blackjack_dealt`)
 =========================================  ==================================================
 
+The bandit of chapter 2 (``cartpole-q bandit``), :data:`BANDIT_WORLDS`:
+
+=========================================  ==================================================
+id                                         world
+=========================================  ==================================================
+``cartpole_q/Bandit-v0``                   the 10-armed testbed, Figures 2.2-2.6 (:mod:`~cartpole_q.worlds.bandit`)
+=========================================  ==================================================
+
 **Registration.** Gymnasium 1.x has no plug-in entry points any more (they were removed
 in 1.0), so the ids are registered by this package: importing ``cartpole_q`` (which the
 command line does) registers them as soon as Gymnasium is imported, before or after, and
@@ -159,11 +167,21 @@ the gambler's time limit is the grid worlds' 10,000 steps (with stakes of 1 an e
 be long)"""
 
 
+BANDIT_TIME_LIMIT = 1_000
+"""steps before a bandit's episode is truncated: the book's run length (the testbed never
+ends an episode itself; ``cartpole-q bandit`` makes it with its study's ``steps``)"""
+
+BANDIT_WORLDS: Sequence[World] = (
+    World(f"{NAMESPACE}/Bandit-v0", "cartpole_q.worlds.bandit:BanditEnv", BANDIT_TIME_LIMIT),
+)
+"""the k-armed testbed of chapter 2 (``cartpole-q bandit``)"""
+
+
 def register_worlds() -> None:
     """Register every world with Gymnasium (an id registered already is left as it is)."""
     import gymnasium
 
-    for world in (*WORLDS, *PLANNING_WORLDS, *BLACKJACK_WORLDS):
+    for world in (*WORLDS, *PLANNING_WORLDS, *BLACKJACK_WORLDS, *BANDIT_WORLDS):
         if world.id not in gymnasium.registry:
             gymnasium.register(
                 world.id,

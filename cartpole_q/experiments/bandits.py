@@ -1,0 +1,613 @@
+"""Bandit studies (``cartpole-q bandit``): a study file, its curves, its figure.
+
+A study file names the testbed (``cartpole_q/Bandit-v0``'s ``k``, ``mean``, ``spread``,
+``walk``), the runs (``seeds``: one run per seed) and their ``steps``, the learners to
+compare (``curves``: a method and its parameters; a parameter study varies one parameter
+over ``values``), the figure and the book's numbers to print beside ours. :func:`run_study`
+plays every curve (:mod:`cartpole_q.engines.bandit`); :func:`write_study` draws the figure
+with its data beside it (``<figure>.csv``).
+
+Figure kinds: ``curves`` (Figures 2.2-2.5: each step's average reward and/or % optimal
+action, averaged over the runs) and ``parameter_study`` (Figure 2.6: the average reward over
+all the steps against each method's parameter, on a log2 axis).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
+from cartpole_q.experiments.sweep_spec import check_top_keys, checked_name, safe_name
+from cartpole_q.rl.bandits import RULES, BanditAgent
+
+STUDY_KEYS = ("name", "testbed", "seeds", "steps", "curves", "figure", "book")
+"""the keys a study file may have"""
+TESTBED_KEYS = ("k", "mean", "spread", "walk")
+CURVE_KEYS = (
+    "label", "method", "epsilon", "c", "alpha", "q_init", "baseline", "vary", "values",
+)  # fmt: skip
+PARAMETERS = ("epsilon", "c", "alpha", "q_init")
+"""the parameters a curve sets (and a parameter study varies)"""
+METHOD_PARAMETERS = {
+    "epsilon_greedy": ("epsilon", "alpha", "q_init"),
+    "ucb": ("c", "alpha", "q_init"),
+    "gradient": ("alpha", "baseline"),
+}
+"""the keys each method takes (``alpha`` of a value method: a number or ``sample_average``)"""
+FIGURE_KINDS = ("curves", "parameter_study")
+FIGURE_KEYS = ("kind", "file", "title", "metrics")
+METRICS = {"average_reward": "Average reward", "optimal_percent": "% Optimal action"}
+"""a curve's per-step metrics and their axis labels (the book's)"""
+BOOK_KEYS = ("label", "value", "curve", "above", "of", "step", "steps")
+BOOK_OF = ("average_reward", "optimal_percent", "peak")
+"""what a ``book`` entry compares: a metric at a step (or averaged over steps), or a
+parameter study line's best point; with ``above``, the book's claim that one curve lies above
+another over some steps (no value: ours is counted)"""
+ENGINES = ("numba", "gymnasium")
+
+
+@dataclass(frozen=True)
+class Curve:
+    """One learner of a study (a parameter study: one line, one learner per value)."""
+
+    label: str
+    method: str
+    settings: Mapping[str, float | bool]
+    """its fixed parameters (``alpha`` 0.0: sample averages)"""
+    vary: str | None
+    """the parameter a parameter study varies, or ``None``"""
+    values: tuple[float, ...]
+    """the values it takes"""
+
+    def agents(self) -> list[BanditAgent]:
+        """The learners this curve plays: one, or one per value of the varied parameter."""
+        settings = [dict(self.settings)]
+        if self.vary is not None:
+            settings = [{**self.settings, self.vary: value} for value in self.values]
+        return [
+            BanditAgent(
+                RULES[self.method],
+                float(given.get("epsilon", 0.0)),
+                float(given.get("c", 0.0)),
+                float(given.get("alpha", 0.0)),
+                float(given.get("q_init", 0.0)),
+                bool(given.get("baseline", False)),
+            )
+            for given in settings
+        ]
+
+
+@dataclass(frozen=True)
+class BookNumber:
+    """A number the book shows (read off its figure), compared with ours."""
+
+    label: str
+    value: float | None
+    """``None``: a claim that ``curve`` lies above ``above``"""
+    curve: int
+    of: str
+    steps: tuple[int, int]
+    """the steps (1-based, inclusive) the metric is averaged over"""
+    decimals: int
+    """the decimals the book's value is given with (ours is printed with one more)"""
+    above: int | None = None
+    """the curve the book shows ``curve`` above (over ``steps``), or ``None``"""
+
+
+@dataclass(frozen=True)
+class Study:
+    """A checked study file."""
+
+    name: str
+    testbed: tuple[int, float, float, float]
+    """``(k, mean, spread, walk)``"""
+    seeds: tuple[int, ...]
+    steps: int
+    curves: tuple[Curve, ...]
+    kind: str
+    file: str
+    title: str
+    metrics: tuple[str, ...]
+    book: tuple[BookNumber, ...]
+    where: str
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a study measured: per curve, per learner, each step's two metrics."""
+
+    average_reward: list[np.ndarray]
+    """per curve: ``(learners, steps)``"""
+    optimal_percent: list[np.ndarray]
+    """per curve: ``(learners, steps)``"""
+    engine: str
+    seconds: float
+
+
+def _number(value: Any, where: str) -> float:
+    """A number, also as YAML strings such as ``1e-3`` or the book's axis labels ``1/128``."""
+    if isinstance(value, str):
+        text = value.strip()
+        with contextlib.suppress(ValueError):
+            value = float(text)
+        fraction = re.fullmatch(r"(\d+(?:\.\d+)?)\s*/\s*(\d+(?:\.\d+)?)", text)
+        if fraction and float(fraction[2]) != 0:
+            value = float(fraction[1]) / float(fraction[2])
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ConfigError(
+            f"{where}: must be a number (such as 0.1 or 1/128), got {shown_value(value)}."
+        )
+    return float(value)
+
+
+def _whole(raw: Mapping[str, Any], key: str, default: int, where: str, least: int = 1) -> int:
+    value = raw.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ConfigError(
+            f"{where}: {key}: must be a whole number >= {least}, got {shown_value(value)}."
+        )
+    return value
+
+
+def load_study(path: Path) -> Study:
+    """Read and check a study file.
+
+    Raises:
+        ConfigError: naming the file and the key, with what is wrong.
+    """
+    raw = read_yaml_mapping(path, "study file")
+    where = str(path)
+    if not raw:
+        raise ConfigError(
+            f"{where}: is empty; a study file gives `seeds`, `steps`, `curves` and `figure` "
+            "(see examples/book/fig2_2_epsilon_greedy.yaml)."
+        )
+    check_top_keys(raw, STUDY_KEYS, where)
+    name = checked_name(raw, safe_name(path.stem), where)
+    testbed_raw = raw.get("testbed", {})
+    if not isinstance(testbed_raw, Mapping):
+        raise ConfigError(
+            f"{where}: testbed: must be a mapping such as {{k: 10, mean: 0}}, got "
+            f"{shown_value(testbed_raw)}."
+        )
+    check_top_keys(testbed_raw, TESTBED_KEYS, f"{where}: testbed")
+    k = _whole(testbed_raw, "k", 10, f"{where}: testbed")
+    mean, spread, walk = (
+        _number(testbed_raw.get(key, default), f"{where}: testbed.{key}")
+        for key, default in (("mean", 0.0), ("spread", 1.0), ("walk", 0.0))
+    )
+    if spread < 0 or walk < 0:
+        raise ConfigError(f"{where}: testbed.spread and testbed.walk must not be negative.")
+    if "seeds" not in raw:
+        raise ConfigError(f"{where}: seeds: is missing; one run per seed, such as 0-1999.")
+    try:
+        seeds = parse_seeds(raw["seeds"])
+    except ValueError as error:
+        raise ConfigError(f"{where}: seeds: {error}") from None
+    steps = _whole(raw, "steps", 1000, where)
+    curves_raw = raw.get("curves")
+    if not isinstance(curves_raw, list) or not curves_raw:
+        raise ConfigError(
+            f"{where}: curves: must be a list of learners such as {{method: epsilon_greedy, "
+            f"epsilon: 0.1}}, got {shown_value(curves_raw)}."
+        )
+    curves = tuple(_curve(entry, index, where) for index, entry in enumerate(curves_raw))
+    kind, file, title, metrics = _figure(raw.get("figure"), name, where)
+    varied = [curve.vary is not None for curve in curves]
+    if kind == "parameter_study" and not all(varied):
+        index = varied.index(False)
+        raise ConfigError(
+            f"{where}: curves[{index}]: a parameter study's curve varies a parameter: give "
+            "`vary` (epsilon, c, alpha or q_init) and its `values`."
+        )
+    if kind == "curves" and any(varied):
+        index = varied.index(True)
+        raise ConfigError(
+            f"{where}: curves[{index}].vary: only a parameter study varies a parameter "
+            "(figure.kind: parameter_study)."
+        )
+    book = tuple(
+        _book(entry, index, len(curves), steps, kind, where)
+        for index, entry in enumerate(_list(raw, "book", where))
+    )
+    return Study(
+        name, (k, mean, spread, walk), seeds, steps, curves, kind, file, title, metrics, book,
+        where,
+    )  # fmt: skip
+
+
+def _list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:
+    value = raw.get(key, [])
+    if not isinstance(value, list):
+        raise ConfigError(f"{where}: {key}: must be a list, got {shown_value(value)}.")
+    return value
+
+
+def _curve(raw: Any, index: int, where: str) -> Curve:
+    here = f"{where}: curves[{index}]"
+    if not isinstance(raw, Mapping):
+        raise ConfigError(f"{here}: must be a mapping {{method, ...}}, got {shown_value(raw)}.")
+    check_top_keys(raw, CURVE_KEYS, here)
+    method = raw.get("method")
+    if method not in METHOD_PARAMETERS:
+        raise ConfigError(
+            f"{here}.method: must be one of {', '.join(METHOD_PARAMETERS)}, got {shown_value(method)}."
+        )
+    allowed = METHOD_PARAMETERS[str(method)]
+    for key in (*PARAMETERS, "baseline"):
+        if key in raw and key not in allowed:
+            raise ConfigError(
+                f"{here}.{key}: {method} takes no {key} (it takes {', '.join(allowed)})."
+            )
+    settings: dict[str, float | bool] = {}
+    for key in ("epsilon", "c", "q_init"):
+        if key in raw:
+            settings[key] = _number(raw[key], f"{here}.{key}")
+    if "alpha" in raw:
+        if raw["alpha"] == "sample_average" and method != "gradient":
+            settings["alpha"] = 0.0
+        else:
+            settings["alpha"] = _number(raw["alpha"], f"{here}.alpha")
+            if settings["alpha"] <= 0:
+                raise ConfigError(
+                    f"{here}.alpha: must be positive (a constant step size)"
+                    + ("" if method == "gradient" else ", or sample_average")
+                    + f", got {settings['alpha']:g}."
+                )
+    if "baseline" in raw:
+        if not isinstance(raw["baseline"], bool):
+            raise ConfigError(f"{here}.baseline: must be true or false.")
+        settings["baseline"] = raw["baseline"]
+    vary, values = raw.get("vary"), raw.get("values")
+    if vary is not None:
+        if vary not in allowed or vary == "baseline":
+            raise ConfigError(
+                f"{here}.vary: {method} can vary {', '.join(p for p in allowed if p != 'baseline')}, "
+                f"got {shown_value(vary)}."
+            )
+        if vary in raw:
+            raise ConfigError(f"{here}: {vary} is both set and varied; give it only in `values`.")
+        if not isinstance(values, list) or not values:
+            raise ConfigError(
+                f"{here}.values: the values of {vary}, a list, got {shown_value(values)}."
+            )
+        numbers = tuple(_number(v, f"{here}.values[{i}]") for i, v in enumerate(values))
+        if any(v <= 0 for v in numbers):
+            raise ConfigError(f"{here}.values: must be positive (the axis is log2).")
+        for number in numbers:
+            _check_range(str(vary), number, f"{here}.values")
+    elif values is not None:
+        raise ConfigError(f"{here}.values: give `vary` too (the parameter the values are of).")
+    else:
+        numbers = ()
+    if method == "gradient" and "alpha" not in settings and vary != "alpha":
+        raise ConfigError(f"{here}.alpha: the gradient bandit needs a step size.")
+    for key, number in settings.items():
+        if key in PARAMETERS and isinstance(number, float):
+            _check_range(key, number, f"{here}.{key}")
+    label = raw.get("label", _default_label(str(method), settings))
+    if not isinstance(label, str) or not label:
+        raise ConfigError(f"{here}.label: must be text, got {shown_value(label)}.")
+    return Curve(label, str(method), settings, None if vary is None else str(vary), numbers)
+
+
+def _check_range(key: str, value: float, where: str) -> None:
+    """Refuse a parameter outside its range (epsilon in [0, 1], c and alpha not negative)."""
+    if key == "epsilon" and not 0.0 <= value <= 1.0:
+        raise ConfigError(f"{where}: epsilon must be in [0, 1], got {value:g}.")
+    if key == "c" and value < 0.0:
+        raise ConfigError(f"{where}: c must not be negative, got {value:g}.")
+    if key == "alpha" and value < 0.0:
+        raise ConfigError(f"{where}: alpha must be positive, got {value:g}.")
+
+
+def _default_label(method: str, settings: Mapping[str, float | bool]) -> str:
+    shown = ", ".join(
+        f"{key} {value:g}" for key, value in settings.items() if not isinstance(value, bool)
+    )
+    if settings.get("baseline"):
+        shown += ", with baseline"
+    return f"{method} ({shown})" if shown else method
+
+
+def _figure(raw: Any, name: str, where: str) -> tuple[str, str, str, tuple[str, ...]]:
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            f"{where}: figure: must be a mapping such as {{kind: curves, file: {name}.png}}, got "
+            f"{shown_value(raw)}."
+        )
+    check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
+    kind = raw.get("kind")
+    if kind not in FIGURE_KINDS:
+        raise ConfigError(
+            f"{where}: figure.kind: must be one of {', '.join(FIGURE_KINDS)}, got {shown_value(kind)}."
+        )
+    file = raw.get("file", f"{name}.png")
+    if (
+        not isinstance(file, str)
+        or "/" in file
+        or Path(file).suffix.lower() not in (".png", ".svg", ".pdf")
+    ):
+        raise ConfigError(
+            f"{where}: figure.file: must be a file name ending in .png, .svg or .pdf, got "
+            f"{shown_value(file)}."
+        )
+    title = raw.get("title", name)
+    if not isinstance(title, str):
+        raise ConfigError(f"{where}: figure.title: must be text, got {shown_value(title)}.")
+    metrics = raw.get("metrics", list(METRICS) if kind == "curves" else ["average_reward"])
+    if (
+        not isinstance(metrics, list)
+        or not metrics
+        or any(metric not in METRICS for metric in metrics)
+        or len(set(metrics)) != len(metrics)
+    ):
+        raise ConfigError(
+            f"{where}: figure.metrics: a list of {', '.join(METRICS)}, got {shown_value(metrics)}."
+        )
+    if kind == "parameter_study" and metrics != ["average_reward"]:
+        raise ConfigError(
+            f"{where}: figure.metrics: a parameter study draws the average reward (Figure 2.6)."
+        )
+    return str(kind), file, title, tuple(metrics)
+
+
+def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) -> BookNumber:
+    here = f"{where}: book[{index}]"
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            f"{here}: must be a mapping {{label, value, curve, ...}}, got {shown_value(raw)}."
+        )
+    check_top_keys(raw, BOOK_KEYS, here)
+    label, value, above = raw.get("label"), raw.get("value"), raw.get("above")
+    if not isinstance(label, str):
+        raise ConfigError(f"{here}.label: must be text, got {shown_value(label)}.")
+    if above is None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+        raise ConfigError(f"{here}.value: the book's value, a number, got {shown_value(value)}.")
+    if above is not None and value is not None:
+        raise ConfigError(f"{here}: give the book's `value` or the curve it is `above`, not both.")
+    for key, given in (("curve", raw.get("curve")), ("above", above)):
+        if key == "above" and given is None:
+            continue
+        if isinstance(given, bool) or not isinstance(given, int) or not 0 <= given < curves:
+            raise ConfigError(
+                f"{here}.{key}: a curve's index in `curves` (0 to {curves - 1}), got "
+                f"{shown_value(given)}."
+            )
+    curve = raw["curve"]
+    if above is not None and kind == "parameter_study":
+        raise ConfigError(f"{here}.above: compares the curves of a curves figure.")
+    of = raw.get("of", "average_reward")
+    if of not in BOOK_OF or (of == "peak") != (kind == "parameter_study"):
+        allowed = "peak" if kind == "parameter_study" else "average_reward, optimal_percent"
+        raise ConfigError(f"{here}.of: must be {allowed} for this figure, got {shown_value(of)}.")
+    if "step" in raw and "steps" in raw:
+        raise ConfigError(f"{here}: give `step` or `steps` ([first, last]), not both.")
+    if "steps" in raw:
+        span = raw["steps"]
+        if (
+            not isinstance(span, list)
+            or len(span) != 2
+            or not all(isinstance(s, int) and not isinstance(s, bool) for s in span)
+            or not 1 <= span[0] <= span[1] <= steps
+        ):
+            raise ConfigError(
+                f"{here}.steps: [first, last], 1 <= first <= last <= {steps}, got {shown_value(span)}."
+            )
+        first, last = span
+    else:
+        first = last = _whole(raw, "step", steps, here)
+        if last > steps:
+            raise ConfigError(f"{here}.step: {last}, but the runs have {steps} steps.")
+    if value is None:
+        return BookNumber(label, None, curve, str(of), (first, last), 0, above)
+    text = repr(float(value))
+    decimals = 0 if isinstance(value, int) or "e" in text else len(text.partition(".")[2])
+    return BookNumber(label, float(value), curve, str(of), (first, last), decimals)
+
+
+def run_study(
+    study: Study, engine: str = "numba", stop: Callable[[], bool] | None = None
+) -> Outcome | None:
+    """Play every curve's learners, one run per seed each.
+
+    ``stop`` is asked before every run; when it says so the study ends, returning ``None``.
+    """
+    import time
+
+    from cartpole_q.engines.bandit import play_curve
+    from cartpole_q.envs.twins.bandit import ArmedTestbed
+
+    start = time.perf_counter()
+    testbed = ArmedTestbed(*study.testbed)
+    seeds = list(study.seeds)
+    rewards, optimal = [], []
+    for curve in study.curves:
+        results = []
+        for agent in curve.agents():
+            result = play_curve(agent, testbed, seeds, study.steps, engine, stop=stop)
+            if result is None:
+                return None
+            results.append(result)
+        rewards.append(np.array([result.average_reward for result in results]))
+        optimal.append(np.array([result.optimal_percent for result in results]))
+    return Outcome(rewards, optimal, engine, time.perf_counter() - start)
+
+
+def mean_over_steps(curve: np.ndarray, first: int = 1, last: int | None = None) -> float:
+    """A curve's mean over steps ``first`` to ``last`` (1-based): summed in step order from 0.0."""
+    last = curve.shape[0] if last is None else last
+    total = 0.0
+    for value in curve[first - 1 : last].tolist():
+        total += value
+    return total / (last - first + 1)
+
+
+def study_points(study: Study, outcome: Outcome) -> list[np.ndarray]:
+    """A parameter study's points: per curve, each value's mean reward over all the steps."""
+    return [
+        np.array([mean_over_steps(row) for row in rewards]) for rewards in outcome.average_reward
+    ]
+
+
+@dataclass(frozen=True)
+class BookRow:
+    """One line of the comparison: the book's number (read off its figure) and ours."""
+
+    label: str
+    book: float
+    ours: float
+    where: str
+    """the step(s), or the parameter value, ours is taken at"""
+    decimals: int
+    """the book's value's decimals; ours is printed with one more"""
+
+    def text(self) -> str:
+        """``epsilon 0.1, average reward at step 1000: book ~1.35, ours 1.353 (step 1000)``."""
+        book, ours = f"{self.book:.{self.decimals}f}", f"{self.ours:.{self.decimals + 1}f}"
+        return f"{self.label}: book ~{book}, ours {ours} ({self.where})"
+
+
+@dataclass(frozen=True)
+class AboveRow:
+    """The book's claim that one curve lies above another, and how often ours does."""
+
+    label: str
+    steps: tuple[int, int]
+    above_count: int
+    """the steps where ours is strictly above"""
+    means: tuple[float, float]
+    """each curve's mean over the steps"""
+    from_step: int | None
+    """the step from which ours stays above to the last step (``None``: not above at the last)"""
+
+    def text(self) -> str:
+        """``UCB above epsilon-greedy: book above; ours above at 985 of 990 steps (...)``."""
+        first, last = self.steps
+        since = "" if self.from_step is None else f", and at every step from {self.from_step} on"
+        return (
+            f"{self.label}: book above; ours above at {self.above_count} of {last - first + 1} "
+            f"steps {first}-{last} (means {self.means[0]:.3f} and {self.means[1]:.3f}){since}"
+        )
+
+
+def book_rows(study: Study, outcome: Outcome) -> list[BookRow | AboveRow]:
+    """The book's numbers beside ours."""
+    rows: list[BookRow | AboveRow] = []
+    points = study_points(study, outcome) if study.kind == "parameter_study" else []
+    for number in study.book:
+        curve = study.curves[number.curve]
+        if number.of == "peak" and number.value is not None:
+            best = int(np.argmax(points[number.curve]))
+            rows.append(BookRow(
+                number.label, number.value, float(points[number.curve][best]),
+                f"its best, at {curve.vary} = {_fraction(curve.values[best])}", number.decimals,
+            ))  # fmt: skip
+            continue
+        metric = (
+            outcome.average_reward if number.of == "average_reward" else outcome.optimal_percent
+        )
+        first, last = number.steps
+        ours = mean_over_steps(metric[number.curve][0], first, last)
+        if number.above is not None or number.value is None:
+            below = metric[number.above or 0][0]
+            count = int(np.sum(metric[number.curve][0][first - 1 : last] > below[first - 1 : last]))
+            means = (ours, mean_over_steps(below, first, last))
+            not_above = np.flatnonzero(~(metric[number.curve][0] > below))
+            since = int(not_above[-1]) + 2 if not_above.size else 1
+            from_step = None if since > study.steps else since
+            rows.append(AboveRow(number.label, number.steps, count, means, from_step))
+            continue
+        span = f"step {first}" if first == last else f"mean over steps {first}-{last}"
+        rows.append(BookRow(number.label, number.value, ours, span, number.decimals))
+    return rows
+
+
+def _fraction(value: float) -> str:
+    """``0.0078125`` as ``1/128``, ``4.0`` as ``4``: the book's axis labels."""
+    if value >= 1 and float(value).is_integer():
+        return str(int(value))
+    inverse = 1.0 / value
+    if float(inverse).is_integer():
+        return f"1/{int(inverse)}"
+    return f"{value:g}"
+
+
+def summary(study: Study, outcome: Outcome) -> list[str]:
+    """Lines saying what ran and what each curve ended at."""
+    k, mean, spread, walk = study.testbed
+    testbed = f"{k}-armed testbed, q*(a) ~ N({mean:g}, {spread:g}^2)"
+    if walk > 0:
+        testbed += f", walking by N(0, {walk:g}^2) per step"
+    lines = [
+        f"{study.name}: {len(study.seeds)} runs x {study.steps} steps on the {testbed}, "
+        f"{outcome.engine} engine, {outcome.seconds:.1f} s"
+    ]
+    last = study.steps
+    first = max(1, last - 99)
+    if study.kind == "parameter_study":
+        for curve, points in zip(study.curves, study_points(study, outcome), strict=True):
+            shown = ", ".join(
+                f"{_fraction(v)}: {p:.3f}" for v, p in zip(curve.values, points, strict=True)
+            )
+            lines.append(f"  {curve.label} ({curve.vary}): {shown}")
+        return lines
+    for index, curve in enumerate(study.curves):
+        reward = outcome.average_reward[index][0]
+        optimal = outcome.optimal_percent[index][0]
+        lines.append(
+            f"  {curve.label}: step {last}: average reward {reward[-1]:.3f}, "
+            f"{optimal[-1]:.1f}% optimal; steps {first}-{last}: "
+            f"{mean_over_steps(reward, first, last):.3f}, "
+            f"{mean_over_steps(optimal, first, last):.1f}%"
+        )
+    return lines
+
+
+def study_figure(study: Study, outcome: Outcome) -> Any:
+    """The study's figure (a :class:`~cartpole_q.figures.DataFigure`)."""
+    from cartpole_q import figures
+
+    labels = [curve.label for curve in study.curves]
+    if study.kind == "parameter_study":
+        lines = [
+            figures.ParameterLine(curve.label, curve.vary or "", np.array(curve.values), points)
+            for curve, points in zip(study.curves, study_points(study, outcome), strict=True)
+        ]
+        return figures.parameter_study_figure(
+            lines, f"Average reward over first {study.steps:,} steps", study.title
+        )
+    panels = []
+    for metric in study.metrics:
+        values = outcome.average_reward if metric == "average_reward" else outcome.optimal_percent
+        panels.append(
+            (METRICS[metric], [(label, v[0]) for label, v in zip(labels, values, strict=True)])
+        )
+    return figures.step_curves_figure(panels, study.title)
+
+
+def write_study(study: Study, outcome: Outcome, out: Path) -> Path:
+    """Write the figure with its data (``<figure>.csv``) beside it."""
+    from cartpole_q.store.figure_file import write_figure
+
+    return write_figure(out, study_figure(study, outcome))
+
+
+def check_outputs(out: Path, force: bool) -> None:
+    """Refuse, before any work, outputs that exist (without ``force``) or cannot be written."""
+    from cartpole_q.store.figure_file import check_figure_file
+
+    check_figure_file(out, "--out", force)
+
+
+def default_out(study: Study) -> Path:
+    """The figure file when ``--out`` is not given: the study's ``figure.file`` here."""
+    return Path(study.file)
