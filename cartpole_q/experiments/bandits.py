@@ -25,7 +25,13 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
-from cartpole_q.experiments.sweep_spec import check_top_keys, checked_name, safe_name
+from cartpole_q.experiments.sweep_spec import (
+    check_top_keys,
+    checked_figure_section,
+    checked_list,
+    checked_name,
+    safe_name,
+)
 from cartpole_q.rl.bandits import RULES, BanditAgent
 
 STUDY_KEYS = ("name", "testbed", "seeds", "steps", "curves", "figure", "book")
@@ -216,19 +222,12 @@ def load_study(path: Path) -> Study:
         )
     book = tuple(
         _book(entry, index, len(curves), steps, kind, where)
-        for index, entry in enumerate(_list(raw, "book", where))
+        for index, entry in enumerate(checked_list(raw, "book", where))
     )
     return Study(
         name, (k, mean, spread, walk), seeds, steps, curves, kind, file, title, metrics, book,
         where,
     )  # fmt: skip
-
-
-def _list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:
-    value = raw.get(key, [])
-    if not isinstance(value, list):
-        raise ConfigError(f"{where}: {key}: must be a list, got {shown_value(value)}.")
-    return value
 
 
 def _curve(raw: Any, index: int, where: str) -> Curve:
@@ -319,30 +318,7 @@ def _default_label(method: str, settings: Mapping[str, float | bool]) -> str:
 
 
 def _figure(raw: Any, name: str, where: str) -> tuple[str, str, str, tuple[str, ...]]:
-    if not isinstance(raw, Mapping):
-        raise ConfigError(
-            f"{where}: figure: must be a mapping such as {{kind: curves, file: {name}.png}}, got "
-            f"{shown_value(raw)}."
-        )
-    check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
-    kind = raw.get("kind")
-    if kind not in FIGURE_KINDS:
-        raise ConfigError(
-            f"{where}: figure.kind: must be one of {', '.join(FIGURE_KINDS)}, got {shown_value(kind)}."
-        )
-    file = raw.get("file", f"{name}.png")
-    if (
-        not isinstance(file, str)
-        or "/" in file
-        or Path(file).suffix.lower() not in (".png", ".svg", ".pdf")
-    ):
-        raise ConfigError(
-            f"{where}: figure.file: must be a file name ending in .png, .svg or .pdf, got "
-            f"{shown_value(file)}."
-        )
-    title = raw.get("title", name)
-    if not isinstance(title, str):
-        raise ConfigError(f"{where}: figure.title: must be text, got {shown_value(title)}.")
+    kind, file, title = checked_figure_section(raw, name, where, FIGURE_KEYS, FIGURE_KINDS)
     metrics = raw.get("metrics", list(METRICS) if kind == "curves" else ["average_reward"])
     if (
         not isinstance(metrics, list)
@@ -357,7 +333,7 @@ def _figure(raw: Any, name: str, where: str) -> tuple[str, str, str, tuple[str, 
         raise ConfigError(
             f"{where}: figure.metrics: a parameter study draws the average reward (Figure 2.6)."
         )
-    return str(kind), file, title, tuple(metrics)
+    return kind, file, title, tuple(metrics)
 
 
 def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) -> BookNumber:

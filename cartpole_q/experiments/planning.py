@@ -20,7 +20,13 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, EnvConfig, load_config, read_yaml_mapping, shown_value
 from cartpole_q.envs.models import PlanningModel, planning_model
-from cartpole_q.experiments.sweep_spec import check_top_keys, checked_name, safe_name
+from cartpole_q.experiments.sweep_spec import (
+    check_top_keys,
+    checked_figure_section,
+    checked_list,
+    checked_name,
+    safe_name,
+)
 from cartpole_q.rl import dynamic_programming as dp
 
 STUDY_KEYS = (
@@ -217,7 +223,7 @@ def load_study(path: Path) -> Study:
         raise ConfigError(f"{where}: max_sweeps: must be at least 1.")
     figure = _figure(raw.get("figure"), name, where)
     book = tuple(
-        _book(entry, index, where) for index, entry in enumerate(_list(raw, "book", where))
+        _book(entry, index, where) for index, entry in enumerate(checked_list(raw, "book", where))
     )
     return Study(
         name, env, str(algorithm), gamma, policy, str(order), tolerance, max_sweeps,
@@ -225,36 +231,8 @@ def load_study(path: Path) -> Study:
     )  # fmt: skip
 
 
-def _list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:
-    value = raw.get(key, [])
-    if not isinstance(value, list):
-        raise ConfigError(f"{where}: {key}: must be a list, got {shown_value(value)}.")
-    return value
-
-
 def _figure(raw: Any, name: str, where: str) -> FigureSpec:
-    if not isinstance(raw, Mapping):
-        raise ConfigError(
-            f"{where}: figure: must be a mapping such as {{kind: grid, file: {name}.png}}, got "
-            f"{shown_value(raw)}."
-        )
-    check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
-    kind = raw.get("kind")
-    if kind not in FIGURE_KINDS:
-        raise ConfigError(
-            f"{where}: figure.kind: must be one of {', '.join(FIGURE_KINDS)}, got {shown_value(kind)}."
-        )
-    file = raw.get("file", f"{name}.png")
-    if (
-        not isinstance(file, str)
-        or "/" in file
-        or Path(file).suffix.lower() not in (".png", ".svg", ".pdf")
-    ):
-        raise ConfigError(
-            f"{where}: figure.file: must be a file name ending in .png, .svg or .pdf, got "
-            f"{shown_value(file)}."
-        )
-    title = raw.get("title", name)
+    kind, file, title = checked_figure_section(raw, name, where, FIGURE_KEYS, FIGURE_KINDS)
     show = raw.get("show", [])
     if not isinstance(show, list) or not all(
         isinstance(k, int) and not isinstance(k, bool) and k >= 0 for k in show
@@ -264,10 +242,12 @@ def _figure(raw: Any, name: str, where: str) -> FigureSpec:
             f"{shown_value(show)}."
         )
     greedy = raw.get("greedy", False)
-    if not isinstance(greedy, bool) or not isinstance(title, str):
-        raise ConfigError(f"{where}: figure.greedy must be true or false, figure.title a string.")
+    if not isinstance(greedy, bool):
+        raise ConfigError(
+            f"{where}: figure.greedy: must be true or false, got {shown_value(greedy)}."
+        )
     decimals = _integer(raw, "decimals", 1, f"{where}: figure") or 0
-    return FigureSpec(str(kind), file, title, tuple(show), greedy, decimals)
+    return FigureSpec(kind, file, title, tuple(show), greedy, decimals)
 
 
 def _book(raw: Any, index: int, where: str) -> BookNumber:

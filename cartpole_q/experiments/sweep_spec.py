@@ -525,3 +525,58 @@ def _expand(
         config = load_config(base, overrides, source=label, override_source=label)
         points.append(Point(index, values, config))
     return tuple(points)
+
+
+def checked_list(raw: Mapping[str, Any], key: str, where: str) -> list[Any]:
+    """A study file's ``key``: a list (empty when left out).
+
+    Raises:
+        ConfigError: it is there and not a list.
+    """
+    value = raw.get(key, [])
+    if not isinstance(value, list):
+        raise ConfigError(f"{where}: {key}: must be a list, got {shown_value(value)}.")
+    return value
+
+
+def checked_figure_section(
+    raw: Any, name: str, where: str, keys: Sequence[str], kinds: Sequence[str]
+) -> tuple[str, str, str]:
+    """A study file's ``figure`` section's common keys: its ``kind``, ``file`` and ``title``.
+
+    Args:
+        raw: the section as read.
+        name: the study's name (the default file is ``<name>.png``, the default title it).
+        where: the file, for messages.
+        keys: every key the section may hold.
+        kinds: the ``kind`` values it takes (the first is the example in messages).
+
+    Raises:
+        ConfigError: naming the key: not a mapping, an unknown key or kind, a file that is
+            not a bare ``.png``, ``.svg`` or ``.pdf`` name, a title that is not text.
+    """
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            f"{where}: figure: must be a mapping such as {{kind: {kinds[0]}, file: {name}.png}}, "
+            f"got {shown_value(raw)}."
+        )
+    check_top_keys(raw, tuple(keys), f"{where}: figure")
+    kind = raw.get("kind")
+    if kind not in kinds:
+        raise ConfigError(
+            f"{where}: figure.kind: must be one of {', '.join(kinds)}, got {shown_value(kind)}."
+        )
+    file = raw.get("file", f"{name}.png")
+    if (
+        not isinstance(file, str)
+        or "/" in file
+        or Path(file).suffix.lower() not in (".png", ".svg", ".pdf")
+    ):
+        raise ConfigError(
+            f"{where}: figure.file: must be a file name ending in .png, .svg or .pdf, got "
+            f"{shown_value(file)}."
+        )
+    title = raw.get("title", name)
+    if not isinstance(title, str):
+        raise ConfigError(f"{where}: figure.title: must be text, got {shown_value(title)}.")
+    return str(kind), file, title

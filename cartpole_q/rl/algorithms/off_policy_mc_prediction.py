@@ -28,13 +28,12 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithms.mc_prediction import VISIT
 from cartpole_q.rl.prediction import POLICY, policy_table
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
 
 SAMPLINGS = ("ordinary", "weighted")
 """``agent.sampling`` values, in the order of their codes"""
-VISITS = ("every", "first")
-"""``agent.visits`` values, in the order of their codes"""
 
 
 def behaviour_action(
@@ -98,10 +97,6 @@ SAMPLING = Param(
     "sampling", "weighted",
     "importance sampling: ordinary (the average of W * G) or weighted (G weighted by W)",
     kind="choice", choices=SAMPLINGS,
-)  # fmt: skip
-VISIT = Param(
-    "visits", "every", "which visits of a state learn from their return: every one, or the first",
-    kind="choice", choices=VISITS,
 )  # fmt: skip
 
 ALGORITHM = Algorithm(
