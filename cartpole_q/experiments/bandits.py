@@ -24,13 +24,12 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
+from cartpole_q.config import ConfigError, parse_seeds, shown_value
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
     checked_list,
-    checked_name,
-    safe_name,
+    read_study_file,
 )
 from cartpole_q.rl.bandits import RULES, BanditAgent
 
@@ -169,15 +168,12 @@ def load_study(path: Path) -> Study:
     Raises:
         ConfigError: naming the file and the key, with what is wrong.
     """
-    raw = read_yaml_mapping(path, "study file")
-    where = str(path)
-    if not raw:
-        raise ConfigError(
-            f"{where}: is empty; a study file gives `seeds`, `steps`, `curves` and `figure` "
-            "(see examples/book/fig2_2_epsilon_greedy.yaml)."
-        )
-    check_top_keys(raw, STUDY_KEYS, where)
-    name = checked_name(raw, safe_name(path.stem), where)
+    raw, where, name = read_study_file(
+        path,
+        STUDY_KEYS,
+        "`seeds`, `steps`, `curves` and `figure`",
+        "examples/book/fig2_2_epsilon_greedy.yaml",
+    )
     testbed_raw = raw.get("testbed", {})
     if not isinstance(testbed_raw, Mapping):
         raise ConfigError(

@@ -18,14 +18,13 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, EnvConfig, load_config, read_yaml_mapping, shown_value
+from cartpole_q.config import ConfigError, EnvConfig, load_config, shown_value
 from cartpole_q.envs.models import PlanningModel, planning_model
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
     checked_list,
-    checked_name,
-    safe_name,
+    read_study_file,
 )
 from cartpole_q.rl import dynamic_programming as dp
 
@@ -167,15 +166,12 @@ def load_study(path: Path) -> Study:
     Raises:
         ConfigError: naming the file and the key, with what is wrong.
     """
-    raw = read_yaml_mapping(path, "study file")
-    where = str(path)
-    if not raw:
-        raise ConfigError(
-            f"{where}: is empty; a study file gives `env`, `algorithm`, `gamma` and `figure` "
-            "(see examples/book/fig4_1_small_gridworld.yaml)."
-        )
-    check_top_keys(raw, STUDY_KEYS, where)
-    name = checked_name(raw, safe_name(path.stem), where)
+    raw, where, name = read_study_file(
+        path,
+        STUDY_KEYS,
+        "`env`, `algorithm`, `gamma` and `figure`",
+        "examples/book/fig4_1_small_gridworld.yaml",
+    )
     env_raw = raw.get("env")
     if not isinstance(env_raw, Mapping) or "id" not in env_raw:
         raise ConfigError(

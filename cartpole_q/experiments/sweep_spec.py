@@ -580,3 +580,25 @@ def checked_figure_section(
     if not isinstance(title, str):
         raise ConfigError(f"{where}: figure.title: must be text, got {shown_value(title)}.")
     return str(kind), file, title
+
+
+def read_study_file(
+    path: Path, keys: Sequence[str], gives: str, example: str
+) -> tuple[Mapping[str, Any], str, str]:
+    """A study file's mapping, its name for messages, and its study name (``name``, or the stem).
+
+    Args:
+        path: the file.
+        keys: its top-level keys.
+        gives: what a study file gives, for the message of an empty one.
+        example: a shipped study file to point to.
+
+    Raises:
+        ConfigError: an empty or unreadable file, an unknown key, a bad name.
+    """
+    raw = read_yaml_mapping(path, "study file")
+    where = str(path)
+    if not raw:
+        raise ConfigError(f"{where}: is empty; a study file gives {gives} (see {example}).")
+    check_top_keys(raw, tuple(keys), where)
+    return raw, where, checked_name(raw, safe_name(path.stem), where)
