@@ -21,6 +21,7 @@ import math
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import gymnasium
@@ -852,14 +853,49 @@ class Prediction(Agent):
     def __init__(self, n_states: int, n: int, q_init: float, *args: Any) -> None:
         super().__init__(n_states, n, q_init, *args)
         self.q = [[q_init] for _ in range(n_states)]
+        self.greedy: list[int] = []
+        if self.params["policy"] in ("greedy", "epsilon_greedy"):
+            # agent.policy_run's q_table.npy, its rows in C order: the lowest best action.
+            table = np.load(Path(self.params["policy_run"]) / "q_table.npy").reshape(-1, n)
+            for values in table.tolist():
+                self.greedy.append(values.index(max(values)))
 
-    def draw(self, x: int) -> int:
-        """``pi``'s action: ``agent.policy: random``, one ``rng.integers(0, n)``; ``stick_20``
-        (Blackjack, rows in C order over (32, 11, 2)): stick (0) on a player sum of 20 or
-        21, else hit (1), no draw."""
+    def pi_of(self, b: int, x: int) -> float:
+        """``pi(b | x)``: ``1 / n``; a rule's or the greedy policy's 1.0 or 0.0; epsilon-greedy's
+        ``(1 - epsilon) + epsilon / n`` for the greedy action, ``epsilon / n`` for another."""
+        policy = self.params["policy"]
+        if policy == "random":
+            return 1.0 / self.n
+        if policy == "epsilon_greedy":
+            epsilon = float(self.params["policy_epsilon"])
+            return (1.0 - epsilon) + epsilon / self.n if b == self.greedy[x] else epsilon / self.n
+        return 1.0 if b == self.rule(x) else 0.0
+
+    def rule(self, x: int) -> int:
+        """A deterministic policy's action: ``stick_20`` (Blackjack, rows in C order over (32,
+        11, 2)): stick (0) on a player sum of 20 or 21, else hit (1); ``greedy``: the run's."""
         if self.params["policy"] == "stick_20":
             return 0 if x // (11 * 2) >= 20 else 1
-        return int(self.rng.integers(0, self.n))
+        return self.greedy[x]
+
+    def draw(self, x: int) -> int:
+        """``pi``'s action: ``random``, one ``rng.integers(0, n)``; ``epsilon_greedy``, one
+        ``u = rng.random()`` and the lowest action whose running sum of ``pi`` passes it; a
+        rule or ``greedy``, its action, no draw."""
+        policy = self.params["policy"]
+        if policy == "random":
+            return int(self.rng.integers(0, self.n))
+        if policy == "epsilon_greedy":
+            u = self.rng.random()
+            total, last = 0.0, 0
+            for b in range(self.n):
+                total = total + self.pi_of(b, x)
+                if u < total:
+                    return b
+                if self.pi_of(b, x) > 0.0:
+                    last = b
+            return last
+        return self.rule(x)
 
     def v(self, x: int) -> float:
         return self.q[x][0]
@@ -1067,11 +1103,6 @@ class OffPolicyMCPrediction(Prediction):
     def draw(self, x: int) -> int:
         return int(self.rng.integers(0, self.n))  # b: uniform, whatever the target
 
-    def pi(self, b: int, x: int) -> float:
-        """The target's probability of ``b`` in ``x``: ``1 / n``, or a rule's 1.0 or 0.0."""
-        if self.params["policy"] == "random":
-            return 1.0 / self.n
-        return 1.0 if b == Prediction.draw(self, x) else 0.0
 
     def step(
         self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
@@ -1087,7 +1118,7 @@ class OffPolicyMCPrediction(Prediction):
         for t in range(len(self.episode) - 1, -1, -1):
             x, b, reward = self.episode[t]
             g = self.gamma * g + reward
-            w = w * (self.pi(b, x) / (1.0 / self.n))
+            w = w * (self.pi_of(b, x) / (1.0 / self.n))
             if self.params["visits"] == "every" or first[x] == t:
                 if self.params["sampling"] == "ordinary":
                     self.sums[x] = self.sums[x] + 1.0
@@ -1101,9 +1132,11 @@ class OffPolicyMCPrediction(Prediction):
 
 
 def true_values(
-    env: gymnasium.Env[Any, Any], n: int, gamma: float
+    env: gymnasium.Env[Any, Any], n: int, gamma: float, pi: Callable[[int, int], float] | None = None
 ) -> tuple[list[int], list[float]]:
-    """docs/algorithms.md, "The error": the uniform policy's values on the measured states.
+    """docs/algorithms.md, "The error": the policy's values on the measured states.
+
+    ``pi(b, x)`` is the policy's probability of ``b`` in ``x`` (uniform if None).
 
     ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; measured
     are the states reachable from the start distribution along outcomes that do not
@@ -1124,7 +1157,7 @@ def true_values(
         ends = True
         for b in range(n):
             for probability, to, reward, done in table[x][b]:
-                weight = (1.0 / n) * probability
+                weight = (1.0 / n if pi is None else pi(b, x)) * probability
                 expected[x] += weight * reward
                 if not done:
                     matrix[x, to] += weight
@@ -1200,6 +1233,8 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "tolerance": 1e-6,
     "max_passes": 100_000,
     "sampling": "weighted",
+    "policy_run": "",
+    "policy_epsilon": 0.1,
 }
 PREDICTION_DEFAULTS: dict[str, Any] = {"update": "constant_alpha"}
 """mc_prediction's own default of a key another algorithm defaults otherwise"""
@@ -1300,7 +1335,7 @@ def reference_train(
     if isinstance(agent, Prediction):
         threshold = None  # a prediction run never solves
         if hasattr(env.unwrapped, "P"):
-            measured, truth = true_values(env, n, float(gamma))
+            measured, truth = true_values(env, n, float(gamma), agent.pi_of)
             errors = []
     if isinstance(
         agent,

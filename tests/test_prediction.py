@@ -505,3 +505,128 @@ def test_the_mean_square_aggregate_is_the_mean_of_squares() -> None:
     centre, low, high = aggregate_band(curves, "mean_square", np.random.default_rng(0))
     assert centre.tolist() == [5.0, 8.0 / 3.0]  # (1 + 9) / 2 (a NaN is no seed); (4 + 0 + 4) / 3
     assert (low <= centre).all() and (centre <= high).all()
+
+
+# -- a control run's policy (agent.policy greedy / epsilon_greedy, agent.policy_run) --------
+
+LAKE = {"env.id": "FrozenLake-v1", "discretization": None, "agent.gamma": 0.95}
+
+
+def _control_run(path: Path, q_table: np.ndarray, env_id: str = "FrozenLake-v1") -> Path:
+    """A control run's two files the policy is read from."""
+    path.mkdir(parents=True)
+    np.save(path / rundir.Q_TABLE_FILE, q_table)
+    write_yaml(path / "config.yaml", {"env": {"id": env_id}})
+    return path
+
+
+def test_the_greedy_policy_of_q_star_has_the_optimal_values(tmp_path: Path) -> None:
+    """Evaluating the greedy policy of Q* gives v* (the two solvers agree to rounding)."""
+    from cartpole_q.envs.models import EnvModel, env_model
+    from cartpole_q.rl.value_iteration import value_iteration
+
+    config = load_config(overrides={**LAKE, "agent.algorithm": "td"})
+    model = env_model(config.env)
+    assert isinstance(model, EnvModel)
+    optimum = value_iteration(model.model, 0.95, tolerance=1e-14)
+    run = _control_run(tmp_path / "lake", optimum.q)
+    for policy in ("greedy", "epsilon_greedy"):
+        overrides = {**LAKE, "agent.algorithm": "td", "agent.policy": policy}
+        config = load_config(overrides={**overrides, "agent.policy_run": str(run)})
+        truth = prediction_truth(config, inspect_env(config))
+        assert truth.states is not None
+        # no hole, no goal; Q*'s greedy policy never reaches state 3 (up from 1, left from 2)
+        reached = (
+            [0, 1, 2, 4, 6, 8, 9, 10, 13, 14]
+            if policy == "greedy"
+            else [0, 1, 2, 3, 4, 6, 8, 9, 10, 13, 14]
+        )
+        assert truth.states.tolist() == reached
+        exact = optimum.values[truth.states]
+        if policy == "greedy":
+            np.testing.assert_allclose(truth.values, exact, rtol=0, atol=1e-12)
+        else:  # epsilon 0.1 of uniform moves costs something in every state
+            assert (truth.values < exact - 1e-3).all()
+
+
+def test_a_runs_epsilon_greedy_policy_plays_its_probabilities(tmp_path: Path) -> None:
+    """epsilon 1: uniform; the visits of a one-state-per-row policy follow pi."""
+    run = _control_run(tmp_path / "lake", np.tile(np.array([0.0, 1.0, 0.0, 0.0]), (16, 1)))
+    base = {**LAKE, "agent.algorithm": "td", "train.episodes": 300, "agent.policy_run": str(run)}
+    greedy = train(load_config(overrides={**base, "agent.policy": "greedy"}), final_eval=False)
+    assert greedy.visits[..., [0, 2, 3]].sum() == 0 and greedy.visits[..., 1].sum() > 0
+    mixed = train(
+        load_config(
+            overrides={**base, "agent.policy": "epsilon_greedy", "agent.policy_epsilon": 0.4}
+        ),
+        final_eval=False,
+    )
+    shares = mixed.visits.sum(axis=0) / mixed.visits.sum()
+    np.testing.assert_allclose(shares, [0.1, 0.7, 0.1, 0.1], atol=0.03)
+
+
+@pytest.mark.parametrize(
+    ("assignments", "message"),
+    [
+        (["agent.policy=greedy"], "agent.policy_run: agent.policy greedy evaluates a control run"),
+        (["agent.policy=greedy", "agent.policy_run=PREDICTION"], "is a prediction run"),
+        (["agent.policy=greedy", "agent.policy_run=NOWHERE"], "has no q_table.npy"),
+        (["agent.policy_run=CONTROL"], "is read only with agent.policy greedy or epsilon_greedy"),
+        (
+            ["agent.policy=greedy", "agent.policy_run=CONTROL", "env.kwargs.map_name=8x8"],
+            "its q_table.npy is float64 of shape (16, 4); this config's table is float64 of shape (64, 4)",
+        ),
+        (["agent.policy=epsilon_greedy", "agent.policy_run=TAXI"], "its policy is one of Taxi-v4"),
+        (
+            ["agent.policy=greedy", "agent.policy_run=CONTROL", "discretization.tilings=4"],
+            "agent.policy: greedy takes a run's table policy",
+        ),
+    ],
+    ids=["no-run", "prediction-run", "missing", "not-asked", "shape", "other-world", "tiles"],
+)
+def test_a_runs_policy_is_refused_before_anything_is_written(
+    tmp_path: Path, assignments: list[str], message: str
+) -> None:
+    places = {
+        "CONTROL": _control_run(tmp_path / "control", np.zeros((16, 4))),
+        "TAXI": _control_run(tmp_path / "taxi", np.zeros((16, 4)), env_id="Taxi-v4"),
+        "PREDICTION": tmp_path / "prediction",
+        "NOWHERE": tmp_path / "nowhere",
+    }
+    (tmp_path / "prediction").mkdir()
+    np.save(tmp_path / "prediction" / rundir.V_TABLE_FILE, np.zeros(16))
+    args = ["train", "--set", "env.id=FrozenLake-v1", "--set", "agent.algorithm=td"]
+    for assignment in assignments:
+        for name, place in places.items():
+            assignment = assignment.replace(name, str(place))
+        args += ["--set", assignment]
+    out = tmp_path / "out"
+    result = invoke(*args, "--out", str(out))
+    assert result.exit_code == 2, result.output
+    assert message in " ".join(result.stderr.split()), result.stderr
+    assert "Traceback" not in result.output
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_an_interrupted_run_of_a_runs_policy_resumes_byte_identically(
+    tmp_path: Path, engine: str
+) -> None:
+    control = str(Path(__file__).parent / "data" / "frozenlake_q_learning_run")
+    overrides = {
+        **LAKE, "engine": engine, "agent.algorithm": "mc_prediction",
+        "agent.policy": "epsilon_greedy", "agent.policy_run": control,
+        "train.episodes": 60, "train.checkpoint_every": 10,
+    }  # fmt: skip
+    whole = train(load_config(overrides=overrides), final_eval=False)
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= 2)
+    assert outcome.result.interrupted
+    resumed = invoke("train", "--resume", str(run), "-q")
+    assert resumed.exit_code == 0, resumed.output
+    assert np.load(run / rundir.V_TABLE_FILE).tobytes() == whole.v_table.tobytes()
+    loaded = rundir.load_run(run)
+    assert whole.errors is not None and loaded.errors is not None
+    assert loaded.errors.tolist() == whole.errors.tolist()

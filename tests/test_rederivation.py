@@ -365,7 +365,13 @@ OTHER_TWIN_VARIANTS = {
         "mc_prediction-stick_20",
         "off_policy_mc_prediction-weighted-stick_20",
     },
-    "frozenlake": {"q_learning", "q_learning-random-ties"},  # the tie rule is no new loop
+    # the tie rule is no new loop; a run's policies play the walks' compiled prediction loops
+    "frozenlake": {
+        "q_learning",
+        "q_learning-random-ties",
+        "td-greedy",
+        "mc_prediction-epsilon_greedy",
+    },
     # Chapter 9's algorithms on the aggregated walk: gradient MC, semi-gradient TD(0), n-step.
     "walk1000": {"td", "mc_prediction", "n_step_td"},
 }
@@ -511,6 +517,45 @@ def test_a_named_policy(world: str, variant: str, engine: str) -> None:
     """Blackjack's "stick on 20 or 21" (Example 5.1), a rule the world declares, evaluated."""
     expected = _assert_same(world, variant, engine)
     assert expected.solved_episode is None
+
+
+# A control run's files (q_learning on FrozenLake-v1, 5,000 episodes, seed 3): its greedy
+# policy, the lowest best action of each row (the holes' and the goal's rows are all 0.0).
+FROZENLAKE_RUN = str(Path(__file__).parent / "data" / "frozenlake_q_learning_run")
+RUN_POLICY_VARIANTS = {
+    "td-greedy": ("td", {"policy": "greedy", "policy_run": FROZENLAKE_RUN}),
+    "mc_prediction-epsilon_greedy": (
+        "mc_prediction",
+        {"policy": "epsilon_greedy", "policy_run": FROZENLAKE_RUN, "policy_epsilon": 0.3},
+    ),
+    "true_online_td_lambda-epsilon_greedy": (
+        "true_online_td_lambda",
+        {"policy": "epsilon_greedy", "policy_run": FROZENLAKE_RUN, "lambda": 0.8},
+    ),
+    "off_policy_mc_prediction-greedy": (
+        "off_policy_mc_prediction",
+        {"policy": "greedy", "policy_run": FROZENLAKE_RUN},
+    ),
+    "off_policy_mc_prediction-ordinary-epsilon_greedy": (
+        "off_policy_mc_prediction",
+        {
+            "policy": "epsilon_greedy",
+            "policy_run": FROZENLAKE_RUN,
+            "policy_epsilon": 0.5,
+            "sampling": "ordinary",
+        },
+    ),
+}
+ALL_VARIANTS.update(RUN_POLICY_VARIANTS)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"), _params(["frozenlake"], list(RUN_POLICY_VARIANTS))
+)
+def test_a_runs_policy(world: str, variant: str, engine: str) -> None:
+    """A control run's greedy and epsilon-greedy policies (``agent.policy_run``), evaluated."""
+    expected = _assert_same(world, variant, engine)
+    assert expected.errors is not None and expected.errors[-1] < expected.errors[0]
 
 
 def test_every_package_algorithm_is_re_derived() -> None:

@@ -16,6 +16,7 @@ import math
 import re
 from collections import Counter
 from collections.abc import Mapping
+from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
@@ -85,7 +86,7 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     train = TrainConfig(**reader.fields(TrainConfig, "train."))
     _check_epsilon_floor(reader, agent, train.episodes)
     env = _env(reader)
-    _check_named_policy(reader, agent, env.id)
+    _check_named_policy(reader, agent, env.id, tiled=tilings > 1)
     return Config(
         name=name,
         **reader.fields(Config, "", skip=("name",)),
@@ -140,16 +141,29 @@ def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
         )
 
 
-def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str) -> None:
-    """A named ``agent.policy`` (not ``random``) is a rule of the world.
+def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled: bool) -> None:
+    """A named ``agent.policy`` (not ``random``) is a rule of the world, or a run's policy.
 
-    It gives an action per table row (the worlds that declare one have Discrete
-    observations: no grid, no tiles).
+    Either gives an action per table row (the worlds that declare a rule have Discrete
+    observations: no grid, no tiles); ``agent.policy_run`` is read by a run's policy alone.
     """
     from cartpole_q.profiles import profile_for
 
+    if not get_algorithm(agent.algorithm).predicts:
+        return
     name = agent.params.get("policy", "random")
-    if name == "random" or not get_algorithm(agent.algorithm).predicts:
+    run = str(agent.params.get("policy_run", ""))
+    if name in ("greedy", "epsilon_greedy"):
+        _check_policy_run(reader, name, run, tiled)
+        return
+    if run:
+        raise reader.error(
+            "agent.policy_run",
+            f"{run} is read only with agent.policy greedy or epsilon_greedy (agent.policy is "
+            f"{name}); "
+            "remove it, or set agent.policy: greedy.",
+        )
+    if name == "random":
         return
     declared = profile_for(env_id).policies
     if name not in declared:
@@ -159,6 +173,34 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str) -> Non
             f"{name} is a rule another world declares; {env_id} declares {rules}. Use "
             "random, or an env.id whose rule it is (stick_20: Blackjack-v1).",
         )
+
+
+def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None:
+    """A run's policy needs the run: a directory holding a control run's ``q_table.npy``.
+
+    Its world and shape are checked when the table is read (the environment's shape is
+    not known here).
+    """
+    if tiled:
+        raise reader.error(
+            "agent.policy",
+            f"{name} takes a run's table policy, one action per table row; on tiles there are "
+            "no rows. Use discretization.tilings: 1.",
+        )
+    if not run:
+        raise reader.error(
+            "agent.policy_run",
+            f"agent.policy {name} evaluates a control run's policy: give its run directory "
+            "(agent.policy_run: runs/NAME).",
+        )
+    path = Path(run)
+    if not (path / "q_table.npy").is_file():
+        what = (
+            "is a prediction run: it has state values (v_table.npy), no policy"
+            if (path / "v_table.npy").is_file()
+            else "has no q_table.npy: it is not a finished run directory"
+        )
+        raise reader.error("agent.policy_run", f"{run} {what}. Give a control run's directory.")
 
 
 def _check_epsilon_floor(reader: _Reader, agent: AgentConfig, episodes: int) -> None:
@@ -265,9 +307,11 @@ def _algorithm_params(reader: _Reader) -> Mapping[str, ParamValue]:
     algorithm = get_algorithm(agent["algorithm"])  # valid: it was read before
     values: dict[str, ParamValue] = {}
     for param in algorithm.params:
-        values[param.key] = reader.value(
-            f"agent.{param.key}", agent.get(param.key, param.default), param
-        )
+        given = agent.get(param.key, param.default)
+        if param.kind == "str" and given in ("", None):  # text left out (a path not given)
+            values[param.key] = ""
+            continue
+        values[param.key] = reader.value(f"agent.{param.key}", given, param)
     return MappingProxyType(values)
 
 

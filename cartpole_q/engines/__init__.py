@@ -50,6 +50,24 @@ def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance =
     return "gymnasium"
 
 
+def check_prediction(config: Config, env_info: EnvInfo) -> None:
+    """A prediction run's policy and true values, checked before any file is written.
+
+    The policy of ``agent.policy_run`` is read and checked against this config's world and
+    table, and the true values are solved (kept for the run in this process): a policy
+    with no values (``agent.gamma`` 1 and an episode that may never end) is refused here,
+    not after the run directory exists. Nothing happens for a control algorithm.
+
+    Raises:
+        ConfigError: naming ``agent.policy_run`` or ``agent.policy``.
+    """
+    from cartpole_q.engines.base import prediction_truth
+    from cartpole_q.rl.algorithms import get as get_algorithm
+
+    if get_algorithm(config.agent.algorithm).predicts:
+        prediction_truth(config, env_info)
+
+
 def make_engine(
     name: str,
     config: Config,

@@ -11,9 +11,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, NamedTuple, Protocol
 
 import numpy as np
+import yaml
 
 from cartpole_q.config import Config, ConfigError, Schedule
 from cartpole_q.envs.gym import EnvInfo
@@ -284,10 +286,14 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     tiled = config.discretization is not None and config.discretization.tilings > 1
     if tiled:
         return Truth.none()
-    # A sweep's runs of one point ask for the same values: solved once per process.
+    # A sweep's runs of one point ask for the same values: solved once per process. A run's
+    # policy is keyed by its actions (the file may change between two calls).
+    from_run = config.agent.params.get("policy") in ("greedy", "epsilon_greedy")
     key = (
         repr(config.env), env_info.max_episode_steps, env_info.state_shape, env_info.n_actions,
         config.agent.gamma, config.agent.params.get("policy"),
+        config.agent.params.get("policy_epsilon"),
+        tuple(run_greedy_actions(config, env_info)) if from_run else None,
     )  # fmt: skip
     found = _TRUTHS.get(key)
     if found is None:
@@ -310,8 +316,48 @@ def named_policy(config: Config, env_info: EnvInfo) -> list[int] | None:
     name = config.agent.params.get("policy", "random")
     if name == "random":
         return None
+    if name in ("greedy", "epsilon_greedy"):
+        return run_greedy_actions(config, env_info)
     rule = profile_for(config.env.id).policies[str(name)]
     return rule(tuple(env_info.state_shape))
+
+
+def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
+    """The greedy action of every row of ``agent.policy_run``'s ``q_table.npy``.
+
+    The lowest action of the largest value (design.md's argmax), in the table's C order.
+    The run must be a control run on this config's ``env.id`` whose table has this
+    config's shape, ``(*state_shape, n_actions)``. Reading one file is the only I/O of this
+    layer: the table is the policy's definition, as a world's rule is (validation has
+    checked that the file exists).
+
+    Raises:
+        ConfigError: naming ``agent.policy_run``: the table is unreadable, another world's,
+            of another shape, or not finite.
+    """
+    run = Path(str(config.agent.params["policy_run"]))
+    field = f"agent.policy_run: {run}"
+    try:
+        table = np.load(run / "q_table.npy", allow_pickle=False)
+        raw = yaml.safe_load((run / "config.yaml").read_text(encoding="utf-8"))
+    except (OSError, ValueError, yaml.YAMLError) as error:
+        raise ConfigError(
+            f"{field}: cannot read its q_table.npy and config.yaml ({error})."
+        ) from None
+    env_id = raw.get("env", {}).get("id") if isinstance(raw, dict) else None
+    if env_id != config.env.id:
+        raise ConfigError(
+            f"{field}: its policy is one of {env_id}, not of env.id {config.env.id}; "
+            "evaluate it on its own world."
+        )
+    shape = (*env_info.state_shape, env_info.n_actions)
+    if table.shape != shape or table.dtype != np.float64 or not np.isfinite(table).all():
+        raise ConfigError(
+            f"{field}: its q_table.npy is {table.dtype} of shape {table.shape}; this config's "
+            f"table is float64 of shape {shape} with finite values (the same discretization)."
+        )
+    rows = table.reshape(-1, env_info.n_actions)
+    return [int(action) for action in np.argmax(rows, axis=1)]
 
 
 def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:

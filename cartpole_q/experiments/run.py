@@ -116,10 +116,11 @@ def prepare(config: Config, source: str | Provenance) -> Prepared:
     Raises:
         ConfigError: the config does not fit its environment or engine.
     """
-    from cartpole_q.engines import resolve_engine
+    from cartpole_q.engines import check_prediction, resolve_engine
 
     env_info = inspect_env(config, source)
     engine = resolve_engine(config, env_info, source)
+    check_prediction(config, env_info)
     return Prepared(config, env_info, engine, str(source))
 
 

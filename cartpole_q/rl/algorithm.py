@@ -47,7 +47,7 @@ class Param:
     doc: str
     """what it means, one line"""
     kind: str = "float"
-    """``float``, ``int`` or ``choice``"""
+    """``float``, ``int``, ``choice`` or ``str`` (text the hooks never read: a path)"""
     low: float | None = None
     """the smallest value (``None``: no bound)"""
     high: float | None = None
@@ -66,6 +66,8 @@ class Param:
         >>> Param("lambda", 0.9, "", low=0.0, high=1.0).interval
         '[0, 1]'
         """
+        if self.kind == "str":
+            return "text"
         if self.kind == "choice":
             if len(self.choices) == 1:
                 return self.choices[0]
@@ -86,6 +88,8 @@ class Param:
         """
         if self.kind == "choice":
             return float(self.choices.index(str(value)))
+        if self.kind == "str":
+            return 0.0  # text (a path) is read when memory is made, never by the hooks
         return float(value)
 
 

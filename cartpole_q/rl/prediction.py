@@ -28,35 +28,88 @@ import numpy as np
 from cartpole_q.rl.algorithm import MemoryContext, Param
 from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable, value
 
-POLICIES = ("random", "stick_20", "left")
+POLICIES = ("random", "stick_20", "left", "greedy", "epsilon_greedy")
 """``agent.policy`` values, in the order of their codes: ``random`` is uniform over the
-actions (Sutton & Barto's random walks); the others are deterministic rules a world declares
-(its profile's ``policies``): ``stick_20`` is Blackjack's "stick on 20 or 21" (Example 5.1),
-``left`` the one-state MDP's "always left" (Example 5.5)"""
+actions (Sutton & Barto's random walks); ``stick_20`` and ``left`` are deterministic rules a
+world declares (its profile's ``policies``): Blackjack's "stick on 20 or 21" (Example 5.1),
+the one-state MDP's "always left" (Example 5.5); ``greedy`` and ``epsilon_greedy`` are a
+control run's policy (``agent.policy_run``: its ``q_table.npy``), greedy or epsilon-greedy
+with ``agent.policy_epsilon``"""
+
+DRAWN = POLICIES.index("epsilon_greedy")
+"""the code of the one policy whose actions are drawn from its table's probabilities"""
 
 POLICY = Param(
     "policy", "random",
-    "the policy whose values are learnt: random (uniform over the actions), or a rule the "
-    "world declares (stick_20: Blackjack's stick on 20 or 21; left: the one-state MDP's)",
+    "the policy whose values are learnt: random (uniform over the actions), a rule the "
+    "world declares (stick_20: Blackjack's stick on 20 or 21; left: the one-state MDP's), "
+    "or the greedy or epsilon_greedy policy of the run agent.policy_run",
     kind="choice", choices=POLICIES,
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""
+
+POLICY_RUN = Param(
+    "policy_run", "",
+    "agent.policy greedy or epsilon_greedy: the run directory whose q_table.npy gives the "
+    "greedy actions (a control run on the same env and discretization)",
+    kind="str",
+)  # fmt: skip
+"""``agent.policy_run`` of every prediction algorithm (read when memory is made; the hooks
+get 0.0 in its place)"""
+
+POLICY_EPSILON = Param(
+    "policy_epsilon", 0.1,
+    "agent.policy epsilon_greedy: the probability of a uniform action (pi gives epsilon / n "
+    "to every action and 1 - epsilon more to the greedy one)",
+    low=0.0, high=1.0,
+)  # fmt: skip
+"""``agent.policy_epsilon`` of every prediction algorithm"""
+
+POLICY_SOURCE = (POLICY_RUN, POLICY_EPSILON)
+"""the keys that say where a run's policy comes from: every prediction algorithm's last two"""
 
 
 @compilable
 def policy_action(policy: np.ndarray, state: int, params: Params, rng: Rng) -> int:
     """The evaluated policy's action in ``state``.
 
-    ``random``: ``rng.integers(0, n)``; a named rule: the action of probability 1 in the
-    table (no draw).
+    ``random``: ``rng.integers(0, n)``; ``epsilon_greedy``: one ``u = rng.random()``, then
+    the lowest action whose running sum of the row's probabilities exceeds ``u`` (the last
+    action of positive probability if rounding leaves none); a rule or ``greedy``: the
+    lowest action of the row's largest probability (no draw).
     """
     if params[0] == 0.0:
         return int(rng.integers(0, policy.shape[1]))
+    if params[0] == DRAWN:
+        return drawn_action(policy, state, rng.random())
     chosen = 0
     for action in range(1, policy.shape[1]):
         if policy[state, action] > policy[state, chosen]:
             chosen = action
     return chosen
+
+
+@compilable
+def drawn_action(policy: np.ndarray, state: int, u: float) -> int:
+    """The action a uniform ``u`` in ``[0, 1)`` draws from the row ``state`` of ``policy``.
+
+    The lowest ``b`` with ``u < policy[state, 0] + ... + policy[state, b]`` (summed in
+    action order from 0.0); if rounding leaves none, the last ``b`` of positive probability.
+
+    >>> import numpy as np
+    >>> row = np.array([[0.05, 0.9, 0.05]])
+    >>> [drawn_action(row, 0, u) for u in (0.0, 0.05, 0.94, 0.95, 0.999)]
+    [0, 1, 1, 2, 2]
+    """
+    total = 0.0
+    last = 0
+    for action in range(policy.shape[1]):
+        total += policy[state, action]
+        if u < total:
+            return action
+        if policy[state, action] > 0.0:
+            last = action
+    return last
 
 
 @compilable
@@ -70,18 +123,31 @@ def first_policy_action(
 def policy_table(context: MemoryContext) -> np.ndarray:
     """``pi`` as a table, one row per state.
 
-    ``random`` gives every action ``1 / n`` in every state; a named rule, 1.0 to its action
-    in each state (``context.policy``, from the world's profile).
+    ``random`` gives every action ``1 / n`` in every state; a named rule and ``greedy``, 1.0
+    to its action in each state (``context.policy``: the world's rule, or the greedy actions
+    of ``agent.policy_run``); ``epsilon_greedy``, ``(1 - epsilon) + epsilon / n`` to the
+    greedy action and ``epsilon / n`` to each other (``epsilon`` = ``agent.policy_epsilon``).
+
+    >>> context = MemoryContext(2, 2, 0.0, {"policy": "epsilon_greedy", "policy_epsilon": 0.2}, 10, policy=[1, 0])
+    >>> policy_table(context).tolist()
+    [[0.1, 0.9], [0.9, 0.1]]
 
     Raises:
-        ValueError: a named rule without its actions in ``context.policy``.
+        ValueError: a named rule or a run's policy without its actions in ``context.policy``.
     """
-    if context.params.get("policy", "random") == "random":
+    name = context.params.get("policy", "random")
+    if name == "random":
         return np.full((context.n_states, context.n_actions), 1.0 / context.n_actions)
     if context.policy is None or len(context.policy) != context.n_states:
-        raise ValueError(f"agent.policy {context.params['policy']} needs its actions per state")
+        raise ValueError(f"agent.policy {name} needs its actions per state")
+    rows, actions = np.arange(context.n_states), np.asarray(context.policy, dtype=np.int64)
+    if name == "epsilon_greedy":
+        epsilon = float(context.params.get("policy_epsilon", POLICY_EPSILON.default))
+        table = np.full((context.n_states, context.n_actions), epsilon / context.n_actions)
+        table[rows, actions] = (1.0 - epsilon) + epsilon / context.n_actions
+        return table
     table = np.zeros((context.n_states, context.n_actions))
-    table[np.arange(context.n_states), np.asarray(context.policy, dtype=np.int64)] = 1.0
+    table[rows, actions] = 1.0
     return table
 
 

@@ -31,7 +31,13 @@ import math
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
 
 TARGETS = ("td", "mc")
@@ -122,7 +128,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its sums are kept per state",
     step=step,
     start=first_policy_action,
-    params=(POLICY, TARGET, TOLERANCE, MAX_PASSES),
+    params=(POLICY, TARGET, TOLERANCE, MAX_PASSES, *POLICY_SOURCE),
     memory=batch_memory,
     memory_names=(
         "policy", "batch_states", "batch_targets", "batch_bootstrap_states",

@@ -24,7 +24,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, update, value
 
 UPDATES = ("constant_alpha", "sample_average")
@@ -95,7 +101,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its counts and first visits are kept per state",
     step=step,
     start=first_policy_action,
-    params=(POLICY, UPDATE, VISIT),
+    params=(POLICY, UPDATE, VISIT, *POLICY_SOURCE),
     memory=mc_prediction_memory,
     memory_names=(
         "policy", "episode_states", "episode_rewards", "visit_counts", "first_visits",

@@ -23,7 +23,13 @@ import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.pending import N, push, queue_memory, settle_oldest
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table
 
 
@@ -61,7 +67,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, N),
+    params=(POLICY, N, *POLICY_SOURCE),
     memory=n_step_memory,
     memory_names=("policy", "pending_states", "pending_actions", "pending_rewards", "queue"),
 )

@@ -29,7 +29,7 @@ import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
 from cartpole_q.rl.algorithms.mc_prediction import VISIT
-from cartpole_q.rl.prediction import POLICY, policy_table
+from cartpole_q.rl.prediction import POLICY, POLICY_SOURCE, policy_table
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
 
 SAMPLINGS = ("ordinary", "weighted")
@@ -107,7 +107,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its sums of weights and first visits are kept per state",
     step=step,
     start=behaviour_action,
-    params=(POLICY, SAMPLING, VISIT),
+    params=(POLICY, SAMPLING, VISIT, *POLICY_SOURCE),
     memory=off_policy_memory,
     memory_names=(
         "policy", "episode_states", "episode_actions", "episode_rewards", "weight_sums",

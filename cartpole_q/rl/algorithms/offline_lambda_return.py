@@ -26,7 +26,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, update, value
 from cartpole_q.rl.traces import LAMBDA
 
@@ -73,7 +79,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA),
+    params=(POLICY, LAMBDA, *POLICY_SOURCE),
     memory=lambda_return_memory,
     memory_names=(
         "policy",

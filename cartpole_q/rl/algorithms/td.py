@@ -23,7 +23,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, update, value
 
 
@@ -52,7 +58,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY,),
+    params=(POLICY, *POLICY_SOURCE),
     memory=memory,
     memory_names=("policy",),
 )

@@ -24,7 +24,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, value
 from cartpole_q.rl.traces import (
     LAMBDA,
@@ -69,7 +75,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA, TRACE),
+    params=(POLICY, LAMBDA, TRACE, *POLICY_SOURCE),
     memory=td_lambda_memory,
     memory_names=(
         "policy", "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count",

@@ -21,7 +21,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.prediction import POLICY, first_policy_action, policy_action, policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_SOURCE,
+    first_policy_action,
+    policy_action,
+    policy_table,
+)
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, feature_alpha, shift, value
 from cartpole_q.rl.traces import (
     LAMBDA,
@@ -78,7 +84,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA),
+    params=(POLICY, LAMBDA, *POLICY_SOURCE),
     memory=true_online_memory,
     memory_names=(
         "policy", "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count",
