@@ -1103,7 +1103,6 @@ class OffPolicyMCPrediction(Prediction):
     def draw(self, x: int) -> int:
         return int(self.rng.integers(0, self.n))  # b: uniform, whatever the target
 
-
     def step(
         self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
     ) -> int | None:
@@ -1132,7 +1131,10 @@ class OffPolicyMCPrediction(Prediction):
 
 
 def true_values(
-    env: gymnasium.Env[Any, Any], n: int, gamma: float, pi: Callable[[int, int], float] | None = None
+    env: gymnasium.Env[Any, Any],
+    n: int,
+    gamma: float,
+    pi: Callable[[int, int], float] | None = None,
 ) -> tuple[list[int], list[float]]:
     """docs/algorithms.md, "The error": the policy's values on the measured states.
 
