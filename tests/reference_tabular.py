@@ -897,8 +897,9 @@ class Prediction(Agent):
             return last
         return self.rule(x)
 
-    def v(self, x: int) -> float:
-        return self.q[x][0]
+    def v(self, x: Any) -> float:
+        """``V(x)``: ``x``'s entry, or on tiles its tiles' weights summed (``value``)."""
+        return self.value(x, 0)
 
 
 class TD(Prediction):
@@ -1006,14 +1007,22 @@ class TrueOnlineTDLambda(Prediction, TraceAgent):
         v_next = 0.0 if terminated else self.v(s2)
         v_s = self.v(s)
         delta = r + self.gamma * v_next - v_s
-        flat = s * self.n  # the pair (s, 0), as the traces key it
-        z_s = self.traces.get(flat, 0.0)
+        # The pairs (s, 0) as the traces key them; on tiles (docs/algorithms.md, "Tile
+        # coding", true online) each of s's tiles, with a tile's step size alpha / T.
+        rows = s if isinstance(s, tuple) else (s,)
+        tile_alpha = self.alpha / len(rows) if isinstance(s, tuple) else self.alpha
+        z_s = 0.0 if isinstance(s, tuple) else self.traces.get(s * self.n, 0.0)
+        if isinstance(s, tuple):
+            for row in rows:
+                z_s = z_s + self.traces.get(row * self.n, 0.0)
         self.decay()
-        if flat not in self.traces:
-            self.traces[flat] = 0.0
-        self.traces[flat] = self.traces[flat] + (1.0 - self.alpha * self.gamma * self.lam * z_s)
+        for row in rows:
+            flat = row * self.n
+            if flat not in self.traces:
+                self.traces[flat] = 0.0
+            self.traces[flat] = self.traces[flat] + (1.0 - tile_alpha * self.gamma * self.lam * z_s)
         self.apply_scaled(self.alpha * (delta + v_s - self.v_old))
-        self.q[s][0] = self.q[s][0] + -(self.alpha * (v_s - self.v_old))
+        self.add(s, 0, -(self.alpha * (v_s - self.v_old)))
         self.v_old = v_next
         if terminated or truncated:
             self.traces.clear()
@@ -1135,10 +1144,13 @@ def true_values(
     n: int,
     gamma: float,
     pi: Callable[[int, int], float] | None = None,
-) -> tuple[list[int], list[float]]:
+    tile_rows: Callable[[Any], Any] | None = None,
+) -> tuple[list[Any], list[float]]:
     """docs/algorithms.md, "The error": the policy's values on the measured states.
 
-    ``pi(b, x)`` is the policy's probability of ``b`` in ``x`` (uniform if None).
+    ``pi(b, x)`` is the policy's probability of ``b`` in ``x`` (uniform if None); a world
+    observed as points (``point_of_state``, on tiles) measures each state on the tiles
+    ``tile_rows`` gives its point.
 
     ``(I - gamma * P_pi) v = r_pi`` from the world's table ``P``, solved by numpy; measured
     are the states reachable from the start distribution along outcomes that do not
@@ -1180,11 +1192,15 @@ def true_values(
     values = dict(zip(order, np.linalg.solve(system, expected[order]), strict=True))
     measured = [x for x in order if not terminal[x]]
     observed = getattr(env.unwrapped, "observation_of_state", None)
+    points = getattr(env.unwrapped, "point_of_state", None)
+    if points is not None:  # a world observed as points, on tiles: each state's tiles
+        assert tile_rows is not None
+        return [tile_rows(points[x]) for x in measured], [float(values[x]) for x in measured]
     rows = [x if observed is None else int(observed[x]) for x in measured]
     return rows, [float(values[x]) for x in measured]
 
 
-def rms_error(agent: Prediction, measured: list[int], truth: list[float]) -> float:
+def rms_error(agent: Prediction, measured: list[Any], truth: list[float]) -> float:
     """``math.sqrt(S / k)``, ``S`` the squared differences summed in state order from 0.0.
 
     ``measured`` holds each measured state's row (a row once per state observed as it).
@@ -1331,13 +1347,16 @@ def reference_train(
         n_states, n, weight_init, float(gamma), rng,
         {**defaults, **(params or {}), "tilings": tilings},
     )  # fmt: skip
-    measured: list[int] = []
+    measured: list[Any] = []
     truth: list[float] = []
     errors: list[float] | None = None
     if isinstance(agent, Prediction):
         threshold = None  # a prediction run never solves
-        if hasattr(env.unwrapped, "P"):
-            measured, truth = true_values(env, n, float(gamma), agent.pi_of)
+        # "State aggregation" and "Tile coding": a world observed as points is measured on
+        # tiles only (with one tiling nothing is measured).
+        points = getattr(env.unwrapped, "point_of_state", None)
+        if hasattr(env.unwrapped, "P") and (points is None or tilings > 1):
+            measured, truth = true_values(env, n, float(gamma), agent.pi_of, row)
             errors = []
     if isinstance(
         agent,

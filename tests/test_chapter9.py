@@ -76,7 +76,7 @@ def test_the_table_is_example_9_1s() -> None:
 def test_the_true_values_are_the_books_s_curve_per_true_state() -> None:
     """v(1) = -0.922 ... v(1000) = 0.922, odd about the middle; the same with groups."""
     plain = prediction_truth(_config(), inspect_env(_config()))
-    assert plain.states.tolist() == list(range(1, 1001)) == plain.rows.tolist()
+    assert plain.states.tolist() == list(range(1, 1001)) == plain.rows[:, 0].tolist()
     values = plain.values
     assert values[0] == pytest.approx(-0.92196046, abs=1e-8)
     assert values[-1] == pytest.approx(0.92196046, abs=1e-8)
@@ -87,7 +87,7 @@ def test_the_true_values_are_the_books_s_curve_per_true_state() -> None:
     assert values[99] == pytest.approx(-0.75418, abs=1e-5)
     grouped = prediction_truth(_config(10), inspect_env(_config(10)))
     assert grouped.states.tolist() == list(range(1, 1001))
-    assert grouped.rows.tolist() == [(s - 1) // 100 for s in range(1, 1001)]
+    assert grouped.rows[:, 0].tolist() == [(s - 1) // 100 for s in range(1, 1001)]
     assert grouped.values.tobytes() == values.tobytes()  # the world is the same, observed in groups
 
 
@@ -229,3 +229,41 @@ def test_gradient_mc_and_semi_gradient_td_approach_their_fixed_points() -> None:
         })  # fmt: skip
         learned = train(config, final_eval=False).v_table
         assert np.max(np.abs(learned - target)) < 0.06, (algorithm, learned, target)
+
+
+# -- tile coding: the walk observed as a point (env.kwargs.position) ---------------------------
+
+TILES = {"bins": [5], "low": [1.0], "high": [1001.0], "tilings": 50}
+
+
+def test_the_walk_observed_as_a_point_passes_check_env_and_refuses_groups() -> None:
+    env = gymnasium.make(WALK, position=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        check_env(env.unwrapped)
+    observation, _ = env.reset(seed=3)
+    assert observation.dtype == np.float32 and observation.tolist() == [500.0]
+    with pytest.raises(ValueError, match="position and groups"):
+        gymnasium.make(WALK, position=True, groups=10)
+    settings = twin_settings(WALK, {"position": True}, 10_000)
+    assert isinstance(settings, str)  # no twin observes points: the gymnasium engine
+
+
+def test_the_truth_on_tiles_is_each_states_fifty_tiles() -> None:
+    """Figure 9.10's coding: 50 tilings of 5 tiles of 200 states, offset by 4 states."""
+    overrides = {
+        "env.id": WALK, "env.kwargs": {"position": True}, "discretization": TILES,
+        "agent.algorithm": "td", "agent.gamma": 1.0,
+    }  # fmt: skip
+    config = load_config(overrides=overrides)
+    truth = prediction_truth(config, inspect_env(config))
+    assert truth.rows.shape == (1000, 50) and truth.states.tolist() == list(range(1, 1001))
+    table = load_config(overrides={**overrides, "discretization": None, "env.kwargs": {}})
+    exact = prediction_truth(table, inspect_env(table))
+    assert truth.values.tobytes() == exact.values.tobytes()  # the same walk, the same values
+    # state 1 lies in tile 0 of every tiling; the tilings shift by 4 states (1/50 of 200)
+    assert truth.rows[0].tolist() == [t * 6 for t in range(50)]
+    tiling_1 = truth.rows[:, 1] - 6  # tiling 1's tile of each state
+    assert tiling_1[:196].tolist() == [0] * 196 and tiling_1[196] == 1  # state 197 moves on
+    no_truth = load_config(overrides={**overrides, "discretization": {**TILES, "tilings": 1}})
+    assert not prediction_truth(no_truth, inspect_env(no_truth)).measured

@@ -43,7 +43,9 @@ def test_the_walks_true_values_are_the_book_s() -> None:
     ):
         config = _config(overrides)
         truth = prediction_truth(config, inspect_env(config))
-        assert truth.rows.tolist() == list(range(1, len(expected) + 1))  # the ends are left out
+        assert truth.rows[:, 0].tolist() == list(
+            range(1, len(expected) + 1)
+        )  # the ends are left out
         np.testing.assert_allclose(truth.values, expected, rtol=0, atol=1e-15)
 
 
@@ -227,7 +229,7 @@ def test_the_measured_states_are_those_an_episode_can_be_in() -> None:
     """Taxi's 100 states with the passenger at the destination are never occupied."""
     taxi = load_config(overrides={"env.id": "Taxi-v4", "agent.algorithm": "td", "agent.gamma": 0.9})
     truth = prediction_truth(taxi, inspect_env(taxi))
-    assert len(truth.rows) == 400 and len(set(truth.rows.tolist())) == 400
+    assert len(truth.rows) == 400 and len(set(truth.rows[:, 0].tolist())) == 400
 
 
 def test_a_policy_that_may_never_end_is_refused_at_gamma_1() -> None:
@@ -433,7 +435,7 @@ def test_the_one_state_mdp_and_importance_sampling() -> None:
     for policy, value in (("left", 1.0), ("random", 1 / 11)):
         config = load_config(overrides={**base, "agent.algorithm": "td", "agent.policy": policy})
         truth = prediction_truth(config, inspect_env(config))
-        assert truth.rows.tolist() == [0] and truth.values[0] == pytest.approx(value, abs=1e-15)
+        assert truth.rows.tolist() == [[0]] and truth.values[0] == pytest.approx(value, abs=1e-15)
     overrides = {
         **base, "agent.algorithm": "off_policy_mc_prediction", "agent.policy": "left",
         "train.episodes": 200, "seed": 2,
@@ -490,7 +492,7 @@ def test_blackjack_dealt_one_hand_measures_that_state() -> None:
         }
     )  # fmt: skip
     truth = prediction_truth(config, inspect_env(config))
-    assert truth.rows.tolist() == [(13 * 11 + 2) * 2 + 1]
+    assert truth.rows.tolist() == [[(13 * 11 + 2) * 2 + 1]]
     assert truth.values[0] == pytest.approx(-0.277204, abs=1e-6)
     result = train(config, final_eval=False)
     assert result.errors is not None

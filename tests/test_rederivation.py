@@ -558,6 +558,34 @@ def test_a_runs_policy(world: str, variant: str, engine: str) -> None:
     assert expected.errors is not None and expected.errors[-1] < expected.errors[0]
 
 
+# Example 9.1's walk observed as a point and tile-coded (Figure 9.10): 10 tilings of 5 tiles
+# of 200 states; V is the tiles' sum, measured on each of the 1000 states' tiles. No twin
+# observes points: the gymnasium engine alone. Every prediction algorithm that runs on tiles.
+CASES["walk1000_tiles"] = {
+    "env": {"id": "cartpole_q/RandomWalk1000-v0", "kwargs": {"position": True}},
+    "discretization": {"bins": [5], "low": [1.0], "high": [1001.0], "tilings": 10},
+    "agent": {"gamma": 1.0, "alpha": 0.3, "epsilon": 0.1, "q_init": 0.0},
+    "episodes": 8,
+    "seed": 10,
+}
+TILED_PREDICTION = [
+    variant
+    for variant, (algorithm, _) in PREDICTION_VARIANTS.items()
+    if algorithm not in ("mc_prediction", "batch_prediction", "off_policy_mc_prediction")
+]
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"), _params(["walk1000_tiles"], TILED_PREDICTION)
+)
+def test_prediction_on_tiles(world: str, variant: str, engine: str) -> None:
+    """Semi-gradient TD, n-step TD, TD(lambda), the lambda-return (gradient MC at lambda 1)
+    with tile coding: V and every episode's error against the 1000 states' true values."""
+    expected = _assert_same(world, variant, engine)
+    assert expected.errors is not None and len(expected.errors) == 8
+    assert expected.errors[-1] < expected.errors[0]
+
+
 def test_every_package_algorithm_is_re_derived() -> None:
     """A new algorithm in the package fails here until the re-derivation covers it."""
     package = {module.ALGORITHM.name for module in PACKAGE}

@@ -113,7 +113,8 @@ class Truth(NamedTuple):
     """
 
     rows: np.ndarray
-    """int64: the table row each measured state is observed as, the states in order"""
+    """int64 ``(k, T)``: the table rows each measured state is observed as, the states in
+    order: one row (``T = 1``) on a table, its ``T`` tiles on tiles (``V`` is their sum)"""
     values: np.ndarray
     """float64: the evaluated policy's exact value of each"""
     states: np.ndarray
@@ -124,7 +125,7 @@ class Truth(NamedTuple):
     def none(cls) -> Truth:
         """Nothing to measure."""
         nothing = np.zeros(0, dtype=np.int64)
-        return cls(nothing, np.zeros(0, dtype=np.float64), nothing.copy())
+        return cls(nothing.reshape(0, 1), np.zeros(0, dtype=np.float64), nothing.copy())
 
     @property
     def measured(self) -> bool:
@@ -280,12 +281,10 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     ``agent.gamma``; each model state is measured on the table row it is observed as
     (several on one row only where the world aggregates states by design: where two share a
     row by accident, as Blackjack's natural 21 and a 21 with a usable ace, nothing is
-    measured), or only the states the world names (Blackjack dealt one hand). Nothing is
-    measured for a world without a model, or on tiles.
+    measured), or only the states the world names (Blackjack dealt one hand). On tiles, a
+    world observed as points (its ``point_of_state``) measures each state on its tiles.
+    Nothing is measured for a world without a model.
     """
-    tiled = config.discretization is not None and config.discretization.tilings > 1
-    if tiled:
-        return Truth.none()
     # A sweep's runs of one point ask for the same values: solved once per process. A run's
     # policy is keyed by its actions (the file may change between two calls).
     from_run = config.agent.params.get("policy") in ("greedy", "epsilon_greedy")
@@ -362,7 +361,54 @@ def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
 
 def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     """:func:`prediction_truth`, solved (see there)."""
+    if config.discretization is not None and config.discretization.tilings > 1:
+        return _tiled_truth(config, env_info)
     return exact_values(config, env_info, measure_shared_rows=False)
+
+
+def _tiled_truth(config: Config, env_info: EnvInfo) -> Truth:
+    """The random policy's exact values, each state measured on the tiles of its point.
+
+    Only the random policy runs on tiles (a rule or a run's policy gives an action per
+    table row); a world that does not observe points (``point_of_state``) measures nothing.
+    """
+    from cartpole_q.envs.models import point_model
+    from cartpole_q.rl.tiles import active_tiles
+
+    found = point_model(config.env)
+    d = config.discretization
+    if found is None or d is None or config.agent.params.get("policy", "random") != "random":
+        return Truth.none()
+    tabular, points = found
+    pi = np.full((tabular.n_states, env_info.n_actions), 1.0 / env_info.n_actions)
+    reachable, values = _policy_values(config, tabular, pi)
+    measured = ~tabular.terminal_states()[reachable]
+    states = reachable[measured]
+    rows = np.zeros((len(states), d.tilings), dtype=np.int64)
+    low, high = np.array(d.low, dtype=np.float64), np.array(d.high, dtype=np.float64)
+    bins = np.array(d.bins, dtype=np.int64)
+    for i, state in enumerate(states):
+        active_tiles(points[state], low, high, bins, d.tilings, rows[i])
+    return Truth(rows, values[measured].astype(np.float64), states.astype(np.int64))
+
+
+def _policy_values(config: Config, tabular: Any, pi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The reachable states under ``pi`` and their values (``evaluate_policy``).
+
+    Raises:
+        ConfigError: naming ``agent.policy``: the values are not defined (``gamma`` 1 and a
+            policy that may never end an episode).
+    """
+    reachable = np.flatnonzero(reachable_states(tabular, pi))
+    try:
+        values = evaluate_policy(tabular, pi, config.agent.gamma, reachable)
+    except ValueError as error:
+        raise ConfigError(
+            f"agent.policy: the {config.agent.params.get('policy')} policy's values on "
+            f"{config.env.id} are not defined at agent.gamma {config.agent.gamma:g} ({error}); "
+            "give agent.gamma below 1."
+        ) from None
+    return reachable, values
 
 
 def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = True) -> Truth:
@@ -386,15 +432,7 @@ def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = 
         )
     )  # fmt: skip
     pi = rows_pi[row_of_state]
-    reachable = np.flatnonzero(reachable_states(tabular, pi))
-    try:
-        values = evaluate_policy(tabular, pi, config.agent.gamma, reachable)
-    except ValueError as error:
-        raise ConfigError(
-            f"agent.policy: the {config.agent.params.get('policy')} policy's values on "
-            f"{config.env.id} are not defined at agent.gamma {config.agent.gamma:g} ({error}); "
-            "give agent.gamma below 1."
-        ) from None
+    reachable, values = _policy_values(config, tabular, pi)
     measured = ~tabular.terminal_states()[reachable]
     if model.measured is not None:  # the world measures these states only
         measured &= np.isin(reachable, model.measured)
@@ -404,7 +442,9 @@ def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = 
     if shared and not (model.aggregates or measure_shared_rows):
         return Truth.none()  # states observed alike by accident: no one value per row
     return Truth(
-        rows.astype(np.int64), values[measured].astype(np.float64), states.astype(np.int64)
+        rows.astype(np.int64).reshape(-1, 1),
+        values[measured].astype(np.float64),
+        states.astype(np.int64),
     )
 
 

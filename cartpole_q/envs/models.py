@@ -121,6 +121,30 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
         made.close()
 
 
+def point_model(env: EnvConfig) -> tuple[TabularModel, np.ndarray] | None:
+    """The model of a world observed as points, and each state's point, or ``None``.
+
+    A world with a transition table that observes its states as points of a Box (its
+    ``point_of_state``, float32 ``(n_states, d)``: the 1000-state walk with ``position``)
+    has no table rows a policy could be read from, so :func:`env_model` gives it none; its
+    model still gives the true values of a prediction run on tiles.
+    """
+    from cartpole_q.envs.gym import make_env
+
+    made = make_env(env)
+    try:
+        unwrapped = made.unwrapped
+        points = getattr(unwrapped, "point_of_state", None)
+        transitions = getattr(unwrapped, "P", None)
+        initial = getattr(unwrapped, "initial_state_distrib", None)
+        if points is None or not isinstance(transitions, Mapping) or initial is None:
+            return None
+        model = TabularModel.from_transitions(transitions, initial, int(made.action_space.n))
+        return model, np.asarray(points, dtype=np.float32)
+    finally:
+        made.close()
+
+
 def _pays_only_success(model: TabularModel) -> bool:
     """Whether the only rewards are 1 on a terminating step and 0 otherwise."""
     paid = model.reward != 0

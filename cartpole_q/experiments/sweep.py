@@ -475,7 +475,7 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         lines.append(("initial values", states, start, start, start))
     for label, path in zip(labels, paths, strict=True):
         runs = load_run_set(path).runs
-        per_seed = np.array([run.q_table.reshape(-1)[truth.rows] for run in runs])
+        per_seed = np.array([_state_values(run.q_table, truth.rows) for run in runs])
         centre, low, high = aggregate_band(per_seed, "mean", rng)
         lines.append((label, states, centre, low, high))
     lines.append(("true values", states, truth.values, truth.values, truth.values))
@@ -683,3 +683,15 @@ def _threshold(spec: SweepSpec) -> float | None:
         return inspect_env(spec.points[0].config).reward_threshold
     except ConfigError:
         return None
+
+
+def _state_values(table: np.ndarray, rows: np.ndarray) -> np.ndarray:
+    """``V`` of each measured state: its row, or its ``T`` tiles summed in tiling order.
+
+    ``rows`` is a :class:`~cartpole_q.engines.base.Truth`'s ``(k, T)``.
+    """
+    weights = table.reshape(-1)
+    values = np.zeros(rows.shape[0])
+    for t in range(rows.shape[1]):
+        values = values + weights[rows[:, t]]
+    return values

@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from cartpole_q.rl.algorithm import MemoryContext, Param
-from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable, value
+from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable
 
 POLICIES = ("random", "stick_20", "left", "greedy", "epsilon_greedy")
 """``agent.policy`` values, in the order of their codes: ``random`` is uniform over the
@@ -153,17 +153,25 @@ def policy_table(context: MemoryContext) -> np.ndarray:
 
 @compilable
 def value_error(q: Table, rows: np.ndarray, values: np.ndarray) -> float:
-    """The root mean square error of ``V`` on ``rows`` against their true ``values``.
+    """The root mean square error of ``V`` on the ``k`` states of ``rows`` against ``values``.
 
-    ``sqrt(S / k)``: ``S`` sums ``(V(row) - value) * (V(row) - value)`` over the ``k`` rows
-    in order, from 0.0 (each state weighs the same, as Sutton & Barto's random walks do).
+    ``rows`` is ``(k, T)``: state ``i``'s estimate is ``0.0 + q[rows[i, 0], 0] + ... +
+    q[rows[i, T-1], 0]`` (its row on a table, ``T = 1``; its tiles' weights summed in tiling
+    order on tiles). ``sqrt(S / k)``: ``S`` sums ``(estimate - value) * (estimate - value)``
+    over the states in order, from 0.0 (each state weighs the same, as Sutton & Barto's random
+    walks do).
 
     >>> import numpy as np
-    >>> value_error(np.array([[0.5], [0.5]]), np.array([0, 1]), np.array([0.0, 1.0]))
+    >>> value_error(np.array([[0.5], [0.5]]), np.array([[0], [1]]), np.array([0.0, 1.0]))
     0.5
+    >>> value_error(np.array([[0.25], [0.5]]), np.array([[0, 1]]), np.array([1.0]))  # tiles
+    0.25
     """
     total = 0.0
     for i in range(rows.shape[0]):
-        difference = value(q, rows[i], 0) - values[i]
+        estimate = 0.0
+        for t in range(rows.shape[1]):
+            estimate += q[rows[i, t], 0]
+        difference = estimate - values[i]
         total += difference * difference
     return math.sqrt(total / rows.shape[0])

@@ -93,11 +93,20 @@ class JumpingWalkEnv(TableWorld):
     semi-gradient update of the group's weight is the tabular update of its row. The model
     (``P``) keeps every state: the true values are per state (:attr:`observation_of_state`).
 
+    **A point for tile coding.** With ``position=True`` the observation is the state's
+    number as a point on a line, ``Box(0, states + 1, (1,), float32)`` (state ``s`` observed
+    as ``[s]``), so that ``discretization`` with ``tilings: T > 1`` tile-codes it (section
+    9.5.4, Figure 9.10: 50 tilings of 5 tiles of 200 states are ``bins: [5], low: [1], high:
+    [1001], tilings: 50``). :attr:`point_of_state` declares the mapping, so the true values
+    are measured on tiles too.
+
     Args:
         states: the non-terminal states (even, so that the start is ``states // 2``).
         reach: the longest jump, either way.
         groups: aggregate the states into this many groups (it must divide ``states``), or
             ``None``: the observation is the state.
+        position: observe the state as a point (a Box) rather than an integer (not with
+            ``groups``).
 
     >>> walk = JumpingWalkEnv(states=10, reach=3, groups=2)
     >>> walk.P[9][1]  # from 9, right: to 10, or into the +1 end with probability 2/3
@@ -107,7 +116,11 @@ class JumpingWalkEnv(TableWorld):
     """
 
     def __init__(
-        self, states: int = JUMP_STATES, reach: int = JUMP_REACH, groups: int | None = None
+        self,
+        states: int = JUMP_STATES,
+        reach: int = JUMP_REACH,
+        groups: int | None = None,
+        position: bool = False,
     ) -> None:
         if states < 2 or states % 2:
             raise ValueError(f"the jumping walk needs an even number of states, got {states}")
@@ -126,6 +139,11 @@ class JumpingWalkEnv(TableWorld):
                 np.int64
             )
             self.observation_space = spaces.Discrete(groups)
+        if position:
+            if groups is not None:
+                raise ValueError("position and groups are two observations: give one")
+            self.point_of_state = np.arange(states + 2, dtype=np.float32).reshape(-1, 1)
+            self.observation_space = spaces.Box(0.0, float(states + 1), (1,), np.float32)
 
     def _table(self) -> Table:
         """``P``: the jumps that stay on the walk, then the one into an end; absorbing ends."""

@@ -42,6 +42,11 @@ class TableWorld(gymnasium.Env[Any, Any]):
     itself); a world that sets it aggregates states, and its compiled twin is
     ``envs/twins/aggregated_table.py``"""
 
+    point_of_state: np.ndarray | None = None
+    """float32 ``(n_states, d)``: a world observed as points (a Box) rather than integers
+    gives each state's observation here (``None``: it observes integers); tile coding then
+    measures the true values on each state's tiles"""
+
     def __init__(self, n_states: int, n_actions: int, start: int) -> None:
         self.observation_space = spaces.Discrete(n_states)
         self.action_space = spaces.Discrete(n_actions)
@@ -52,13 +57,13 @@ class TableWorld(gymnasium.Env[Any, Any]):
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[int, dict[str, Any]]:
+    ) -> tuple[Any, dict[str, Any]]:
         """Start an episode: the start state, drawn as the toy-text worlds draw it."""
         super().reset(seed=seed)
         self.s = int(categorical_sample(self.initial_state_distrib, self.np_random))
         return self.observe(self.s), {"prob": 1.0}
 
-    def step(self, action: int) -> tuple[int, float, bool, bool, dict[str, Any]]:
+    def step(self, action: int) -> tuple[Any, float, bool, bool, dict[str, Any]]:
         """Take ``action``: one outcome of ``P[s][action]``, drawn with ``np_random``."""
         outcomes = self.P[self.s][int(action)]
         chosen = int(categorical_sample([outcome[0] for outcome in outcomes], self.np_random))
@@ -66,8 +71,10 @@ class TableWorld(gymnasium.Env[Any, Any]):
         self.s = following
         return self.observe(following), reward, terminated, False, {"prob": probability}
 
-    def observe(self, state: int) -> int:
-        """The observation of ``state``: the state, or its group where the world aggregates."""
+    def observe(self, state: int) -> Any:
+        """The observation of ``state``: the state, its group, or its point (a Box world)."""
+        if self.point_of_state is not None:
+            return self.point_of_state[state].copy()
         if self.observation_of_state is None:
             return state
         return int(self.observation_of_state[state])
