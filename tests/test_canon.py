@@ -24,6 +24,7 @@ from tests.conftest import invoke
 NEW = (
     "n_step_sarsa", "n_step_tree_backup", "sarsa_lambda", "watkins_q_lambda",
     "true_online_sarsa_lambda", "dyna_q", "dyna_q_plus", "monte_carlo", "off_policy_monte_carlo",
+    "monte_carlo_es",
 )  # fmt: skip
 SHORT = {
     "train": {"episodes": 150, "stop_when_solved": False, "eval_every": 0},
