@@ -118,7 +118,7 @@ def test_the_policy_figure_draws_the_greedy_policy_beside_the_optimum(tmp_path: 
     panels = {row.rsplit('",', 1)[0].lstrip('"') for row in rows}
     assert len(rows) == 8 * 100 and len(panels) == 8
     exact = [row for row in rows if row.startswith('"exact optimum (the rules), policy, no')]
-    assert [row.rsplit(",", 5)[1:3] + [row.rsplit(",", 1)[1]] for row in exact[:4]] == [
+    assert [[*row.rsplit(",", 5)[1:3], row.rsplit(",", 1)[1]] for row in exact[:4]] == [
         ["1", "12", "1"], ["2", "12", "1"], ["3", "12", "1"], ["4", "12", "0"]
     ]  # fmt: skip
     assert any(" of 200 optimal, policy, usable ace" in panel for panel in panels)
