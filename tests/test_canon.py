@@ -147,6 +147,7 @@ def _last_step(name: str, *, terminated: bool, truncated: bool, **params: Any) -
         ("true_online_sarsa_lambda", {}, 4.0),
         ("dyna_q", {"planning_steps": 0}, 4.0),
         ("monte_carlo", {"update": "constant_alpha"}, 4.0),  # E(s'), the epsilon-greedy value
+        ("monte_carlo_es", {"update": "constant_alpha"}, 4.0),  # monte_carlo's, unchanged
         ("off_policy_monte_carlo", {}, 4.0),  # max(s'), the greedy target's value
     ],
 )
