@@ -881,6 +881,61 @@ def blackjack_values_figure(maps: Sequence[tuple[str, np.ndarray]], title: str) 
     return figure
 
 
+def blackjack_optimal_figure(
+    maps: Sequence[tuple[str, np.ndarray, np.ndarray]], title: str
+) -> DataFigure:
+    """Blackjack's policy and its values as Sutton & Barto's Figure 5.2, one pair per map.
+
+    Each map is ``(label, policy, values)``, both of shape ``(32, 11, 2)`` (player sum,
+    dealer's card, usable ace): the action in each state (0 stick, 1 hit) and its value.
+    Drawn for player sums 12-21: a policy panel and a value panel (from -1 to 1) per map,
+    usable ace above, none below. Every other map's policy cells that differ from the last map's (the exact optimum, when it is last)
+    are marked with a cross.
+    """
+    from matplotlib.patches import Patch
+
+    sums, dealer = np.arange(12, 22), np.arange(1, 11)
+    figure = DataFigure(figsize=(3.3 * 2 * len(maps) + 1.4, 6.6), dpi=DPI, layout="constrained")
+    panels = np.asarray(figure.subplots(2, 2 * len(maps), squeeze=False))
+    colours = ListedColormap(["#d9e6f2", "#c0392b"])
+    image = None
+    for column, (label, policy, values) in enumerate(maps):
+        for row, usable in enumerate((1, 0)):
+            ace = "usable ace" if usable else "no usable ace"
+            chosen = policy[12:22, 1:11, usable]
+            axes = panels[row, 2 * column]
+            axes.imshow(chosen.astype(float), origin="lower", cmap=colours, vmin=0, vmax=1,
+                        aspect="auto", extent=(0.5, 10.5, 11.5, 21.5), interpolation="nearest")  # fmt: skip
+            figure.data.panel(f"{label}, policy, {ace}").cells(
+                "action (0 stick / 1 hit)", dealer.tolist(), sums.tolist(), chosen
+            )
+            if column < len(maps) - 1:
+                other = maps[-1][1][12:22, 1:11, usable]
+                for i, j in zip(*np.nonzero(chosen != other), strict=True):
+                    axes.plot(dealer[j], sums[i], marker="x", color="black", markersize=8)
+            axes.set_title(f"{label}\npolicy, {ace}", fontsize="small")
+            shown = values[12:22, 1:11, usable]
+            axes_v = panels[row, 2 * column + 1]
+            image = axes_v.imshow(shown, origin="lower", cmap="RdYlGn", vmin=-1.0, vmax=1.0,
+                                  aspect="auto", extent=(0.5, 10.5, 11.5, 21.5),
+                                  interpolation="nearest")  # fmt: skip
+            figure.data.panel(f"{label}, values, {ace}").cells(
+                "value", dealer.tolist(), sums.tolist(), shown
+            )
+            axes_v.set_title(f"{label}\nvalues, {ace}", fontsize="small")
+            for each in (axes, axes_v):
+                each.set_xticks(dealer, ["A", *map(str, range(2, 11))])
+                each.set_yticks(sums)
+                each.set_xlabel("dealer showing")
+                each.set_ylabel("player sum")
+    if image is not None:
+        figure.colorbar(image, ax=panels, label="value", shrink=0.8)
+    handles = [Patch(color="#c0392b", label="hit"), Patch(color="#d9e6f2", label="stick")]
+    figure.legend(handles=handles, loc="outside lower center", ncol=2)
+    figure.suptitle(title)
+    return figure
+
+
 def robustness_figure(
     axes_values: Sequence[tuple[str, np.ndarray]],
     means: np.ndarray,

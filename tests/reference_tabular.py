@@ -351,6 +351,10 @@ class Agent:
             return int(self.rng.integers(0, self.n))
         return self.exploit(x)
 
+    def start(self, x: int) -> int:
+        """An episode's first action: ``draw(x)`` (design.md), unless the algorithm says else."""
+        return self.draw(x)
+
     def exploit(self, x: int) -> int:
         """The greedy branch: the lowest best action, or with ``tie_break: random`` one of the
         ``k`` tied best, the ``rng.integers(0, k)``-th in action order (no draw when k = 1)."""
@@ -838,6 +842,13 @@ class MonteCarlo(Agent):
             w = w / self.behaviour[t]
 
 
+class MonteCarloES(MonteCarlo):
+    """``monte_carlo_es``: ``monte_carlo`` whose first action is one ``rng.integers(0, n)``."""
+
+    def start(self, x: int) -> int:
+        return int(self.rng.integers(0, self.n))
+
+
 class OffPolicyMonteCarlo(MonteCarlo):
     """``off_policy_monte_carlo``: behaviour epsilon-greedy, target greedy."""
 
@@ -1225,6 +1236,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "dyna_q": DynaQ,
     "dyna_q_plus": DynaQPlus,
     "monte_carlo": MonteCarlo,
+    "monte_carlo_es": MonteCarloES,
     "off_policy_monte_carlo": OffPolicyMonteCarlo,
     "td": TD,
     "n_step_td": NStepTD,
@@ -1383,7 +1395,7 @@ def reference_train(
             set_physics(env, drawn)
         observation, _ = env.reset(seed=env_seed if episode == 0 else None)
         s = row(observation)
-        a: int | None = agent.draw(s)
+        a: int | None = agent.start(s)
         episode_return, length = 0.0, 0
         while a is not None:
             observation, reward, terminated, truncated, _ = env.step(a)

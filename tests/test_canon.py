@@ -24,6 +24,7 @@ from tests.conftest import invoke
 NEW = (
     "n_step_sarsa", "n_step_tree_backup", "sarsa_lambda", "watkins_q_lambda",
     "true_online_sarsa_lambda", "dyna_q", "dyna_q_plus", "monte_carlo", "off_policy_monte_carlo",
+    "monte_carlo_es",
 )  # fmt: skip
 SHORT = {
     "train": {"episodes": 150, "stop_when_solved": False, "eval_every": 0},
@@ -146,6 +147,7 @@ def _last_step(name: str, *, terminated: bool, truncated: bool, **params: Any) -
         ("true_online_sarsa_lambda", {}, 4.0),
         ("dyna_q", {"planning_steps": 0}, 4.0),
         ("monte_carlo", {"update": "constant_alpha"}, 4.0),  # E(s'), the epsilon-greedy value
+        ("monte_carlo_es", {"update": "constant_alpha"}, 4.0),  # monte_carlo's, unchanged
         ("off_policy_monte_carlo", {}, 4.0),  # max(s'), the greedy target's value
     ],
 )

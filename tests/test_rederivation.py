@@ -66,7 +66,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
     **{
         f"{name}-{update}": (name, {"update": update})
-        for name in ("monte_carlo", "off_policy_monte_carlo")
+        for name in ("monte_carlo", "monte_carlo_es", "off_policy_monte_carlo")
         for update in ("sample_average", "constant_alpha")
     },
 }
@@ -87,9 +87,16 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
             "dyna_q",
             "dyna_q_plus",
             "monte_carlo",
+            "monte_carlo_es",
             "off_policy_monte_carlo",
         )
     },
+    # Monte Carlo ES as the book's (section 5.3): greedy after the uniform first action.
+    "monte_carlo_es-greedy": ("monte_carlo_es", {"epsilon": 0.0}),
+    "monte_carlo_es-greedy-random-ties": (
+        "monte_carlo_es",
+        {"epsilon": 0.0, "tie_break": "random"},
+    ),
     "n_step_sarsa-n1": ("n_step_sarsa", {"n": 1}),
     "n_step_tree_backup-n1": ("n_step_tree_backup", {"n": 1}),
     "n_step_sarsa-n150": ("n_step_sarsa", {"n": 150}),
@@ -151,6 +158,14 @@ PREDICTION_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         {"target": "mc", "alpha": 0.005, "tolerance": 1e-9, "max_passes": 10},
     ),
 }
+ES_VARIANTS = [
+    "monte_carlo_es-sample_average",
+    "monte_carlo_es-constant_alpha",
+    "monte_carlo_es-greedy",
+    "monte_carlo_es-greedy-random-ties",
+    "monte_carlo-sample_average",
+]
+"""the variants run on the exploring-starts world (monte_carlo: its starts without ES)"""
 AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init"}
 """keys a variant may give that are the agent's own, not its algorithm's"""
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
@@ -313,6 +328,13 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 600,
         "seed": 10,
     },
+    # Exploring starts (Example 5.3): a uniformly random one of 200 states every episode.
+    "blackjack_es": {
+        "env": {"id": "cartpole_q/BlackjackES-v0"},
+        "agent": {"gamma": 1.0, "alpha": 0.1, "epsilon": 0.1, "q_init": 0.0},
+        "episodes": 6000,
+        "seed": 11,
+    },
     # Tile coding: 4 tilings of a 4 x 3 grid (docs/algorithms.md, "Tile coding").
     "mountaincar_tiles": {
         "env": {"id": "MountainCar-v0"},
@@ -340,7 +362,7 @@ NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physic
 NUMBA_WORLDS |= {"walk5", "walk19", "walk1000"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
-NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack"}
+NUMBA_WORLDS |= {"frozenlake", "taxi", "cliffwalking", "blackjack", "blackjack_es"}
 # The numba engine compiles one loop per (algorithm, twin), about 15 s each on a cold cache
 # (30 s on tiles), so it runs every variant on CartPole's twin only. The algorithms' hooks
 # are the same code on every twin, and the gymnasium engine runs every variant everywhere;
@@ -372,6 +394,8 @@ OTHER_TWIN_VARIANTS = {
         "td-greedy",
         "mc_prediction-epsilon_greedy",
     },
+    # Figure 5.2's world and algorithm (its study compiles this loop anyway)
+    "blackjack_es": set(ES_VARIANTS),
     # Chapter 9's algorithms on the aggregated walk: gradient MC, semi-gradient TD(0), n-step.
     "walk1000": {"td", "mc_prediction", "n_step_td"},
 }
@@ -584,6 +608,18 @@ def test_prediction_on_tiles(world: str, variant: str, engine: str) -> None:
     expected = _assert_same(world, variant, engine)
     assert expected.errors is not None and len(expected.errors) == 8
     assert expected.errors[-1] < expected.errors[0]
+
+
+@pytest.mark.parametrize(("world", "variant", "engine"), _params(["blackjack_es"], ES_VARIANTS))
+def test_exploring_starts(world: str, variant: str, engine: str) -> None:
+    """Monte Carlo ES on Blackjack started in a random state: every pair starts episodes."""
+    expected = _assert_same(world, variant, engine)
+    started = expected.visits[12:22, 1:11, :, :]
+    assert started.shape == (10, 10, 2, 2)
+    if variant.startswith("monte_carlo_es"):
+        assert started.min() > 0  # all 400 pairs taken
+    else:  # epsilon-greedy first actions: this seed leaves some pair untried
+        assert started.min() == 0
 
 
 def test_every_package_algorithm_is_re_derived() -> None:

@@ -71,7 +71,9 @@ def test_offsets_are_asymmetric_and_one_bin_dimensions_ignored() -> None:
 
 
 def test_dyna_and_monte_carlo_are_refused_on_tiles() -> None:
-    for algorithm in ("dyna_q", "dyna_q_plus", "monte_carlo", "off_policy_monte_carlo"):
+    for algorithm in (
+        "dyna_q", "dyna_q_plus", "monte_carlo", "monte_carlo_es", "off_policy_monte_carlo",
+    ):  # fmt: skip
         with pytest.raises(ConfigError, match=r"discretization.tilings: tile coding"):
             load_config("mountaincar_tiles", {"agent.algorithm": algorithm})
 

@@ -74,6 +74,9 @@ SETTINGS: dict[str, tuple[str, dict[str, Any], float]] = {
     "blackjack-no-sab": ("Blackjack-v1", {"sab": False}, 0.7),
     "blackjack-natural": ("Blackjack-v1", {"sab": False, "natural": True}, 0.7),
     "blackjack-sab-natural": ("Blackjack-v1", {"natural": True}, 0.7),
+    # Sutton & Barto's Example 5.3: a uniformly random one of 200 states every episode
+    "blackjack-es": ("cartpole_q/BlackjackES-v0", {}, 0.7),
+    "blackjack-es-no-sab": ("cartpole_q/BlackjackES-v0", {"sab": False, "natural": True}, 0.7),
     # Sutton & Barto's worlds that play their table (cartpole_q/worlds/)
     "windy": ("cartpole_q/WindyGridworld-v0", {}, 0.5),
     "kings-stay": ("cartpole_q/KingsWindyGridworld-v0", {"stay": True}, 0.5),
@@ -117,7 +120,7 @@ def test_numba_draws_what_numpy_draws_for_random_and_choice() -> None:
 def _purposeful_policy(env_id: str, kwargs: dict[str, Any]) -> Any:
     """An action for an observation that tends to end episodes (the goal, a drop-off, a stick)."""
     env = gym.make(env_id, **kwargs).unwrapped
-    if env_id.startswith("Blackjack"):
+    if "Blackjack" in env_id:
         return lambda observation: int(observation[0] < 17)
     n_actions = int(env.action_space.n)  # type: ignore[attr-defined]
     model = TabularModel.from_transitions(env.P, env.initial_state_distrib, n_actions)  # type: ignore[attr-defined]
@@ -175,7 +178,7 @@ def _side_by_side(name: str, seed: int, steps: int) -> Counter[str]:
             seen["terminated" if terminated else "truncated"] += 1
             gym_observation, _ = env.reset()
             twin.reset(state, observation, rng, params)
-            if env_id.startswith("FrozenLake"):
+            if env_id.startswith(("FrozenLake", "cartpole_q/BlackjackES")):
                 seen["start " + str(_components(gym_observation))] += 1
             length = 0
     assert tuple(observation.tolist()) == _components(gym_observation)
@@ -204,8 +207,29 @@ def test_twin_steps_as_gymnasium_does(name: str, seed: int) -> None:
         assert seen["reward -100"] > 0 and seen["terminated"] > 0, seen
     if name == "blackjack-natural":
         assert seen["reward 1.5"] > 0, seen
-    if env_id.startswith("Blackjack"):
+    if "Blackjack" in env_id:
         assert seen["reward 1"] and seen["reward -1"] and seen["reward 0"], seen
+    if env_id.startswith("cartpole_q/BlackjackES"):  # every one of the 200 states, no natural
+        starts = {key for key in seen if key.startswith("start")}
+        assert len(starts) == 200, len(starts)
+        assert seen["reward 1.5"] == 0, seen
+
+
+def test_exploring_starts_deal_the_drawn_state_never_a_natural() -> None:
+    """The ES world's reset: three draws pick the state, a fourth the dealer's hidden card."""
+    env = gym.make("cartpole_q/BlackjackES-v0").unwrapped
+    for seed in range(40):
+        observation, _ = env.reset(seed=seed)
+        draws = seeding.np_random(seed)[0]
+        player_sum = 12 + int(draws.integers(0, 10))
+        card = 1 + int(draws.integers(0, 10))
+        usable = int(draws.integers(0, 2))
+        hidden = [1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 10, 10, 10][int(draws.integers(0, 13))]
+        assert tuple(int(v) for v in observation) == (player_sum, card, usable), seed
+        assert env.dealer == [card, hidden]  # type: ignore[attr-defined]
+        assert sorted(env.player) != [1, 10]  # type: ignore[attr-defined]
+        assert draws.bit_generator.state == env.np_random.bit_generator.state
+    assert len(env.measured_states) == 200  # type: ignore[attr-defined]
 
 
 def test_the_table_is_the_environments_own() -> None:

@@ -31,9 +31,14 @@ from cartpole_q.config import (
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
-from cartpole_q.experiments.sweep_spec import VALUES_FIGURE, SweepSpec, load_sweep
+from cartpole_q.experiments.sweep_spec import POLICY_FIGURE, VALUES_FIGURE, SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
-from cartpole_q.figures import DataFigure, blackjack_values_figure, summary_line_figure
+from cartpole_q.figures import (
+    DataFigure,
+    blackjack_optimal_figure,
+    blackjack_values_figure,
+    summary_line_figure,
+)
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
 from cartpole_q.profiles import profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
@@ -379,6 +384,8 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
         return plot_against(spec, paths, directory / figure.file)
     if figure.metric == VALUES_FIGURE:
         return plot_values(spec, paths, labels, directory / figure.file)
+    if figure.metric == POLICY_FIGURE:
+        return plot_policy(spec, paths, labels, directory / figure.file)
     return plot_metric(
         paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
         figure.smooth, figure.log_y, force=True, style=style,
@@ -484,6 +491,95 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         figure.log_y, (figure.y_min, figure.y_max), second,
     )  # fmt: skip
     return write_figure(out, drawn)
+
+
+INDIFFERENT = 1e-12
+"""below this gap between the exact values of stick and hit a state counts as indifferent:
+either action is optimal"""
+
+
+@dataclass(frozen=True)
+class PolicyMatch:
+    """A greedy policy against the exact optimal one, on the states Figure 5.2 draws."""
+
+    states: int
+    """the states compared: player sums 12-21, every dealer card, usable ace or not (200)"""
+    matching: int
+    """the states whose greedy action is the optimal one (or either, where indifferent)"""
+    indifferent: int
+    """the states where both actions are optimal (their exact values within
+    :data:`INDIFFERENT`)"""
+    differing: tuple[tuple[int, int, int], ...]
+    """``(player sum, dealer card, usable ace)`` of each state that differs"""
+    largest_value_error: float
+    """the largest ``|max_b Q(s, b) - v*(s)|`` over the states compared"""
+
+
+def blackjack_optimum(config: Config) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Blackjack's exact optimal action values from the rules, as ``(32, 11, 2, 2)`` tables.
+
+    Returns:
+        ``q*`` per observation row and action, the optimal policy (the lowest action among
+        the maxima: stick on ties) and ``v*``, each shaped by the observation.
+    """
+    from cartpole_q.envs.models import BLACKJACK_SHAPE, env_model
+    from cartpole_q.rl.value_iteration import finite_horizon
+
+    exact = env_model(config.env)
+    if isinstance(exact, str):
+        raise RunError(f"figure.metric: policy needs the exact model of {config.env.id}: {exact}.")
+    solution = finite_horizon(exact.model, exact.horizon)
+    rows = int(np.prod(BLACKJACK_SHAPE))  # model states 0..rows-1 are the observation rows
+    q_star = solution.q[:rows].reshape(*BLACKJACK_SHAPE, -1)
+    return q_star, np.argmax(q_star, axis=-1), q_star.max(axis=-1)
+
+
+def policy_match(q_table: np.ndarray, q_star: np.ndarray) -> PolicyMatch:
+    """Compare the greedy actions of ``q_table`` with ``q_star``'s on the 200 states."""
+    greedy = np.argmax(q_table, axis=-1)
+    optimal = np.argmax(q_star, axis=-1)
+    matching = indifferent = 0
+    differing = []
+    error = 0.0
+    for player_sum in range(12, 22):
+        for card in range(1, 11):
+            for usable in (0, 1):
+                state = (player_sum, card, usable)
+                tie = abs(float(q_star[state][0] - q_star[state][1])) < INDIFFERENT
+                indifferent += int(tie)
+                if tie or greedy[state] == optimal[state]:
+                    matching += 1
+                else:
+                    differing.append(state)
+                error = max(error, abs(float(q_table[state].max() - q_star[state].max())))
+    return PolicyMatch(200, matching, indifferent, tuple(differing), error)
+
+
+def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path) -> Path:
+    """The ``figure.metric: policy`` figure: greedy policies and ``max_b Q`` beside the optimum.
+
+    Each point's table is the mean of its seeds' ``Q``; its greedy policy (lowest action on
+    ties) and ``max_b Q`` are drawn beside the exact optimal policy and ``v*`` of the first
+    point's world, from its rules (Sutton & Barto Figure 5.2). Each point's label says how
+    many of the 200 states' greedy actions are optimal.
+    """
+    from cartpole_q.envs.gym import inspect_env
+
+    figure = spec.figure
+    assert figure is not None
+    first = spec.points[0].config
+    info = inspect_env(first)
+    q_star, optimal, v_star = blackjack_optimum(first)
+    maps = []
+    for label, path in zip(labels, paths, strict=True):
+        runs = load_run_set(path).runs
+        tables = np.array([run.q_table.reshape(*info.state_shape, -1) for run in runs])
+        q_table = tables.mean(axis=0)
+        match = policy_match(q_table, q_star)
+        name = f"{label}: {match.matching} of {match.states} optimal"
+        maps.append((name, np.argmax(q_table, axis=-1), q_table.max(axis=-1)))
+    maps.append(("exact optimum (the rules)", optimal, v_star))
+    return write_figure(out, blackjack_optimal_figure(maps, figure.title or spec.name))
 
 
 def plan_tasks(

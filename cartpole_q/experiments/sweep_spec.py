@@ -69,6 +69,11 @@ VALUES_FIGURE = "values"
 """``figure.metric: values``: each point's learned ``V`` against the state, beside the true
 values (prediction; Sutton & Barto Example 6.2's left panel)"""
 
+POLICY_FIGURE = "policy"
+"""``figure.metric: policy``: each point's greedy policy and its values ``max_b Q``, beside
+the exact optimal policy and ``v*`` from the world's model (control on a Blackjack world;
+Sutton & Barto Figure 5.2)"""
+
 
 @dataclass(frozen=True)
 class FigureSpec:
@@ -82,7 +87,8 @@ class FigureSpec:
     metric: str
     """a learning-curve metric (``plot --metric``), or ``values``: each point's learned
     ``V`` per state (the mean over seeds, a 95% bootstrap interval), the policy's true
-    values and the initial values beside them"""
+    values and the initial values beside them; or ``policy``: each point's greedy policy
+    and ``max_b Q`` (of its seeds' mean ``Q``) beside the exact optimum (Blackjack)"""
     x: str = "episode"
     aggregate: str = "mean"
     smooth: int = 1
@@ -270,6 +276,24 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
     from cartpole_q.learning_curves import ERROR_METRIC, info_key_of
     from cartpole_q.rl.algorithms import get as get_algorithm
 
+    if metric == POLICY_FIGURE:
+        from cartpole_q.profiles import profile_for
+
+        for point in points:
+            config = point.config
+            if get_algorithm(config.agent.algorithm).predicts:
+                raise ConfigError(
+                    f"{where}: figure.metric: policy draws a control run's greedy policy, but "
+                    f"point {point.index} runs agent.algorithm {config.agent.algorithm}, a "
+                    "prediction algorithm; draw values of it instead."
+                )
+            if profile_for(config.env.id).policy_map != "blackjack":
+                raise ConfigError(
+                    f"{where}: figure.metric: policy draws Blackjack's policy as Sutton & "
+                    f"Barto's Figure 5.2, but point {point.index} plays {config.env.id}; it "
+                    "needs a Blackjack world (Blackjack-v1, cartpole_q/BlackjackES-v0)."
+                )
+        return
     if metric in (ERROR_METRIC, VALUES_FIGURE):
         for point in points:
             algorithm = point.config.agent.algorithm
@@ -317,12 +341,12 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         )
     metric = values["metric"]
     problem = check_metric(metric) if isinstance(metric, str) else "not a string"
-    if metric == VALUES_FIGURE:
+    if metric in (VALUES_FIGURE, POLICY_FIGURE):
         problem = None
         if values.get("against") is not None:
             raise ConfigError(
-                f"{where}: figure.against: draws a metric against an axis; metric: values "
-                "draws V against the state, so leave one of them out."
+                f"{where}: figure.against: draws a metric against an axis; metric: {metric} "
+                "draws a table against the state, so leave one of them out."
             )
     if problem is not None:
         raise ConfigError(f"{where}: figure.metric: {shown_value(metric)} is {problem}.")

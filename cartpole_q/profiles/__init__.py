@@ -87,6 +87,7 @@ def _entry_point(env_id: str) -> str | None:
 for _profile in (
     cartpole.PROFILE, mountaincar.PROFILE, acrobot.PROFILE, toy_text.FROZENLAKE,
     toy_text.TAXI, toy_text.CLIFFWALKING, toy_text.BLACKJACK, toy_text.BLACKJACK_DEALT,
+    toy_text.BLACKJACK_ES,
     book.WINDY_GRIDWORLD,
     book.KINGS_WINDY_GRIDWORLD, book.DYNA_MAZE, book.MAXIMIZATION_BIAS, book.RANDOM_WALK,
     book.RANDOM_WALK_1000, book.ONE_STATE, planning.GRIDWORLDS, planning.GAMBLER,

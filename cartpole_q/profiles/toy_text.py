@@ -111,3 +111,17 @@ BLACKJACK_DEALT = EnvProfile(
     model="blackjack",
     policies=MappingProxyType({"stick_20": stick_on_20}),
 )
+
+BLACKJACK_ES = EnvProfile(
+    name="BlackjackES",
+    description="Blackjack dealt a uniformly random one of its 200 states every episode "
+    "(exploring starts, Sutton & Barto's Example 5.3)",
+    ids=("cartpole_q/BlackjackES-v0",),
+    entry_points=("cartpole_q.worlds.blackjack_dealt:BlackjackExploringStartsEnv",),
+    observation_names=("player sum", "dealer card", "usable ace"),
+    action_names=("stick", "hit"),
+    policy_map="blackjack",
+    model="blackjack",
+    twin="cartpole_q.envs.twins.blackjack_es",
+    policies=MappingProxyType({"stick_20": stick_on_20}),
+)

@@ -27,13 +27,14 @@ id                                         world
 ``cartpole_q/Gambler-v0``                  Example 4.3, Figure 4.3 (:mod:`~cartpole_q.worlds.gambler`)
 =========================================  ==================================================
 
-Blackjack dealt one hand (chapter 5), :data:`BLACKJACK_WORLDS` (a ``Tuple`` observation,
+Blackjack dealt one hand or a random state (chapter 5), :data:`BLACKJACK_WORLDS` (a ``Tuple`` observation,
 Gymnasium's ``Blackjack-v1`` after the deal; no transition table, a model from the rules):
 
 =========================================  ==================================================
 id                                         world
 =========================================  ==================================================
 ``cartpole_q/BlackjackDealt-v0``           Example 5.4, Figure 5.3: 13 with a usable ace against a 2 (:mod:`~cartpole_q.worlds.blackjack_dealt`)
+``cartpole_q/BlackjackES-v0``              Example 5.3, Figure 5.2: a uniformly random one of 200 states (exploring starts)
 =========================================  ==================================================
 
 The bandit of chapter 2 (``cartpole-q bandit``), :data:`BANDIT_WORLDS`:
@@ -134,6 +135,11 @@ BLACKJACK_WORLDS: Sequence[World] = (
     World(
         f"{NAMESPACE}/BlackjackDealt-v0",
         "cartpole_q.worlds.blackjack_dealt:BlackjackDealtEnv",
+        None,
+    ),
+    World(
+        f"{NAMESPACE}/BlackjackES-v0",
+        "cartpole_q.worlds.blackjack_dealt:BlackjackExploringStartsEnv",
         None,
     ),
 )
