@@ -29,7 +29,7 @@ from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.sweep_spec import load_sweep
 from cartpole_q.statistics import summarize_point
 from cartpole_q.store import sweepdir
-from tests.conftest import invoke, then_sigint, write_yaml
+from tests.conftest import REPO, invoke, then_sigint, write_yaml
 
 # Short runs: 60 episodes of CartPole (few solve), so a sweep of 12 runs takes a second.
 BASE = {
@@ -738,3 +738,17 @@ def test_a_figure_from_results_and_its_dashed_lines_are_checked(
     figure = {key: value for key, value in figure.items() if value is not None}
     with pytest.raises(ConfigError, match=re.escape(named)):
         load_sweep({**CLIFF, "curves": curves, "figure": figure})
+
+
+def test_the_figure_6_3_study_file_runs_the_books_grid() -> None:
+    """examples/book/fig6_3_cliff_alpha.yaml: 3 algorithms x {100, 100,000} episodes x 19 alphas."""
+    spec = load_sweep(REPO / "examples" / "book" / "fig6_3_cliff_alpha.yaml")
+    assert spec.grid["agent.algorithm"] == ["sarsa", "expected_sarsa", "q_learning"]
+    assert spec.grid["train.episodes"] == [100, 100_000]
+    assert spec.grid["agent.alpha"] == [round(0.1 + 0.05 * i, 2) for i in range(19)]
+    assert spec.seeds == tuple(range(100)) and spec.runs == 11_400 and not spec.curves
+    assert spec.figure is not None and spec.figure.dashed == {"train.episodes": 100}
+    agent = spec.points[0].config.agent
+    assert (agent.gamma, agent.epsilon.start, agent.q_init, agent.tie_break) == (
+        1.0, 0.1, 0.0, "random",
+    )  # fmt: skip
