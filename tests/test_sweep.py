@@ -752,3 +752,25 @@ def test_the_figure_6_3_study_file_runs_the_books_grid() -> None:
     assert (agent.gamma, agent.epsilon.start, agent.q_init, agent.tie_break) == (
         1.0, 0.1, 0.0, "random",
     )  # fmt: skip
+
+
+def test_the_shipped_figure_6_3_data_shows_the_books_findings() -> None:
+    """docs/book/fig6_3_cliff_alpha.csv, as the textbook page reports it."""
+    with (REPO / "docs" / "book" / "fig6_3_cliff_alpha.csv").open(newline="") as file:
+        rows = list(csv.DictReader(file))
+    line: dict[str, dict[float, float]] = {}
+    for row in rows:
+        line.setdefault(row["series"], {})[float(row["x"])] = float(row["y"])
+    alphas = [round(0.1 + 0.05 * i, 2) for i in range(19)]
+    assert all(list(points) == alphas for points in line.values()) and len(line) == 6
+
+    def of(algorithm: str, episodes: int) -> dict[float, float]:
+        return line[f"algorithm {algorithm}, episodes {episodes}"]
+
+    for episodes in (100, 100_000):  # Expected SARSA above SARSA at every alpha
+        assert all(of("expected_sarsa", episodes)[a] > of("sarsa", episodes)[a] for a in alphas)
+    assert all(-51.0 < y < -50.5 for y in of("q_learning", 100_000).values())
+    assert all(-21.0 < y < -20.5 for y in of("expected_sarsa", 100_000).values())
+    sarsa = of("sarsa", 100_000)
+    assert [sarsa[a] for a in alphas] == sorted((sarsa[a] for a in alphas), reverse=True)
+    assert round(sarsa[1.0]) == -1029 and round(of("expected_sarsa", 100)[1.0], 1) == -44.1
