@@ -377,6 +377,7 @@ def summary_line_figure(
     log_y: bool = False,
     y_limits: tuple[float | None, float | None] = (None, None),
     second: tuple[str, Sequence[float], np.ndarray] | None = None,
+    line_styles: Sequence[tuple[int, bool]] | None = None,
 ) -> DataFigure:
     """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
 
@@ -384,6 +385,8 @@ def summary_line_figure(
     axis (the book's range: Figure 7.2's 0.25 to 0.55 leaves the large errors off the top).
     Lines of more than 100 points are drawn without markers. ``second`` is ``(label, xs,
     ys)``, drawn shaded on a second y axis at the right (Figure 9.1's on-policy distribution).
+    ``line_styles`` gives each line ``(colour index, dashed)`` (Figure 6.3: a colour per
+    algorithm, interim dashed); by default each line has its own colour, solid.
     """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
@@ -397,10 +400,15 @@ def summary_line_figure(
         axes.set_zorder(right.get_zorder() + 1)  # the lines above the shading
         axes.patch.set_visible(False)
         record.line(label, xs, ys)
-    for (label, xs, centre, low, high), colour in zip(lines, _colours(len(lines)), strict=True):
+    if line_styles is None:
+        line_styles = [(index, False) for index in range(len(lines))]
+    palette = _colours(max((index for index, _ in line_styles), default=-1) + 1)
+    for (label, xs, centre, low, high), (index, dashed) in zip(lines, line_styles, strict=True):
+        colour = palette[index]
         axes.fill_between(xs, low, high, color=colour, alpha=0.25, linewidth=0)
         marker = {"marker": "o", "markersize": 3} if len(xs) <= 100 else {}
-        axes.plot(xs, centre, color=colour, linewidth=1.8, label=label, **marker)  # type: ignore[arg-type]
+        axes.plot(xs, centre, color=colour, linewidth=1.8, label=label,
+                  linestyle="--" if dashed else "-", **marker)  # type: ignore[arg-type]  # fmt: skip
         record.line(label, xs, centre, low, high)
     if log_y:
         axes.set_yscale("log")

@@ -71,6 +71,9 @@ class SeedResult:
     """seconds spent in training episodes"""
     interrupted: bool = False
     """stopped before ``train.episodes`` (or the solve point)"""
+    mean_return: float | None = None
+    """the mean training return over all the run's episodes (:func:`mean_return`; ``None``:
+    not recorded, as in a ``results.csv`` written before the column)"""
 
     @classmethod
     def of_train(cls, result: TrainResult) -> SeedResult:
@@ -89,7 +92,23 @@ class SeedResult:
             reward_threshold=result.reward_threshold,
             train_seconds=round(result.train_seconds, 6),
             interrupted=result.interrupted,
+            mean_return=mean_return(result.returns),
         )
+
+
+def mean_return(returns: Sequence[float] | np.ndarray) -> float | None:
+    """The mean of a run's training returns, exactly rounded (``None`` for no episode).
+
+    The sum is :func:`math.fsum` (correctly rounded, whatever the order), divided once by
+    the number of episodes: the same number from ``metrics.csv``'s ``return`` column.
+
+    >>> mean_return([-13.0, -100.0, 0.1, 0.2]), mean_return([])
+    (-28.175, None)
+    """
+    values = np.asarray(returns, dtype=np.float64)
+    if not len(values):
+        return None
+    return math.fsum(values.tolist()) / len(values)
 
 
 def env_steps_to_solve(result: TrainResult) -> int | None:

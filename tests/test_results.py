@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success
+from cartpole_q.results import MultiSeedSummary, RunSummary, SeedResult, is_success, mean_return
 from cartpole_q.store import rundir, sweepdir
 from tests.conftest import invoke, write_yaml
 
@@ -158,6 +160,7 @@ _results = st.builds(
     eval_mean=st.none() | st.floats(allow_nan=False, allow_infinity=False),
     success=st.none() | st.booleans(),
     train_seconds=st.floats(0, 1e6, allow_nan=False),
+    mean_return=st.none() | st.floats(allow_nan=False, allow_infinity=False),
 )
 
 
@@ -176,6 +179,32 @@ def test_a_damaged_results_row_names_the_file() -> None:
     cells = {**sweepdir.row_cells(row), "episodes": "one"}
     with pytest.raises(sweepdir.RunError, match=r"results.csv: has a damaged row"):
         sweepdir.parse_row(cells, [], Path("results.csv"))
+
+
+def test_the_mean_return_is_exactly_rounded_whatever_the_order() -> None:
+    """``results.csv``'s ``mean_return``: fsum then one division, not a running float sum."""
+    assert sum([0.1] * 10) / 10 == 0.09999999999999999  # what a plain sum would give
+    assert mean_return([0.1] * 10) == 0.1
+    assert mean_return(np.array([1e16, 1.0, -1e16, 1.0])) == 0.5
+    assert mean_return([-13.0, -113.0, -17.0]) == -143.0 / 3
+    assert mean_return([]) is None
+
+
+def test_a_results_csv_from_before_mean_return_is_read_with_it_empty(tmp_path: Path) -> None:
+    """An older sweep directory (no ``mean_return`` column) still reads, and resumes."""
+    rows = [sweepdir.ResultRow("000", {"agent.alpha": "0.1"},
+                               SeedResult(3, 10, 90, None, None, None, -13.0, None,
+                                          mean_return=-20.5))]  # fmt: skip
+    sweepdir.write_results(tmp_path, ["agent.alpha"], rows)
+    text = (tmp_path / sweepdir.RESULTS_FILE).read_text()
+    assert text.splitlines()[0].endswith(",train_seconds,mean_return")
+    assert text.splitlines()[1].endswith(",-20.5")
+    assert sweepdir.read_results(tmp_path, ["agent.alpha"]) == rows
+    older = "\n".join(line.rsplit(",", 1)[0] for line in text.splitlines()) + "\n"
+    (tmp_path / sweepdir.RESULTS_FILE).write_text(older)
+    (row,) = sweepdir.read_results(tmp_path, ["agent.alpha"])
+    assert row.result.mean_return is None
+    assert row.result == dataclasses.replace(rows[0].result, mean_return=None)
 
 
 def test_success_is_reaching_the_threshold_exactly() -> None:

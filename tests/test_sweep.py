@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -27,7 +29,7 @@ from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.sweep_spec import load_sweep
 from cartpole_q.statistics import summarize_point
 from cartpole_q.store import sweepdir
-from tests.conftest import invoke, then_sigint, write_yaml
+from tests.conftest import REPO, invoke, then_sigint, write_yaml
 
 # Short runs: 60 episodes of CartPole (few solve), so a sweep of 12 runs takes a second.
 BASE = {
@@ -208,7 +210,7 @@ def test_the_sweep_directory_has_the_contract_files(reference: Path) -> None:
     assert list(rows[0]) == [
         "point", "agent.alpha", "agent.algorithm", "seed", "solved_episode",
         "env_steps_to_solve", "first_greedy_success_env_steps", "eval_mean", "success",
-        "episodes", "env_steps", "train_seconds",
+        "episodes", "env_steps", "train_seconds", "mean_return",
     ]  # fmt: skip
     assert [(row["point"], row["seed"]) for row in rows] == [
         (f"{p:03d}", str(s)) for p in range(4) for s in range(3)
@@ -249,6 +251,9 @@ def test_each_run_is_exactly_train_with_the_point_config_and_seed(
     assert row["first_greedy_success_env_steps"] == (
         "" if greedy is None else str(greedy["env_steps"])
     )
+    with (tmp_path / "run" / "metrics.csv").open(newline="") as file:
+        returns = [float(line["return"]) for line in csv.DictReader(file)]
+    assert float(row["mean_return"]) == math.fsum(returns) / len(returns)
 
 
 def test_points_csv_holds_each_points_statistics(reference: Path) -> None:
@@ -604,3 +609,168 @@ def test_a_second_sigint_says_exactly_what_is_saved(tmp_path: Path, early: bool)
     else:
         assert f": no run had finished, so nothing is saved in {results} yet" in stderr
     assert f"cartpole-q sweep --resume {directory}" in stderr
+
+
+# -- a figure drawn from results.csv (S&B Figure 6.3) ---------------------------------------
+
+CLIFF = {
+    "name": "cliff",
+    "base": {
+        "env": {"id": "CliffWalking-v1"},
+        "agent": {"gamma": 1.0, "epsilon": 0.1, "q_init": 0.0, "tie_break": "random"},
+        "train": {"episodes": 5, "stop_when_solved": False, "eval_every": 0, "checkpoint_every": 0},
+        "eval": {"episodes": 1},
+    },
+    "seeds": "0-1",
+    "curves": False,
+    "grid": {
+        "agent.algorithm": ["sarsa", "q_learning"],
+        "train.episodes": [5, 20],
+        "agent.alpha": [0.5, 1.0],
+    },
+    "figure": {
+        "metric": "return", "against": "agent.alpha", "dashed": {"train.episodes": 5},
+        "file": "fig.png",
+    },
+}  # fmt: skip
+
+
+def test_a_sweep_without_curves_draws_the_mean_return_of_each_run_from_results(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Figure 6.3's shape: interim (a short run, dashed) and asymptotic (a long run, solid)."""
+    out = tmp_path / "out"
+    result = invoke("sweep", write_yaml(tmp_path / "c.yaml", CLIFF), "--out", out, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert not list(out.glob("points/*/curves.npz")), "curves: false keeps no curves"
+    rows = _results(out)
+    # The long run of a seed, trained alone: its mean return, and the short run's (its first
+    # 5 episodes: the same seed runs the same episodes), exactly.
+    point = next(r["point"] for r in rows if r["agent.algorithm"] == "sarsa"
+                 and r["train.episodes"] == "20" and r["agent.alpha"] == "0.5")  # fmt: skip
+    run = invoke("train", "-c", out / "points" / point / "config.yaml", "--seed", 1,
+                 "--out", tmp_path / "run", "-q")  # fmt: skip
+    assert run.exit_code == 0, run.output
+    with (tmp_path / "run" / "metrics.csv").open(newline="") as file:
+        returns = [float(line["return"]) for line in csv.DictReader(file)]
+    assert len(returns) == 20
+
+    def cell(episodes: str, seed: str) -> float:
+        return float(next(
+            r["mean_return"] for r in rows if r["agent.algorithm"] == "sarsa"
+            and r["train.episodes"] == episodes and r["agent.alpha"] == "0.5" and r["seed"] == seed
+        ))  # fmt: skip
+
+    assert cell("20", "1") == math.fsum(returns) / 20
+    assert cell("5", "1") == math.fsum(returns[:5]) / 5
+    # The plotted y: the mean over seeds of their mean_return.
+    with (out / "fig.csv").open(newline="") as file:
+        plotted = {(r["series"], r["x"]): float(r["y"]) for r in csv.DictReader(file)}
+    assert sorted({series for series, _ in plotted}) == [
+        "algorithm q_learning, episodes 20", "algorithm q_learning, episodes 5",
+        "algorithm sarsa, episodes 20", "algorithm sarsa, episodes 5",
+    ]  # fmt: skip
+    assert plotted[("algorithm sarsa, episodes 5", "0.5")] == np.mean(
+        [cell("5", "0"), cell("5", "1")]
+    )
+    # A colour per algorithm; the short runs dashed.
+    drawn: dict[str, Any] = {}
+
+    def capture(lines, *args, **kwargs):  # type: ignore[no-untyped-def]
+        drawn["labels"] = [line[0] for line in lines]
+        drawn["styles"] = kwargs["line_styles"]
+        from cartpole_q.figures import summary_line_figure
+
+        return summary_line_figure(lines, *args, **kwargs)
+
+    monkeypatch.setattr(sweeping, "summary_line_figure", capture)
+    spec = load_sweep(out / sweepdir.SWEEP_FILE)
+    points = [out / "points" / spec.point_id(p.index) for p in spec.points]
+    sweeping.plot_against(spec, points, tmp_path / "again.png")
+    assert drawn["labels"] == [
+        "algorithm sarsa, episodes 5", "algorithm sarsa, episodes 20",
+        "algorithm q_learning, episodes 5", "algorithm q_learning, episodes 20",
+    ]  # fmt: skip
+    assert drawn["styles"] == [(0, True), (0, False), (1, True), (1, False)]
+
+
+def test_a_figure_without_mean_return_in_results_is_refused(tmp_path: Path) -> None:
+    """A results.csv older than the column (resumed) cannot draw the figure: it says so."""
+    sweep = {
+        **CLIFF, "seeds": "0", "grid": {"train.episodes": [3, 4], "agent.alpha": [0.5]},
+        "figure": {**CLIFF["figure"], "dashed": {"train.episodes": 3}},  # type: ignore[dict-item]
+    }  # fmt: skip
+    out = tmp_path / "out"
+    assert invoke("sweep", write_yaml(tmp_path / "c.yaml", sweep), "--out", out).exit_code == 0
+    lines = (out / sweepdir.RESULTS_FILE).read_text().splitlines()
+    older = "\n".join(line.rsplit(",", 1)[0] for line in lines) + "\n"
+    (out / sweepdir.RESULTS_FILE).write_text(older)
+    spec = load_sweep(out / sweepdir.SWEEP_FILE)
+    points = [out / "points" / spec.point_id(p.index) for p in spec.points]
+    with pytest.raises(
+        sweepdir.RunError, match=r"results\.csv: point 000, seed 0 has no mean_return"
+    ):
+        sweeping.plot_against(spec, points, tmp_path / "again.png")
+
+
+@pytest.mark.parametrize(
+    ("change", "named"),
+    [
+        (
+            {"against": None, "curves": True},
+            "figure.dashed: styles the lines drawn against an axis",
+        ),
+        ({"dashed": {"agent.gamma": 1.0}}, "figure.dashed: 'agent.gamma' is not a grid axis"),
+        ({"dashed": {"agent.alpha": 0.5}}, "figure.dashed: 'agent.alpha' is not a grid axis"),
+        ({"dashed": {"train.episodes": 7}}, "figure.dashed: 7 is not a value of the axis"),
+        ({"dashed": {}}, "figure.dashed: must be one grid axis and one of its values"),
+        ({"dashed": 5}, "figure.dashed: 5 is not a Mapping"),
+        ({"first": 3}, "figure: is drawn from the learning curves, but the sweep says curves"),
+        ({"metric": "length"}, "figure: is drawn from the learning curves, but the sweep says"),
+    ],
+)
+def test_a_figure_from_results_and_its_dashed_lines_are_checked(
+    change: dict[str, Any], named: str
+) -> None:
+    change = dict(change)
+    curves = change.pop("curves", False)
+    figure = {**CLIFF["figure"], **change}  # type: ignore[dict-item]
+    figure = {key: value for key, value in figure.items() if value is not None}
+    with pytest.raises(ConfigError, match=re.escape(named)):
+        load_sweep({**CLIFF, "curves": curves, "figure": figure})
+
+
+def test_the_figure_6_3_study_file_runs_the_books_grid() -> None:
+    """examples/book/fig6_3_cliff_alpha.yaml: 3 algorithms x {100, 100,000} episodes x 19 alphas."""
+    spec = load_sweep(REPO / "examples" / "book" / "fig6_3_cliff_alpha.yaml")
+    assert spec.grid["agent.algorithm"] == ["sarsa", "expected_sarsa", "q_learning"]
+    assert spec.grid["train.episodes"] == [100, 100_000]
+    assert spec.grid["agent.alpha"] == [round(0.1 + 0.05 * i, 2) for i in range(19)]
+    assert spec.seeds == tuple(range(100)) and spec.runs == 11_400 and not spec.curves
+    assert spec.figure is not None and spec.figure.dashed == {"train.episodes": 100}
+    agent = spec.points[0].config.agent
+    assert (agent.gamma, agent.epsilon.start, agent.q_init, agent.tie_break) == (
+        1.0, 0.1, 0.0, "random",
+    )  # fmt: skip
+
+
+def test_the_shipped_figure_6_3_data_shows_the_books_findings() -> None:
+    """docs/book/fig6_3_cliff_alpha.csv, as the textbook page reports it."""
+    with (REPO / "docs" / "book" / "fig6_3_cliff_alpha.csv").open(newline="") as file:
+        rows = list(csv.DictReader(file))
+    line: dict[str, dict[float, float]] = {}
+    for row in rows:
+        line.setdefault(row["series"], {})[float(row["x"])] = float(row["y"])
+    alphas = [round(0.1 + 0.05 * i, 2) for i in range(19)]
+    assert all(list(points) == alphas for points in line.values()) and len(line) == 6
+
+    def of(algorithm: str, episodes: int) -> dict[float, float]:
+        return line[f"algorithm {algorithm}, episodes {episodes}"]
+
+    for episodes in (100, 100_000):  # Expected SARSA above SARSA at every alpha
+        assert all(of("expected_sarsa", episodes)[a] > of("sarsa", episodes)[a] for a in alphas)
+    assert all(-51.0 < y < -50.5 for y in of("q_learning", 100_000).values())
+    assert all(-21.0 < y < -20.5 for y in of("expected_sarsa", 100_000).values())
+    sarsa = of("sarsa", 100_000)
+    assert [sarsa[a] for a in alphas] == sorted((sarsa[a] for a in alphas), reverse=True)
+    assert round(sarsa[1.0]) == -1029 and round(of("expected_sarsa", 100)[1.0], 1) == -44.1

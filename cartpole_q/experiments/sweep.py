@@ -398,20 +398,18 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     A seed's value is the mean of the metric over its first ``figure.first`` episodes (after
     ``(value + offset) * scale``); a point's is the mean over seeds, with a 95% bootstrap
     interval; points that share the other axes' values form one line, ordered by the axis.
+    A sweep that keeps no curves (``curves: false``) draws the mean return over all
+    episodes, each seed's from ``results.csv``'s ``mean_return``. With ``figure.dashed``
+    the lines at its axis value are dashed, and lines that differ only in that axis share a
+    colour.
     """
     figure = spec.figure
     assert figure is not None and figure.against is not None
+    dashed = figure.dashed or {}
     groups: dict[str, list[tuple[float, np.ndarray]]] = {}
+    styles: dict[str, tuple[str, bool]] = {}
     for point, path in zip(spec.points, paths, strict=True):
-        runs = load_run_set(path).runs
-        check_record(path, runs, figure.metric)
-        column = record_column(figure.metric)
-        per_seed = []
-        for run in runs:
-            record = None if column is None else run.record(column)
-            values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, record)
-            values = values[: figure.first] if figure.first is not None else values
-            per_seed.append((float(np.mean(values)) + figure.offset) * figure.scale)
+        per_seed = [(value + figure.offset) * figure.scale for value in _seed_means(spec, path)]
         others = ", ".join(
             f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}"
             for key, value in point.values.items()
@@ -420,6 +418,15 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
         groups.setdefault(others or spec.name, []).append(
             (float(point.values[figure.against]), np.array(per_seed)[:, None])
         )
+        colour_key = ", ".join(
+            f"{key}={axis_cell(value)}"
+            for key, value in point.values.items()
+            if key != figure.against and key not in dashed
+        )
+        at_dashed = bool(dashed) and all(
+            axis_cell(point.values[key]) == axis_cell(value) for key, value in dashed.items()
+        )
+        styles[others or spec.name] = (colour_key, at_dashed)
     lines = []
     rng = np.random.default_rng(0)
     for label, members in groups.items():
@@ -432,11 +439,48 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     first = f"first {figure.first} episodes" if figure.first is not None else "all episodes"
     y_label = figure.y_label or f"{metric_label(figure.metric)}, mean over the {first}"
     title = figure.title or spec.name
+    line_styles = None
+    if figure.dashed is not None:
+        colours = list(dict.fromkeys(styles[label][0] for label in groups))
+        line_styles = [(colours.index(styles[label][0]), styles[label][1]) for label in groups]
     drawn = summary_line_figure(
         lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y,
-        (figure.y_min, figure.y_max),
+        (figure.y_min, figure.y_max), line_styles=line_styles,
     )  # fmt: skip
     return write_figure(out, drawn)
+
+
+def _seed_means(spec: SweepSpec, path: Path) -> list[float]:
+    """A point's per-seed means of the figure's metric, before the figure's transform.
+
+    From the curves (the first ``figure.first`` episodes), or, in a sweep that keeps none,
+    from ``results.csv``'s ``mean_return`` (the mean return over all episodes).
+
+    Raises:
+        RunError: a run has no ``mean_return`` (its row was written before the column).
+    """
+    figure = spec.figure
+    assert figure is not None
+    if not spec.curves:
+        rows = sweepdir.point_results(path) or []
+        missing = next((row for row in rows if row.result.mean_return is None), None)
+        if missing is not None:
+            raise RunError(
+                f"{path.parent.parent / sweepdir.RESULTS_FILE}: point {missing.point}, seed "
+                f"{missing.result.seed} has no mean_return (its row is older than the column); "
+                "run the sweep anew to draw the figure."
+            )
+        return [float(row.result.mean_return or 0.0) for row in rows]
+    runs = load_run_set(path).runs
+    check_record(path, runs, figure.metric)
+    column = record_column(figure.metric)
+    means = []
+    for run in runs:
+        record = None if column is None else run.record(column)
+        values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, record)
+        values = values[: figure.first] if figure.first is not None else values
+        means.append(float(np.mean(values)))
+    return means
 
 
 def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path) -> Path:

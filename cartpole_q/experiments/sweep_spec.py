@@ -54,7 +54,7 @@ class Point:
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "log_x", "title", "y_label", "offset", "scale",
     "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
-    "distribution",
+    "distribution", "dashed",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -119,6 +119,10 @@ class FigureSpec:
     """with ``values``: also draw the evaluated policy's on-policy distribution ``mu`` (the
     fraction of time steps spent in each state, from the world's model) on a second y axis
     (Sutton & Barto Figure 9.1)"""
+    dashed: dict[str, Any] | None = None
+    """with ``against``: ``{AXIS: VALUE}``, another axis and one of its values: the lines of
+    the points at that value are dashed, and lines that differ only in that axis share a
+    colour (Sutton & Barto Figure 6.3: interim dashed, asymptotic solid)"""
 
     def to_dict(self) -> dict[str, Any]:
         """The section as the resolved ``sweep.yaml`` holds it (every key)."""
@@ -251,6 +255,8 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
         _check_info_metric(figure.metric, points, where)
     if figure is not None and figure.against is not None:
         _check_against(figure.against, {**grid, **zipped}, where)
+    if figure is not None and figure.dashed is not None:
+        _check_dashed(figure, grid, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
 
 
@@ -264,6 +270,33 @@ def _check_against(key: str, axes: Mapping[str, list[Any]], where: str) -> None:
     if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axes[key]):
         raise ConfigError(
             f"{where}: figure.against: the axis {key} must hold numbers to be drawn against."
+        )
+
+
+def _check_dashed(figure: FigureSpec, grid: Mapping[str, list[Any]], where: str) -> None:
+    """``figure.dashed`` names one grid axis (not ``against``) and one of its values."""
+    dashed = figure.dashed or {}
+    if figure.against is None:
+        raise ConfigError(
+            f"{where}: figure.dashed: styles the lines drawn against an axis; give "
+            "figure.against too."
+        )
+    if len(dashed) != 1:
+        raise ConfigError(
+            f"{where}: figure.dashed: must be one grid axis and one of its values, such as "
+            f"{{train.episodes: 100}}, got {shown_value(dashed)}."
+        )
+    key, value = next(iter(dashed.items()))
+    others = [axis for axis in grid if axis != figure.against]
+    if key not in others:
+        raise ConfigError(
+            f"{where}: figure.dashed: {shown(key)} is not a grid axis other than "
+            f"figure.against ({', '.join(others) or 'there is none'})."
+        )
+    if axis_cell(value) not in [axis_cell(v) for v in grid[key]]:
+        raise ConfigError(
+            f"{where}: figure.dashed: {shown_value(value)} is not a value of the axis {key} "
+            f"({', '.join(axis_cell(v) for v in grid[key])})."
         )
 
 
@@ -328,12 +361,15 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             f"{shown_value(raw)}."
         )
     check_top_keys(raw, FIGURE_KEYS, f"{where}: figure")
-    if not curves:
+    values = dict(raw)
+    from_results = values.get("metric") == "return" and values.get("first") is None
+    if not curves and not (values.get("against") is not None and from_results):
         raise ConfigError(
             f"{where}: figure: is drawn from the learning curves, but the sweep says curves: "
-            "false; keep the curves or leave the figure out."
+            "false; keep the curves or leave the figure out (only the mean return over all "
+            "episodes against an axis, metric: return with against and no first, is drawn "
+            "from results.csv's mean_return)."
         )
-    values = dict(raw)
     choices = {"x": X_AXES, "aggregate": AGGREGATES}
     if "metric" not in values:
         raise ConfigError(
@@ -366,7 +402,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
         "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),
-        "distribution": (bool,),
+        "distribution": (bool,), "dashed": (Mapping,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)
@@ -402,6 +438,8 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     for key in ("offset", "scale", "reference", "x_max", "y_min", "y_max"):
         if values.get(key) is not None:
             values[key] = float(values[key])
+    if values.get("dashed") is not None:
+        values["dashed"] = dict(values["dashed"])
     return FigureSpec(**values)
 
 

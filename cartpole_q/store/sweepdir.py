@@ -61,8 +61,12 @@ RESULT_COLUMNS = (
     "episodes",
     "env_steps",
     "train_seconds",
+    "mean_return",
 )
 """the ``results.csv`` columns after ``point`` and the axes"""
+ADDED_COLUMNS = ("mean_return",)
+"""columns added since the first ``results.csv``: a file without them (an older sweep) is
+read, and resumed, with their cells empty"""
 TIMING_COLUMNS = ("train_seconds",)
 """the only columns that depend on the machine, the backend or an interruption"""
 
@@ -199,6 +203,7 @@ def parse_row(cells: Mapping[str, str], axes: Sequence[str], where: Path) -> Res
                 eval_mean=_finite(cells["eval_mean"]) if cells["eval_mean"] else None,
                 success=_flag(cells["success"]),
                 train_seconds=_finite(cells["train_seconds"] or "0"),
+                mean_return=_finite(mean) if (mean := cells.get("mean_return")) else None,
             ),
         )
     except (KeyError, ValueError, TypeError, OverflowError):
@@ -254,7 +259,8 @@ def read_results(directory: Path, axes: Sequence[str]) -> list[ResultRow]:
         return []
     with path.open(newline="", encoding="utf-8") as file:
         reader = csv.DictReader(file)
-        if reader.fieldnames != result_header(axes):
+        older = [column for column in result_header(axes) if column not in ADDED_COLUMNS]
+        if reader.fieldnames not in (result_header(axes), older):
             raise RunError(
                 f"{path}: its columns are not the ones {SWEEP_FILE} gives; the sweep directory "
                 "was changed by hand. Start a new sweep."
