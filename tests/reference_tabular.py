@@ -884,9 +884,12 @@ class Prediction(Agent):
 
     def rule(self, x: int) -> int:
         """A deterministic policy's action: ``stick_20`` (Blackjack, rows in C order over (32,
-        11, 2)): stick (0) on a player sum of 20 or 21, else hit (1); ``greedy``: the run's."""
+        11, 2)): stick (0) on a player sum of 20 or 21, else hit (1); ``left``: 0; ``greedy``:
+        the run's."""
         if self.params["policy"] == "stick_20":
             return 0 if x // (11 * 2) >= 20 else 1
+        if self.params["policy"] == "left":
+            return 0
         return self.greedy[x]
 
     def draw(self, x: int) -> int:

@@ -129,6 +129,7 @@ def test_the_policy_figure_draws_the_greedy_policy_beside_the_optimum(tmp_path: 
     [
         ({"agent": {"algorithm": "mc_prediction"}}, "figure.metric: policy draws a control"),
         ({"env": {"id": "FrozenLake-v1"}}, "needs a Blackjack world"),
+        ({"agent": {"gamma": 0.9}}, "compares with Blackjack's undiscounted optimum"),
     ],
 )
 def test_the_policy_figure_refuses_prediction_and_other_worlds(

@@ -552,7 +552,7 @@ def test_the_greedy_policy_of_q_star_has_the_optimal_values(tmp_path: Path) -> N
 
 
 def test_a_runs_epsilon_greedy_policy_plays_its_probabilities(tmp_path: Path) -> None:
-    """epsilon 1: uniform; the visits of a one-state-per-row policy follow pi."""
+    """greedy plays its action alone; epsilon 0.4 gives it 0.7 and each other action 0.1."""
     run = _control_run(tmp_path / "lake", np.tile(np.array([0.0, 1.0, 0.0, 0.0]), (16, 1)))
     base = {**LAKE, "agent.algorithm": "td", "train.episodes": 300, "agent.policy_run": str(run)}
     greedy = train(load_config(overrides={**base, "agent.policy": "greedy"}), final_eval=False)
@@ -578,13 +578,31 @@ def test_a_runs_epsilon_greedy_policy_plays_its_probabilities(tmp_path: Path) ->
             ["agent.policy=greedy", "agent.policy_run=CONTROL", "env.kwargs.map_name=8x8"],
             "its q_table.npy is float64 of shape (16, 4); this config's table is float64 of shape (64, 4)",
         ),
-        (["agent.policy=epsilon_greedy", "agent.policy_run=TAXI"], "its policy is one of Taxi-v4"),
+        (
+            ["agent.policy=epsilon_greedy", "agent.policy_run=TAXI"],
+            "its config.yaml's env.id is Taxi-v4, not this config's FrozenLake-v1",
+        ),
         (
             ["agent.policy=greedy", "agent.policy_run=CONTROL", "discretization.tilings=4"],
             "agent.policy: greedy takes a run's table policy",
         ),
+        (
+            ["agent.policy=greedy", "agent.policy_run=STRING_ENV"],
+            "its config.yaml's env.id is missing",
+        ),
+        (["agent.policy=greedy", "agent.policy_run=EMPTY_TABLE"], "cannot read its q_table.npy"),
     ],
-    ids=["no-run", "prediction-run", "missing", "not-asked", "shape", "other-world", "tiles"],
+    ids=[
+        "no-run",
+        "prediction-run",
+        "missing",
+        "not-asked",
+        "shape",
+        "other-world",
+        "tiles",
+        "env-a-string",
+        "empty-table",
+    ],
 )
 def test_a_runs_policy_is_refused_before_anything_is_written(
     tmp_path: Path, assignments: list[str], message: str
@@ -594,7 +612,11 @@ def test_a_runs_policy_is_refused_before_anything_is_written(
         "TAXI": _control_run(tmp_path / "taxi", np.zeros((16, 4)), env_id="Taxi-v4"),
         "PREDICTION": tmp_path / "prediction",
         "NOWHERE": tmp_path / "nowhere",
+        "STRING_ENV": _control_run(tmp_path / "string", np.zeros((16, 4))),
+        "EMPTY_TABLE": _control_run(tmp_path / "empty", np.zeros((16, 4))),
     }
+    (tmp_path / "string" / "config.yaml").write_text("env: FrozenLake-v1\n")
+    (tmp_path / "empty" / rundir.Q_TABLE_FILE).write_bytes(b"")
     (tmp_path / "prediction").mkdir()
     np.save(tmp_path / "prediction" / rundir.V_TABLE_FILE, np.zeros(16))
     args = ["train", "--set", "env.id=FrozenLake-v1", "--set", "agent.algorithm=td"]
@@ -632,3 +654,58 @@ def test_an_interrupted_run_of_a_runs_policy_resumes_byte_identically(
     loaded = rundir.load_run(run)
     assert whole.errors is not None and loaded.errors is not None
     assert loaded.errors.tolist() == whole.errors.tolist()
+
+
+def test_a_runs_policy_is_read_from_an_absolute_path_and_only_when_training(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A config naming a run that is not there (moved, or read from elsewhere) still loads:
+    the run is read when training starts; the path is kept absolute."""
+    monkeypatch.chdir(tmp_path)
+    config = load_config(
+        overrides={
+            **LAKE,
+            "agent.algorithm": "td",
+            "agent.policy": "greedy",
+            "agent.policy_run": "gone",
+        }
+    )
+    assert config.agent.params["policy_run"] == str(tmp_path / "gone")
+    again = load_config(overrides=config.to_dict())
+    assert again.agent.params["policy_run"] == str(tmp_path / "gone")
+    with pytest.raises(ConfigError, match=r"has no q_table\.npy"):
+        prepare(config, "test")
+
+
+def test_the_true_values_on_tiles_follow_the_discretization() -> None:
+    """Two tilings of the walk over different ranges: each its own tiles (not one cached)."""
+    base = {
+        "env.id": "cartpole_q/RandomWalk1000-v0", "env.kwargs": {"position": True},
+        "agent.algorithm": "td", "agent.gamma": 1.0,
+    }  # fmt: skip
+    rows = []
+    for high in (1001.0, 2001.0):
+        tiles = {"bins": [5], "low": [1.0], "high": [high], "tilings": 4}
+        config = load_config(overrides={**base, "discretization": tiles})
+        rows.append(prediction_truth(config, inspect_env(config)).rows[500].tolist())
+    # state 501: v = 2.5 (then 1.25) bins, floor(4 v) + t over 4 tiles of 6 per tiling
+    assert rows == [[2, 8, 15, 21], [1, 7, 13, 20]]
+
+
+def test_optimum_evaluates_a_runs_greedy_policy(tmp_path: Path) -> None:
+    from cartpole_q.envs.models import EnvModel, env_model
+    from cartpole_q.rl.value_iteration import value_iteration
+
+    model = env_model(load_config(overrides={**LAKE, "agent.algorithm": "td"}).env)
+    assert isinstance(model, EnvModel)
+    optimum = value_iteration(model.model, 0.95, tolerance=1e-14)
+    run = _control_run(tmp_path / "lake", optimum.q)
+    result = invoke(
+        "optimum", "FrozenLake-v1", "--policy", "greedy", "--gamma", "0.95",
+        "--set", f"agent.policy_run={run}", "--json",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    values = json.loads(result.stdout)["values"]
+    assert values["0"] == pytest.approx(float(optimum.values[0]), abs=1e-12)
+    refused = invoke("optimum", "FrozenLake-v1", "--policy", "greedy", "--set", "agent.alpha=0.1")
+    assert refused.exit_code == 2 and "agent.policy_run=RUN_DIR" in refused.stderr

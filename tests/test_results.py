@@ -183,7 +183,7 @@ def test_a_damaged_results_row_names_the_file() -> None:
 
 def test_the_mean_return_is_exactly_rounded_whatever_the_order() -> None:
     """``results.csv``'s ``mean_return``: fsum then one division, not a running float sum."""
-    assert sum([0.1] * 10) / 10 == 0.09999999999999999  # what a plain sum would give
+    # a plain running sum would give 0.09999999999999999 here
     assert mean_return([0.1] * 10) == 0.1
     assert mean_return(np.array([1e16, 1.0, -1e16, 1.0])) == 0.5
     assert mean_return([-13.0, -113.0, -17.0]) == -143.0 / 3

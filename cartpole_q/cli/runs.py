@@ -420,8 +420,9 @@ def optimum_command(
         typer.Option(
             metavar="POLICY",
             help="Instead, the exact state values of this fixed policy (random: uniform over "
-            "the actions), which a prediction run's rms_error is measured against; --gamma "
-            "then defaults to 1.",
+            "the actions; a rule the world declares; greedy or epsilon_greedy of a run, with "
+            "--set agent.policy_run=RUN_DIR), which a prediction run's rms_error is measured "
+            "against; --gamma then defaults to 1.",
         ),
     ] = None,
     json_output: JsonOutput = False,

@@ -13,10 +13,10 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import os
 import re
 from collections import Counter
 from collections.abc import Mapping
-from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
@@ -176,10 +176,11 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
 
 
 def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None:
-    """A run's policy needs the run: a directory holding a control run's ``q_table.npy``.
+    """A run's policy needs the run's directory (a table policy: not on tiles).
 
-    Its world and shape are checked when the table is read (the environment's shape is
-    not known here).
+    The directory itself is read and checked when a run is prepared, not here: a config
+    is also read back from a run directory long after, from anywhere, when the evaluated
+    run may have moved.
     """
     if tiled:
         raise reader.error(
@@ -193,14 +194,6 @@ def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None
             f"agent.policy {name} evaluates a control run's policy: give its run directory "
             "(agent.policy_run: runs/NAME).",
         )
-    path = Path(run)
-    if not (path / "q_table.npy").is_file():
-        what = (
-            "is a prediction run: it has state values (v_table.npy), no policy"
-            if (path / "v_table.npy").is_file()
-            else "has no q_table.npy: it is not a finished run directory"
-        )
-        raise reader.error("agent.policy_run", f"{run} {what}. Give a control run's directory.")
 
 
 def _check_epsilon_floor(reader: _Reader, agent: AgentConfig, episodes: int) -> None:
@@ -312,6 +305,8 @@ def _algorithm_params(reader: _Reader) -> Mapping[str, ParamValue]:
             values[param.key] = ""
             continue
         values[param.key] = reader.value(f"agent.{param.key}", given, param)
+        if param.kind == "str":  # a path: kept absolute, as given from the current directory
+            values[param.key] = os.path.abspath(os.path.expanduser(str(values[param.key])))
     return MappingProxyType(values)
 
 

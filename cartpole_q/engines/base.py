@@ -291,7 +291,7 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     key = (
         repr(config.env), env_info.max_episode_steps, env_info.state_shape, env_info.n_actions,
         config.agent.gamma, config.agent.params.get("policy"),
-        config.agent.params.get("policy_epsilon"),
+        config.agent.params.get("policy_epsilon"), repr(config.discretization),
         tuple(run_greedy_actions(config, env_info)) if from_run else None,
     )  # fmt: skip
     found = _TRUTHS.get(key)
@@ -336,18 +336,27 @@ def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
     """
     run = Path(str(config.agent.params["policy_run"]))
     field = f"agent.policy_run: {run}"
+    if not (run / "q_table.npy").is_file():
+        what = (
+            "is a prediction run: it has state values (v_table.npy), no policy"
+            if (run / "v_table.npy").is_file()
+            else "has no q_table.npy: it is not a finished run directory"
+        )
+        raise ConfigError(f"{field} {what}. Give a control run's directory.")
     try:
         table = np.load(run / "q_table.npy", allow_pickle=False)
         raw = yaml.safe_load((run / "config.yaml").read_text(encoding="utf-8"))
-    except (OSError, ValueError, yaml.YAMLError) as error:
+    except (OSError, ValueError, EOFError, UnicodeError, yaml.YAMLError) as error:
         raise ConfigError(
-            f"{field}: cannot read its q_table.npy and config.yaml ({error})."
+            f"{field}: cannot read its q_table.npy and config.yaml ({type(error).__name__}: "
+            f"{error})."
         ) from None
-    env_id = raw.get("env", {}).get("id") if isinstance(raw, dict) else None
+    section = raw.get("env") if isinstance(raw, dict) else None
+    env_id = section.get("id") if isinstance(section, dict) else None
     if env_id != config.env.id:
         raise ConfigError(
-            f"{field}: its policy is one of {env_id}, not of env.id {config.env.id}; "
-            "evaluate it on its own world."
+            f"{field}: its config.yaml's env.id is {env_id or 'missing'}, not this "
+            f"config's {config.env.id}; evaluate a run's policy on its own world."
         )
     shape = (*env_info.state_shape, env_info.n_actions)
     if table.shape != shape or table.dtype != np.float64 or not np.isfinite(table).all():

@@ -194,7 +194,7 @@ class GymnasiumEngine:
             record_episode(metrics, episode, episode_return, length, epsilon, alpha)
             if info_sums is not None:
                 info_sums[episode] = info_sum
-            if errors is not None and measure is not None:  # (never on tiles: q is the table)
+            if errors is not None and measure is not None:  # q: the table, or tiles' weights
                 errors[episode] = measure(state.tables.q, truth.rows, truth.values)
             state.episode = episode + 1
             state.env_steps += length

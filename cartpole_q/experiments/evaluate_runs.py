@@ -327,8 +327,11 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
         )
     overrides: dict[str, Any] = {"env.id": env_id}
     for key, value in assignments:
-        if key != "env" and not key.startswith("env."):
-            raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
+        if key not in RUN_POLICY_KEYS and key != "env" and not key.startswith("env."):
+            raise UserError(
+                f"--set {key}: optimum takes env keys (env.kwargs.KEY=VALUE) and, for --policy "
+                "greedy or epsilon_greedy, agent.policy_run=RUN_DIR and agent.policy_epsilon=E."
+            )
         overrides[key] = value
     config = load_config(overrides=overrides, override_source=COMMAND_LINE)
     inspect_env(config)  # an unknown id or argument: a config error naming it
@@ -360,6 +363,10 @@ class PolicyValues:
         }  # fmt: skip
 
 
+RUN_POLICY_KEYS = ("agent.policy_run", "agent.policy_epsilon")
+"""the agent keys ``optimum --policy`` takes: a run's policy's"""
+
+
 def policy_values(
     env_id: str, assignments: list[tuple[str, Any]], policy: str, gamma: float
 ) -> PolicyValues:
@@ -375,8 +382,11 @@ def policy_values(
 
     overrides: dict[str, Any] = {"env.id": env_id}
     for key, value in assignments:
-        if key != "env" and not key.startswith("env."):
-            raise UserError(f"--set {key}: optimum takes env keys only (env.kwargs.KEY=VALUE).")
+        if key not in RUN_POLICY_KEYS and key != "env" and not key.startswith("env."):
+            raise UserError(
+                f"--set {key}: optimum takes env keys (env.kwargs.KEY=VALUE) and, for --policy "
+                "greedy or epsilon_greedy, agent.policy_run=RUN_DIR and agent.policy_epsilon=E."
+            )
         overrides[key] = value
     overrides |= {"agent.algorithm": "td", "agent.policy": policy, "agent.gamma": gamma}
     config = load_config(overrides=overrides, override_source=COMMAND_LINE)

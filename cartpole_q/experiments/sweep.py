@@ -524,9 +524,17 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     if len(starts) == 1:
         start = np.full(len(states), starts.pop())
         lines.append(("initial values", states, start, start, start))
-    for label, path in zip(labels, paths, strict=True):
+    for point, label, path in zip(spec.points, labels, paths, strict=True):
+        # Each point reads its own tables' rows (its discretization: tiles, groups).
+        rows = prediction_truth(point.config, inspect_env(point.config)).rows
+        if rows.shape[0] != len(states):
+            raise RunError(
+                f"figure.metric: values draws every point against the same true states, but "
+                f"point {label} measures {rows.shape[0]} states and the first {len(states)}: "
+                "give the points one world."
+            )
         runs = load_run_set(path).runs
-        per_seed = np.array([_state_values(run.q_table, truth.rows) for run in runs])
+        per_seed = np.array([_state_values(run.q_table, rows) for run in runs])
         centre, low, high = aggregate_band(per_seed, "mean", rng)
         lines.append((label, states, centre, low, high))
     lines.append(("true values", states, truth.values, truth.values, truth.values))

@@ -326,6 +326,12 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
                     f"Barto's Figure 5.2, but point {point.index} plays {config.env.id}; it "
                     "needs a Blackjack world (Blackjack-v1, cartpole_q/BlackjackES-v0)."
                 )
+            if config.agent.gamma != 1.0:
+                raise ConfigError(
+                    f"{where}: figure.metric: policy compares with Blackjack's undiscounted "
+                    f"optimum, but point {point.index} learns with agent.gamma "
+                    f"{config.agent.gamma:g}; give agent.gamma: 1."
+                )
         return
     if metric in (ERROR_METRIC, VALUES_FIGURE):
         for point in points:
