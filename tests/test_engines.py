@@ -250,3 +250,16 @@ def test_warm_up_touches_no_state_and_draws_nothing(name: str, algorithm: str) -
     assert engine.env_rng_state() == env_state
     assert (state.tables.q == config.agent.q_init).all() and not state.tables.visits.any()
     assert state.episode == 0
+
+
+def test_every_twin_the_profiles_name_is_one_mypy_checks() -> None:
+    """envs/registry.py checks TWIN_MODULES against the twin interface; a new twin joins it."""
+    from cartpole_q.envs.registry import TWIN_MODULES
+    from cartpole_q.profiles import all_profiles
+
+    named = {
+        profile.twin.rpartition(".")[2]
+        for profile in all_profiles()
+        if profile.twin is not None and profile.twin.startswith("cartpole_q.envs.twins.")
+    }
+    assert named == set(TWIN_MODULES)

@@ -16,13 +16,42 @@ import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from numba import njit
 
+from cartpole_q.envs.twins import TwinModule
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.profiles import EnvProfile, all_profiles, profile_for
+
+if TYPE_CHECKING:  # mypy checks that each twin module meets the interface (never imported here)
+    from cartpole_q.envs.twins import (
+        acrobot,
+        aggregated_table,
+        blackjack,
+        blackjack_es,
+        cartpole,
+        mountaincar,
+        taxi,
+        transition_table,
+    )
+
+    # One assignment per module, so that mypy names the one that does not meet it.
+    _checked: TwinModule = acrobot
+    _checked = aggregated_table
+    _checked = blackjack
+    _checked = blackjack_es
+    _checked = cartpole
+    _checked = mountaincar
+    _checked = taxi
+    _checked = transition_table
+TWIN_MODULES = (
+    "acrobot", "aggregated_table", "blackjack", "blackjack_es", "cartpole", "mountaincar",
+    "taxi", "transition_table",
+)  # fmt: skip
+"""the twin modules mypy checks against :class:`~cartpole_q.envs.twins.TwinModule` (a test
+keeps this list equal to the modules the profiles name)"""
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -67,10 +96,11 @@ class Twin:
     """how an observation becomes a Q-table row: ``box``, ``discrete`` or ``tuple``"""
 
     @classmethod
-    def of(cls, module: ModuleType, profile: EnvProfile) -> Twin:
+    def of(cls, module: TwinModule, profile: EnvProfile) -> Twin:
         """The twin a module defines (see :mod:`cartpole_q.envs.twins`) for a profile."""
-        name = module.__name__.rpartition(".")[2]
-        digest = hashlib.sha256(inspect.getsource(module).encode()).hexdigest()[:12]
+        source = cast(ModuleType, module)
+        name = source.__name__.rpartition(".")[2]
+        digest = hashlib.sha256(inspect.getsource(source).encode()).hexdigest()[:12]
         return cls(
             name=name,
             key=f"{name}_{digest}",
@@ -96,7 +126,9 @@ def _twin_of(profile: EnvProfile) -> Twin | None:
     if profile.twin is None:
         return None
     if profile.name not in _LOADED:
-        _LOADED[profile.name] = Twin.of(importlib.import_module(profile.twin), profile)
+        # The package's twins are checked by mypy (CHECKED_TWINS); a plug-in's at its own risk.
+        module = cast(TwinModule, importlib.import_module(profile.twin))
+        _LOADED[profile.name] = Twin.of(module, profile)
     return _LOADED[profile.name]
 
 

@@ -22,8 +22,67 @@ The environments a twin reproduces are named by their profiles (:mod:`cartpole_q
 which name the twin's module.
 """
 
-from collections.abc import Iterable, Mapping
-from typing import Any
+from collections.abc import Callable, Iterable, Mapping
+from typing import Any, Protocol
+
+
+class TwinModule(Protocol):
+    """The interface above, which each of the package's twin modules meets (mypy checks).
+
+    :data:`cartpole_q.envs.registry.TWIN_MODULES` lists them.
+    The names are a module's, read-only here as a module's constants are to its readers;
+    ``reset`` and ``step`` are numba dispatchers (``Any`` to mypy).
+    """
+
+    @property
+    def STATE_SIZE(self) -> int:
+        """The state array's length."""
+        ...
+
+    @property
+    def STATE_DTYPE(self) -> Any:
+        """The state array's NumPy type."""
+        ...
+
+    @property
+    def OBSERVATION_SIZE(self) -> int:
+        """The observation array's length."""
+        ...
+
+    @property
+    def OBSERVATION_DTYPE(self) -> Any:
+        """The observation array's NumPy type."""
+        ...
+
+    @property
+    def OBSERVATION_KIND(self) -> str:
+        """How an observation becomes a row: box, discrete or tuple."""
+        ...
+
+    @property
+    def READS_ENVIRONMENT(self) -> bool:
+        """``twin_params(kwargs, env_id)`` reads the environment it builds."""
+        ...
+
+    @property
+    def PARAM_NAMES(self) -> tuple[str, ...]:
+        """What ``params`` holds, in order."""
+        ...
+
+    @property
+    def reset(self) -> Any:
+        """The compiled ``reset(state, observation, rng, params)``."""
+        ...
+
+    @property
+    def step(self) -> Any:
+        """The compiled ``step(state, action, observation, rng, params) -> (reward, terminated)``."""
+        ...
+
+    @property
+    def twin_params(self) -> Callable[..., tuple[Any, ...] | str]:
+        """``params`` from ``gymnasium.make`` arguments, or why not."""
+        ...
 
 
 def unsupported_key(kwargs: Mapping[str, Any], supported: Iterable[str]) -> str | None:

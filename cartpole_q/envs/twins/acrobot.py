@@ -147,7 +147,7 @@ def _libm_pow(typingctx: Any, base: Any, exponent: Any) -> Any:
 
     def codegen(context: Any, builder: Any, sig: Any, args: Any) -> Any:
         double = ir.DoubleType()
-        function = cgutils.get_or_insert_function(
+        function = cgutils.get_or_insert_function(  # type: ignore[no-untyped-call]
             builder.module, ir.FunctionType(double, [double, double]), _POW_SYMBOL
         )
         return builder.call(function, args)
@@ -178,7 +178,7 @@ def _numpy_sincos_f32(x: np.float32, cosine: bool) -> np.float32:
     """NumPy's float32 ``sin`` (``cosine`` false) or ``cos`` of a finite float32."""
     if abs(x) > (MAX_CODY_COS_F32 if cosine else MAX_CODY_SIN_F32):
         # NumPy hands these to libm's cosf/sinf (never reached from reset's range).
-        return np.cos(x) if cosine else np.sin(x)
+        return np.cos(x) if cosine else np.sin(x)  # type: ignore[no-any-return]  # NumPy ufuncs: Any
     # NumPy's source multiplies, then adds the magic number; its compiled code fuses the two.
     quadrant = fma_f32(x, TWO_OVER_PI_F32, RINT_MAGIC_F32)
     quadrant = quadrant - RINT_MAGIC_F32
@@ -199,7 +199,7 @@ def _numpy_sincos_f32(x: np.float32, cosine: bool) -> np.float32:
     result = sin_value if quarter_turns & 1 == 0 else cos_value
     if quarter_turns & 2 == 2:
         result = ZERO_F32 - result
-    return result
+    return result  # type: ignore[no-any-return]  # fma_f32 is compiled: Any to mypy
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -112,7 +112,7 @@ def score(state: np.ndarray, hand: int) -> int:
 @njit(cache=True, nogil=True, inline="always")
 def is_natural(state: np.ndarray, hand: int) -> bool:
     """``is_natural``: ``sorted(hand) == [1, 10]``."""
-    return state[hand + CARDS] == 2 and state[hand + HAS_ACE] != 0 and state[hand + RAW_SUM] == 11
+    return state[hand + CARDS] == 2 and state[hand + HAS_ACE] != 0 and state[hand + RAW_SUM] == 11  # type: ignore[no-any-return]
 
 
 @njit(cache=True, nogil=True, inline="always")
