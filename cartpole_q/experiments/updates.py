@@ -258,7 +258,7 @@ def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome |
 
     panels = []
     for panel in study.panels:
-        x = np.arange(panel.updates // panel.every + 1, dtype=np.float64) * panel.every
+        points = np.arange(panel.updates // panel.every + 1) * panel.every
         curves = []
         for branching in panel.branching:
             uniform, on_policy = [], []
@@ -271,8 +271,10 @@ def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome |
                 )  # fmt: skip
                 uniform.append(one)
                 on_policy.append(other)
-            curves.append(_averaged(f"b = {branching}, uniform", x, np.array(uniform), True))
-            curves.append(_averaged(f"b = {branching}, on-policy", x, np.array(on_policy), True))
+            curves.append(_averaged(f"b = {branching}, uniform", points, np.array(uniform), True))
+            curves.append(
+                _averaged(f"b = {branching}, on-policy", points, np.array(on_policy), True)
+            )
         panels.append(curves)
     return Outcome(panels, 0.0, time.perf_counter() - start)
 
@@ -289,7 +291,7 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
             f"{study.name}: {seeds} problems per branching factor, initial error "
             f"{study.initial_error:g}, {outcome.seconds:.1f} s",
             "  RMS error of sample updates after t computations; the book's sqrt((b-1)/(b t)) "
-            "in brackets (times the initial error at t = 0):",
+            "in brackets:",
         ]
         for branching, curve in zip(study.branching, outcome.curves[0], strict=True):
             shown = []
