@@ -1613,3 +1613,32 @@ def trajectory_sampling_figure(
     axes_list[-1].set_xlabel("Computation time, in expected updates")
     figure.suptitle(title, fontsize="medium")
     return figure
+
+
+def until_optimal_figure(
+    curves: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]],
+    title: str,
+) -> DataFigure:
+    """Example 8.4's figure: updates until the greedy path is optimal against maze size.
+
+    ``curves`` are ``(label, states, mean, least, most)``; log y axis (as the book's), each
+    point drawn with the range of its runs.
+    """
+    figure = DataFigure(figsize=(8.0, 5.0), dpi=DPI, layout="constrained")
+    axes = figure.add_subplot()
+    record = figure.data.panel("")
+    for (label, x, mean, low, high), colour in zip(curves, _colours(len(curves)), strict=True):
+        xs = x.tolist()
+        axes.plot(xs, mean, color=colour, marker="o", linewidth=1.4, label=label)
+        if low is not None and high is not None:
+            axes.fill_between(xs, low, high, color=colour, alpha=0.15, linewidth=0)
+            record.line(label, xs, mean.tolist(), low.tolist(), high.tolist())
+        else:
+            record.line(label, xs, mean.tolist())
+    axes.set_yscale("log")
+    axes.set_xlabel("Gridworld size (#states)")
+    axes.set_ylabel("Updates until optimal solution")
+    axes.legend(loc="upper left", fontsize="small")
+    axes.grid(alpha=0.3, which="both")
+    axes.set_title(title)
+    return figure

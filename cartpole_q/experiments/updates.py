@@ -1,6 +1,6 @@
 """Chapter 8's planning studies (``cartpole-q updates``): a study file, its curves, its figure.
 
-Two kinds of study (``figure.kind``), both run outside the episode loop:
+Three kinds of study (``figure.kind``), all run outside the engines' training runs:
 
 - ``expected_vs_sample`` (Figure 8.7): for each branching factor ``b`` of ``branching``,
   one problem per seed (:func:`~cartpole_q.rl.planning_updates.sample_update_errors`); the
@@ -9,6 +9,11 @@ Two kinds of study (``figure.kind``), both run outside the episode loop:
   branching factors, its updates and how often the start state is valued), one task per
   seed, run with uniform and with on-policy updates
   (:mod:`cartpole_q.engines.trajectory`); each point averaged over the tasks.
+- ``until_optimal`` (Example 8.4's figure): for each maze scale ``k`` of ``scales`` (the
+  Dyna maze with every cell a ``k`` x ``k`` block, ``47 k²`` open cells) and each algorithm
+  of ``methods``, one run per seed until the greedy path from the start is a shortest path
+  (:mod:`cartpole_q.engines.until_optimal`); the mean number of updates over the runs, with
+  the smallest and the largest.
 
 :func:`write_study` draws the figure with its data beside it (``<figure>.csv``).
 """
@@ -34,18 +39,29 @@ from cartpole_q.experiments.sweep_spec import (
 
 STUDY_KEYS = (
     "name", "seeds", "branching", "initial_error", "panels", "actions", "epsilon",
-    "termination", "tolerance", "figure",
+    "termination", "tolerance", "scales", "methods", "alpha", "gamma", "planning_steps", "theta",
+    "max_updates", "figure",
 )  # fmt: skip
 """the keys a study file may have"""
 KIND_KEYS = {
     "expected_vs_sample": ("branching", "initial_error"),
     "trajectory_sampling": ("panels", "actions", "epsilon", "termination", "tolerance"),
-}
+    "until_optimal": (
+        "scales", "methods", "alpha", "gamma", "epsilon", "planning_steps", "theta",
+        "max_updates",
+    ),
+}  # fmt: skip
 """the keys each figure kind takes (beside ``name``, ``seeds`` and ``figure``)"""
 FIGURE_KINDS = tuple(KIND_KEYS)
 FIGURE_KEYS = ("kind", "file", "title")
 PANEL_KEYS = ("states", "branching", "updates", "every")
 Z_95 = 1.959963984540054
+UNTIL_OPTIMAL_METHODS = ("prioritized_sweeping", "dyna_q", "q_learning")
+METHOD_LABELS = {
+    "prioritized_sweeping": "Prioritized sweeping",
+    "dyna_q": "Dyna-Q",
+    "q_learning": "Q-learning",
+}
 
 
 @dataclass(frozen=True)
@@ -79,6 +95,14 @@ class Study:
     file: str
     title: str
     where: str
+    scales: tuple[int, ...] = ()
+    """``until_optimal``: the maze scales ``k``"""
+    methods: tuple[str, ...] = ()
+    alpha: float = 0.5
+    gamma: float = 0.95
+    planning_steps: int = 5
+    theta: float = 0.0001
+    max_updates: int = 10_000_000
 
 
 @dataclass(frozen=True)
@@ -103,6 +127,9 @@ class Outcome:
     """``expected_vs_sample``: the largest ``|error|`` of the expected update after ``b``
     computations, over every problem (0 exactly)"""
     seconds: float
+    runs: dict[tuple[str, int], list[Any]] | None = None
+    """``until_optimal``: per ``(method, scale)`` each seed's
+    :class:`~cartpole_q.engines.until_optimal.Result`"""
 
 
 def _number(raw: Mapping[str, Any], key: str, default: float, where: str) -> float:
@@ -178,6 +205,8 @@ def load_study(path: Path) -> Study:
     tolerance = _number(raw, "tolerance", 1e-9, where)
     if kind == "expected_vs_sample":
         branching = _branching(raw, where, 2)
+    elif kind == "until_optimal":
+        return _until_optimal_study(raw, name, seeds, file, title, where)
     else:
         if not 0.0 <= epsilon <= 1.0:
             raise ConfigError(f"{where}: epsilon: must be in [0, 1], got {epsilon:g}.")
@@ -199,6 +228,95 @@ def load_study(path: Path) -> Study:
         name, kind, seeds, branching, initial_error, panels, actions, epsilon, termination,
         tolerance, file, title, where,
     )  # fmt: skip
+
+
+def _until_optimal_study(
+    raw: Mapping[str, Any], name: str, seeds: tuple[int, ...], file: str, title: str, where: str
+) -> Study:
+    scales = raw.get("scales")
+    if (
+        not isinstance(scales, list)
+        or not scales
+        or not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in scales)
+        or len(set(scales)) != len(scales)
+    ):
+        raise ConfigError(
+            f"{where}: scales: must be a list of distinct whole numbers >= 1 (each cell of the "
+            f"Dyna maze becomes a k x k block), such as [1, 2, 3], got {shown_value(scales)}."
+        )
+    methods = raw.get("methods", ["prioritized_sweeping", "dyna_q"])
+    if (
+        not isinstance(methods, list)
+        or not methods
+        or not all(isinstance(m, str) and m in UNTIL_OPTIMAL_METHODS for m in methods)
+        or len(set(methods)) != len(methods)
+    ):
+        raise ConfigError(
+            f"{where}: methods: must be a list of distinct names among "
+            f"{', '.join(UNTIL_OPTIMAL_METHODS)}, got {shown_value(methods)}."
+        )
+    alpha = _number(raw, "alpha", 0.5, where)
+    gamma = _number(raw, "gamma", 0.95, where)
+    epsilon = _number(raw, "epsilon", 0.1, where)
+    theta = _number(raw, "theta", 0.0001, where)
+    for key, value, low, high in (
+        ("alpha", alpha, 0.0, 1.0), ("gamma", gamma, 0.0, 1.0), ("epsilon", epsilon, 0.0, 1.0)
+    ):  # fmt: skip
+        if not low < value <= high:
+            raise ConfigError(f"{where}: {key}: must be in (0, 1], got {value:g}.")
+    if theta < 0:
+        raise ConfigError(f"{where}: theta: must not be negative, got {theta:g}.")
+    planning_steps = _whole(raw, "planning_steps", 5, where, 0)
+    max_updates = _whole(raw, "max_updates", 10_000_000, where, 1)
+    return Study(
+        name, "until_optimal", seeds, (), 1.0, (), 4, epsilon, 0.0, 0.0, file, title, where,
+        tuple(scales), tuple(methods), alpha, gamma, planning_steps, theta, max_updates,
+    )  # fmt: skip
+
+
+def maze_states(scale: int) -> int:
+    """The open cells of the Dyna maze at ``scale`` (the book's number of states): 47 k².
+
+    >>> [maze_states(k) for k in (1, 2, 3)]
+    [47, 188, 423]
+    """
+    return 47 * scale * scale
+
+
+def _until_optimal_runs(
+    study: Study, stop: Callable[[], bool] | None
+) -> dict[tuple[str, int], list[Any]] | None:
+    from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
+    from cartpole_q.worlds.gridworlds import DynaMazeEnv
+
+    runs: dict[tuple[str, int], list[Any]] = {}
+    for scale in study.scales:
+        maze = maze_arrays(DynaMazeEnv(scale))
+        for method in study.methods:
+            settings = Settings(
+                method, study.alpha, study.gamma, study.epsilon, study.planning_steps,
+                study.theta, "random", np.iinfo(np.int64).max, study.max_updates,
+            )  # fmt: skip
+            results = []
+            for seed in study.seeds:
+                if stop is not None and stop():
+                    return None
+                results.append(until_optimal(maze, settings, seed))
+            runs[(method, scale)] = results
+    return runs
+
+
+def until_optimal_curves(study: Study, runs: Mapping[tuple[str, int], list[Any]]) -> list[Curve]:
+    """Per method, the mean updates over the seeds at each maze size, with the least and most."""
+    curves = []
+    x = np.array([float(maze_states(k)) for k in study.scales])
+    for method in study.methods:
+        rows = [np.array([float(r.updates) for r in runs[(method, k)]]) for k in study.scales]
+        mean = np.array([float(np.mean(row)) for row in rows])
+        low = np.array([float(np.min(row)) for row in rows])
+        high = np.array([float(np.max(row)) for row in rows])
+        curves.append(Curve(METHOD_LABELS[method], x, mean, low, high))
+    return curves
 
 
 def _panel(raw: Any, index: int, where: str) -> Panel:
@@ -254,6 +372,12 @@ def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome |
             x = np.arange(2 * branching + 1) / branching
             curves.append(Curve(f"b = {branching}", x, rms_over_problems(sample), None, None))
         return Outcome([curves], largest, time.perf_counter() - start)
+    if study.kind == "until_optimal":
+        runs = _until_optimal_runs(study, stop)
+        if runs is None:
+            return None
+        curves = until_optimal_curves(study, runs)
+        return Outcome([curves], 0.0, time.perf_counter() - start, runs)
     from cartpole_q.engines.trajectory import task_curves
 
     panels = []
@@ -305,6 +429,8 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
             f"{outcome.largest_expected_error:g} (the largest |error| over every problem)"
         )
         return lines
+    if study.kind == "until_optimal":
+        return _until_optimal_summary(study, outcome)
     lines = [
         f"{study.name}: {seeds} tasks per curve, {study.actions} actions, epsilon "
         f"{study.epsilon:g}, termination {study.termination:g}, {outcome.seconds:.1f} s"
@@ -323,6 +449,37 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
             lines.append(
                 f"    {label}, on-policy vs uniform at {values}; {_crossing(uniform, on_policy)}"
             )
+    return lines
+
+
+def _until_optimal_summary(study: Study, outcome: Outcome) -> list[str]:
+    assert outcome.runs is not None
+    lines = [
+        f"{study.name}: {len(study.seeds)} runs per point, alpha {study.alpha:g}, gamma "
+        f"{study.gamma:g}, epsilon {study.epsilon:g}, {study.planning_steps} planning steps, "
+        f"theta {study.theta:g}, {outcome.seconds:.1f} s",
+        "  updates until the greedy path is shortest (mean over runs [least, most]):",
+    ]
+    for scale in study.scales:
+        shown = []
+        for method in study.methods:
+            updates = [r.updates for r in outcome.runs[(method, scale)]]
+            missed = sum(not r.reached for r in outcome.runs[(method, scale)])
+            note = f", {missed} not reached" if missed else ""
+            shown.append(
+                f"{METHOD_LABELS[method]} {np.mean(updates):,.0f} [{min(updates):,}, "
+                f"{max(updates):,}{note}]"
+            )
+        ratio = ""
+        if "prioritized_sweeping" in study.methods and "dyna_q" in study.methods:
+            sweeping = np.mean([r.updates for r in outcome.runs[("prioritized_sweeping", scale)]])
+            dyna = np.mean([r.updates for r in outcome.runs[("dyna_q", scale)]])
+            ratio = f"; Dyna-Q / prioritized sweeping {dyna / sweeping:.1f}"
+        lines.append(
+            f"  k = {scale} ({maze_states(scale):,} states, shortest path {14 * scale} steps): "
+            + "; ".join(shown)
+            + ratio
+        )
     return lines
 
 
@@ -356,6 +513,10 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
             [(b, curve.mean) for b, curve in zip(study.branching, outcome.curves[0], strict=True)],
             study.initial_error,
             study.title,
+        )
+    if study.kind == "until_optimal":
+        return figures.until_optimal_figure(
+            [(c.label, c.x, c.mean, c.low, c.high) for c in outcome.curves[0]], study.title
         )
     panels = []
     for panel, curves in zip(study.panels, outcome.curves, strict=True):

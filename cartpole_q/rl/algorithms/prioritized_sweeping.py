@@ -6,7 +6,9 @@ puts ``(s, a)`` in the queue when ``P > theta``; then, ``agent.planning_steps`` 
 the queue is not empty, the pair of highest priority leaves it and gets Q-learning's update
 on its remembered transition, and every pair remembered as leading to its state (not
 terminally) is queued by its own priority. There is no direct update: every update comes
-from the queue. The next action is drawn from the table after planning. The contract:
+from the queue. The next action is drawn from the table after planning. The memory's last
+array, ``sweep_updates``, counts the updates made (one cell, never read by the algorithm:
+Example 8.4's measure, updates until the greedy path is optimal). The contract:
 docs/algorithms.md.
 
 >>> import numpy as np
@@ -17,6 +19,8 @@ docs/algorithms.md.
 0
 >>> float(q[0, 1])  # P = 1 queued (0, 1); planning: its update, nothing else queued
 0.5
+>>> int(memory[UPDATES][0])  # one update so far
+1
 """
 
 from __future__ import annotations
@@ -39,6 +43,8 @@ from cartpole_q.rl.tabular import (
     value,
 )
 
+QUEUE, UPDATES = 7, 8
+"""the memory's queue (priorities per pair) and its count of updates made"""
 ABSENT = -1.0
 """the priority of a pair not in the queue (every queued priority is above ``theta >= 0``)"""
 
@@ -63,9 +69,12 @@ def first_in_queue(priorities: np.ndarray) -> int:
 @compilable
 def sweep(
     q: Table, model: Memory, priorities: np.ndarray, steps: int, theta: float, alpha: float,
-    gamma: float,
+    gamma: float, updates: np.ndarray,
 ) -> None:  # fmt: skip
-    """Up to ``steps`` updates of the queue's first pairs, queueing their predecessors."""
+    """Up to ``steps`` updates of the queue's first pairs, queueing their predecessors.
+
+    ``updates[0]`` is increased by one per update made.
+    """
     next_states, rewards, terminals = model[0], model[1], model[2]
     n_actions = action_count(q)
     for _ in range(steps):
@@ -78,6 +87,7 @@ def sweep(
         if terminals[flat] == 0:
             target = rewards[flat] + gamma * best_value(q, next_states[flat])
         update(q, state, action, target, alpha)
+        updates[0] += 1
         best = best_value(q, state)
         for before in range(next_states.shape[0]):
             if next_states[before] == state and terminals[before] == 0:
@@ -96,18 +106,22 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     target = reward
     if not terminated:
         target = reward + gamma * best_value(q, next_state)
-    priorities = memory[7]
+    priorities = memory[QUEUE]
     queue(priorities, state * n_actions + action, abs(target - value(q, state, action)), theta)
-    sweep(q, memory, priorities, int(params[0]), theta, alpha, gamma)
+    sweep(q, memory, priorities, int(params[0]), theta, alpha, gamma, memory[UPDATES])
     if terminated or truncated:
         return ENDED
     return behaviour_action(q, params, next_state, epsilon, rng)
 
 
 def sweeping_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
-    """An empty model and an empty queue."""
+    """An empty model, an empty queue and no update made."""
     pairs = context.n_states * context.n_actions
-    return (*model_memory(context.n_states, context.n_actions), np.full(pairs, ABSENT))
+    return (
+        *model_memory(context.n_states, context.n_actions),
+        np.full(pairs, ABSENT),
+        np.zeros(1, dtype=np.int64),
+    )
 
 
 THETA = Param(
@@ -128,5 +142,6 @@ ALGORITHM = Algorithm(
     memory_names=(
         "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
         "model_actions_taken", "model_actions_count", "model_counters", "queue_priorities",
+        "sweep_updates",
     ),
 )  # fmt: skip
