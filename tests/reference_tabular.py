@@ -771,6 +771,54 @@ class DynaQPlus(DynaQ):
     plus = True
 
 
+class PrioritizedSweeping(Agent):
+    """``prioritized_sweeping``: no direct update; planning from a queue by priority."""
+
+    def __init__(self, n_states: int, n: int, *args: Any) -> None:
+        super().__init__(n_states, n, *args)
+        self.model_next = [-1] * (n_states * n)
+        self.model_reward = [0.0] * (n_states * n)
+        self.model_terminated = [False] * (n_states * n)
+        self.priority: dict[int, float] = {}  # queued pairs (flat index) -> priority
+
+    def enqueue(self, flat: int, p: float) -> None:
+        theta = float(self.params["theta"])
+        if p > theta and p > self.priority.get(flat, -1.0):
+            self.priority[flat] = p
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        flat = s * self.n + a
+        self.model_next[flat] = s2
+        self.model_reward[flat] = r
+        self.model_terminated[flat] = terminated
+        y = r if terminated else r + self.gamma * self.max(s2)
+        self.enqueue(flat, abs(y - self.value(s, a)))
+        for _ in range(int(self.params["planning_steps"])):
+            if not self.priority:
+                break
+            top = max(self.priority.values())
+            pair = min(f for f, p in self.priority.items() if p == top)
+            del self.priority[pair]
+            x, b = divmod(pair, self.n)
+            rho = self.model_reward[pair]
+            y = (
+                rho
+                if self.model_terminated[pair]
+                else rho + self.gamma * self.max(self.model_next[pair])
+            )
+            self.update(x, b, y)
+            best = self.max(x)
+            for before in range(len(self.model_next)):
+                if self.model_next[before] == x and not self.model_terminated[before]:
+                    lead = self.model_reward[before] + self.gamma * best
+                    self.enqueue(before, abs(lead - self.value(*divmod(before, self.n))))
+        if terminated or truncated:
+            return None
+        return self.draw(s2)
+
+
 # docs/algorithms.md: Monte Carlo.
 
 
@@ -1238,6 +1286,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "true_online_sarsa_lambda": TrueOnlineSarsaLambda,
     "dyna_q": DynaQ,
     "dyna_q_plus": DynaQPlus,
+    "prioritized_sweeping": PrioritizedSweeping,
     "monte_carlo": MonteCarlo,
     "monte_carlo_es": MonteCarloES,
     "off_policy_monte_carlo": OffPolicyMonteCarlo,
@@ -1258,6 +1307,7 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "trace": "replacing",
     "planning_steps": 10,
     "kappa": 0.001,
+    "theta": 0.0001,
     "update": "sample_average",
     "tie_break": "lowest",  # agent.tie_break, a key of every algorithm
     "policy": "random",

@@ -90,8 +90,9 @@ def shrink_study(path: Path, axes: bool = False) -> None:
     """A sweep or tune file on small settings (comments dropped).
 
     Two seeds, a few trials, and with ``axes`` each sweep axis cut to its first and last
-    values (a zip's axes to their first two): the study keeps its shape and its figure, on
-    fewer points (for studies whose points no page names by number: the book's).
+    values (a zip's axes, and an ``until_optimal`` study's ``scales``, to their first two):
+    the study keeps its shape and its figure, on fewer points (for studies whose points no
+    page names by number: the book's).
     """
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict):
@@ -107,6 +108,8 @@ def shrink_study(path: Path, axes: bool = False) -> None:
         for key, values in (data.get("zip") or {}).items():
             if isinstance(values, list):
                 data["zip"][key] = values[:2]
+        if isinstance(data.get("scales"), list):  # an until_optimal study's maze sizes
+            data["scales"] = data["scales"][:2]
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
 
 

@@ -64,6 +64,7 @@ VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "true_online_sarsa_lambda": ("true_online_sarsa_lambda", {"lambda": 0.8}),
     "dyna_q": ("dyna_q", {"planning_steps": 5}),
     "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
+    "prioritized_sweeping": ("prioritized_sweeping", {"planning_steps": 5, "theta": 0.001}),
     **{
         f"{name}-{update}": (name, {"update": update})
         for name in ("monte_carlo", "monte_carlo_es", "off_policy_monte_carlo")
@@ -86,6 +87,7 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
             "true_online_sarsa_lambda",
             "dyna_q",
             "dyna_q_plus",
+            "prioritized_sweeping",
             "monte_carlo",
             "monte_carlo_es",
             "off_policy_monte_carlo",
@@ -112,6 +114,8 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "true_online_sarsa_lambda-lambda1": ("true_online_sarsa_lambda", {"lambda": 1.0}),
     "dyna_q-planning0": ("dyna_q", {"planning_steps": 0}),
     "dyna_q_plus-kappa0": ("dyna_q_plus", {"planning_steps": 3, "kappa": 0.0}),
+    "prioritized_sweeping-theta0": ("prioritized_sweeping", {"planning_steps": 3, "theta": 0.0}),
+    "prioritized_sweeping-planning0": ("prioritized_sweeping", {"planning_steps": 0}),
     # Greedy behaviour with random ties: b_t = 1 / k of the tied action taken (issue 29: the
     # lowest rule's 0 made W / b_t divide by zero).
     "off_policy_monte_carlo-random-ties-greedy": (
@@ -663,11 +667,13 @@ def test_other_worlds(world: str, variant: str, engine: str) -> None:
     _assert_same(world, variant, engine)
 
 
-# The algorithms that run on tiles (Dyna and Monte Carlo keep states across episodes).
+# The algorithms that run on tiles (Dyna, prioritized sweeping and Monte Carlo keep states
+# across episodes).
 TILE_VARIANTS = [
     variant
     for variant, (algorithm, _) in {**VARIANTS, **EDGE_VARIANTS}.items()
-    if not algorithm.startswith(("dyna", "monte_carlo", "off_policy")) and variant not in LONG_N
+    if not algorithm.startswith(("dyna", "prioritized", "monte_carlo", "off_policy"))
+    and variant not in LONG_N
 ]
 
 

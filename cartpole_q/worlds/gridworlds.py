@@ -34,6 +34,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Any
 
+import numpy as np
+
 from cartpole_q.worlds.table import Outcome, Table, TableWorld
 
 Cell = tuple[int, int]
@@ -216,18 +218,73 @@ class StochasticWindyGridworldEnv(GridWorld):
         )  # fmt: skip
 
 
+def scaled_cells(cells: Iterable[Cell], scale: int) -> frozenset[Cell]:
+    """Every cell of the ``scale`` x ``scale`` blocks that replace ``cells``.
+
+    >>> sorted(scaled_cells({(0, 1)}, 2))
+    [(0, 2), (0, 3), (1, 2), (1, 3)]
+    """
+    return frozenset(
+        (row * scale + down, column * scale + across)
+        for row, column in cells
+        for down in range(scale)
+        for across in range(scale)
+    )
+
+
 class DynaMazeEnv(GridWorld):
     """Example 8.1 (Figure 8.2): a 6 x 9 maze, start (2, 0), goal (0, 8), seven obstacles.
 
     Four moves; reward 0 but +1 on the step that enters the goal. The book discounts with
     gamma 0.95 (a config's ``agent.gamma``); the shortest path takes 14 steps.
+
+    Args:
+        scale: Example 8.4's larger mazes: every cell becomes a ``scale`` x ``scale`` block
+            of cells (a ``6 scale`` x ``9 scale`` grid, each obstacle a block of walls, so
+            ``47 scale²`` open cells); the start and the goal are the top-left cells of
+            their blocks, ``(2 scale, 0)`` and ``(0, 8 scale)`` (as Shangtong Zhang's
+            ``extend_maze``). 1: the maze of Example 8.1.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, scale: int = 1) -> None:
+        if isinstance(scale, bool) or not isinstance(scale, int) or scale < 1:
+            raise ValueError(f"`scale` must be a whole number >= 1, got {scale!r}")
+        self.scale = scale
+        start, goal = DYNA_MAZE_START, MAZE_GOAL
         super().__init__(
-            MAZE_ROWS, MAZE_COLUMNS, DYNA_MAZE_START, MAZE_GOAL, COMPASS_MOVES,
-            step_reward=0.0, goal_reward=1.0, walls=DYNA_MAZE_WALLS,
+            MAZE_ROWS * scale, MAZE_COLUMNS * scale, (start[0] * scale, start[1] * scale),
+            (goal[0] * scale, goal[1] * scale), COMPASS_MOVES, step_reward=0.0,
+            goal_reward=1.0, walls=scaled_cells(DYNA_MAZE_WALLS, scale),
         )  # fmt: skip
+
+    def open_cells(self) -> int:
+        """The cells not walls (47 at scale 1, ``47 scale²``): the book's number of states."""
+        return self.rows * self.columns - len(self.walls)
+
+
+def shortest_path(world: TableWorld, start: int | None = None) -> int:
+    """The fewest steps from ``start`` (the world's start) to a terminal step, by BFS.
+
+    For a deterministic world (one outcome per ``P[s][a]``); -1 when no path ends.
+
+    >>> shortest_path(DynaMazeEnv())
+    14
+    """
+    first = int(np.argmax(world.initial_state_distrib)) if start is None else start
+    distance = {first: 0}
+    frontier = [first]
+    while frontier:
+        following: list[int] = []
+        for state in frontier:
+            for outcomes in world.P[state].values():
+                ((_, next_state, _, terminated),) = outcomes
+                if terminated:
+                    return distance[state] + 1
+                if next_state not in distance:
+                    distance[next_state] = distance[state] + 1
+                    following.append(next_state)
+        frontier = following
+    return -1
 
 
 class ChangingMaze(GridWorld):

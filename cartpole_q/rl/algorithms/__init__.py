@@ -29,6 +29,7 @@ from cartpole_q.rl.algorithms import (
     off_policy_mc_prediction,
     off_policy_monte_carlo,
     offline_lambda_return,
+    prioritized_sweeping,
     q_learning,
     sarsa,
     sarsa_lambda,
@@ -41,9 +42,10 @@ from cartpole_q.rl.algorithms import (
 
 PACKAGE = (
     q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
-    sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus, monte_carlo,
-    monte_carlo_es, off_policy_monte_carlo, td, mc_prediction, batch_prediction,
-    off_policy_mc_prediction, n_step_td, offline_lambda_return, td_lambda, true_online_td_lambda,
+    sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus,
+    prioritized_sweeping, monte_carlo, monte_carlo_es, off_policy_monte_carlo, td,
+    mc_prediction, batch_prediction, off_policy_mc_prediction, n_step_td, offline_lambda_return,
+    td_lambda, true_online_td_lambda,
 )  # fmt: skip
 """the package's algorithm modules, in the order the documentation lists them (control,
 then prediction)"""

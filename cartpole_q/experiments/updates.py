@@ -1,0 +1,549 @@
+"""Chapter 8's planning studies (``cartpole-q updates``): a study file, its curves, its figure.
+
+Three kinds of study (``figure.kind``), all run outside the engines' training runs:
+
+- ``expected_vs_sample`` (Figure 8.7): for each branching factor ``b`` of ``branching``,
+  one problem per seed (:func:`~cartpole_q.rl.planning_updates.sample_update_errors`); the
+  RMS error over the problems after ``t = 0, ..., 2b`` computations.
+- ``trajectory_sampling`` (Figure 8.8): for each panel (a number of states, its
+  branching factors, its updates and how often the start state is valued), one task per
+  seed, run with uniform and with on-policy updates
+  (:mod:`cartpole_q.engines.trajectory`); each point averaged over the tasks.
+- ``until_optimal`` (Example 8.4's figure): for each maze scale ``k`` of ``scales`` (the
+  Dyna maze with every cell a ``k`` x ``k`` block, ``47 k²`` open cells) and each algorithm
+  of ``methods``, one run per seed until the greedy path from the start is a shortest path
+  (:mod:`cartpole_q.engines.until_optimal`); the mean number of updates over the runs, with
+  the smallest and the largest.
+
+:func:`write_study` draws the figure with its data beside it (``<figure>.csv``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from cartpole_q.config import ConfigError, parse_seeds, shown_value
+from cartpole_q.experiments.sweep_spec import (
+    check_top_keys,
+    checked_figure_section,
+    read_study_file,
+)
+
+STUDY_KEYS = (
+    "name", "seeds", "branching", "initial_error", "panels", "actions", "epsilon",
+    "termination", "tolerance", "scales", "methods", "alpha", "gamma", "planning_steps", "theta",
+    "max_updates", "figure",
+)  # fmt: skip
+"""the keys a study file may have"""
+KIND_KEYS = {
+    "expected_vs_sample": ("branching", "initial_error"),
+    "trajectory_sampling": ("panels", "actions", "epsilon", "termination", "tolerance"),
+    "until_optimal": (
+        "scales", "methods", "alpha", "gamma", "epsilon", "planning_steps", "theta",
+        "max_updates",
+    ),
+}  # fmt: skip
+"""the keys each figure kind takes (beside ``name``, ``seeds`` and ``figure``)"""
+FIGURE_KINDS = tuple(KIND_KEYS)
+FIGURE_KEYS = ("kind", "file", "title")
+PANEL_KEYS = ("states", "branching", "updates", "every")
+Z_95 = 1.959963984540054
+UNTIL_OPTIMAL_METHODS = ("prioritized_sweeping", "dyna_q", "q_learning")
+METHOD_LABELS = {
+    "prioritized_sweeping": "Prioritized sweeping",
+    "dyna_q": "Dyna-Q",
+    "q_learning": "Q-learning",
+}
+
+
+@dataclass(frozen=True)
+class Panel:
+    """A panel of Figure 8.8: tasks of ``states`` states, one curve pair per branching."""
+
+    states: int
+    branching: tuple[int, ...]
+    updates: int
+    """expected updates per run"""
+    every: int
+    """the start state is valued after every ``every`` updates (and before the first)"""
+
+
+@dataclass(frozen=True)
+class Study:
+    """A checked study file."""
+
+    name: str
+    kind: str
+    seeds: tuple[int, ...]
+    branching: tuple[int, ...]
+    """``expected_vs_sample``: the branching factors"""
+    initial_error: float
+    panels: tuple[Panel, ...]
+    """``trajectory_sampling``: the panels"""
+    actions: int
+    epsilon: float
+    termination: float
+    tolerance: float
+    file: str
+    title: str
+    where: str
+    scales: tuple[int, ...] = ()
+    """``until_optimal``: the maze scales ``k``"""
+    methods: tuple[str, ...] = ()
+    alpha: float = 0.5
+    gamma: float = 0.95
+    planning_steps: int = 5
+    theta: float = 0.0001
+    max_updates: int = 10_000_000
+
+
+@dataclass(frozen=True)
+class Curve:
+    """A curve averaged over seeds: its points' x, mean, and 95% interval (or none)."""
+
+    label: str
+    x: np.ndarray
+    mean: np.ndarray
+    low: np.ndarray | None
+    high: np.ndarray | None
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a study computed."""
+
+    curves: list[list[Curve]]
+    """per panel (``expected_vs_sample``: one), its curves (``trajectory_sampling``: uniform
+    then on-policy for each branching)"""
+    largest_expected_error: float
+    """``expected_vs_sample``: the largest ``|error|`` of the expected update after ``b``
+    computations, over every problem (0 exactly)"""
+    seconds: float
+    runs: dict[tuple[str, int], list[Any]] | None = None
+    """``until_optimal``: per ``(method, scale)`` each seed's
+    :class:`~cartpole_q.engines.until_optimal.Result`"""
+
+
+def _number(raw: Mapping[str, Any], key: str, default: float, where: str) -> float:
+    value = raw.get(key, default)
+    if isinstance(value, str):  # YAML reads 1e-10 as a string
+        with contextlib.suppress(ValueError):
+            value = float(value)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ConfigError(f"{where}: {key}: must be a number, got {shown_value(value)}.")
+    return float(value)
+
+
+def _whole(raw: Mapping[str, Any], key: str, default: int | None, where: str, least: int) -> int:
+    value = raw.get(key, default)
+    if isinstance(value, bool) or not isinstance(value, int) or value < least:
+        raise ConfigError(
+            f"{where}: {key}: must be a whole number >= {least}, got {shown_value(value)}."
+        )
+    return value
+
+
+def _branching(raw: Mapping[str, Any], where: str, least: int) -> tuple[int, ...]:
+    value = raw.get("branching")
+    if (
+        not isinstance(value, list)
+        or not value
+        or not all(isinstance(b, int) and not isinstance(b, bool) and b >= least for b in value)
+    ):
+        raise ConfigError(
+            f"{where}: branching: must be a list of whole numbers >= {least} (such as [2, 10, "
+            f"100]), got {shown_value(value)}."
+        )
+    return tuple(value)
+
+
+def load_study(path: Path) -> Study:
+    """Read and check a study file.
+
+    Raises:
+        ConfigError: naming the file and the key, with what is wrong.
+    """
+    raw, where, name = read_study_file(
+        path,
+        STUDY_KEYS,
+        "`seeds`, `figure` and the figure kind's keys",
+        "examples/book/fig8_7_expected_vs_sample.yaml",
+    )
+    kind, file, title = checked_figure_section(
+        raw.get("figure"), name, where, FIGURE_KEYS, FIGURE_KINDS
+    )
+    for key in raw:
+        if key in STUDY_KEYS and key not in ("name", "seeds", "figure", *KIND_KEYS[kind]):
+            raise ConfigError(
+                f"{where}: {key}: {'an' if kind[0] in 'aeiou' else 'a'} {kind} study takes no {key} (it takes "
+                f"{', '.join(KIND_KEYS[kind])})."
+            )
+    if "seeds" not in raw:
+        raise ConfigError(
+            f"{where}: seeds: is missing; one problem (or task) per seed, such as 0-99."
+        )
+    try:
+        seeds = parse_seeds(raw["seeds"])
+    except ValueError as error:
+        raise ConfigError(f"{where}: seeds: {error}") from None
+    branching: tuple[int, ...] = ()
+    panels: tuple[Panel, ...] = ()
+    initial_error = _number(raw, "initial_error", 1.0, where)
+    if initial_error < 0:
+        raise ConfigError(f"{where}: initial_error: must not be negative, got {initial_error:g}.")
+    actions = _whole(raw, "actions", 2, where, 1)
+    epsilon = _number(raw, "epsilon", 0.1, where)
+    termination = _number(raw, "termination", 0.1, where)
+    tolerance = _number(raw, "tolerance", 1e-9, where)
+    if kind == "expected_vs_sample":
+        branching = _branching(raw, where, 2)
+    elif kind == "until_optimal":
+        return _until_optimal_study(raw, name, seeds, file, title, where)
+    else:
+        if not 0.0 <= epsilon <= 1.0:
+            raise ConfigError(f"{where}: epsilon: must be in [0, 1], got {epsilon:g}.")
+        if not 0.0 < termination <= 1.0:
+            raise ConfigError(
+                f"{where}: termination: must be in (0, 1] (the evaluation needs episodes to "
+                f"end), got {termination:g}."
+            )
+        if tolerance <= 0:
+            raise ConfigError(f"{where}: tolerance: must be positive, got {tolerance:g}.")
+        panels_raw = raw.get("panels")
+        if not isinstance(panels_raw, list) or not panels_raw:
+            raise ConfigError(
+                f"{where}: panels: must be a list such as [{{states: 1000, branching: [1, 3], "
+                f"updates: 20000, every: 500}}], got {shown_value(panels_raw)}."
+            )
+        panels = tuple(_panel(entry, index, where) for index, entry in enumerate(panels_raw))
+    return Study(
+        name, kind, seeds, branching, initial_error, panels, actions, epsilon, termination,
+        tolerance, file, title, where,
+    )  # fmt: skip
+
+
+def _until_optimal_study(
+    raw: Mapping[str, Any], name: str, seeds: tuple[int, ...], file: str, title: str, where: str
+) -> Study:
+    scales = raw.get("scales")
+    if (
+        not isinstance(scales, list)
+        or not scales
+        or not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in scales)
+        or len(set(scales)) != len(scales)
+    ):
+        raise ConfigError(
+            f"{where}: scales: must be a list of distinct whole numbers >= 1 (each cell of the "
+            f"Dyna maze becomes a k x k block), such as [1, 2, 3], got {shown_value(scales)}."
+        )
+    methods = raw.get("methods", ["prioritized_sweeping", "dyna_q"])
+    if (
+        not isinstance(methods, list)
+        or not methods
+        or not all(isinstance(m, str) and m in UNTIL_OPTIMAL_METHODS for m in methods)
+        or len(set(methods)) != len(methods)
+    ):
+        raise ConfigError(
+            f"{where}: methods: must be a list of distinct names among "
+            f"{', '.join(UNTIL_OPTIMAL_METHODS)}, got {shown_value(methods)}."
+        )
+    alpha = _number(raw, "alpha", 0.5, where)
+    gamma = _number(raw, "gamma", 0.95, where)
+    epsilon = _number(raw, "epsilon", 0.1, where)
+    theta = _number(raw, "theta", 0.0001, where)
+    for key, value, low, high in (
+        ("alpha", alpha, 0.0, 1.0), ("gamma", gamma, 0.0, 1.0), ("epsilon", epsilon, 0.0, 1.0)
+    ):  # fmt: skip
+        if not low < value <= high:
+            raise ConfigError(f"{where}: {key}: must be in (0, 1], got {value:g}.")
+    if theta < 0:
+        raise ConfigError(f"{where}: theta: must not be negative, got {theta:g}.")
+    planning_steps = _whole(raw, "planning_steps", 5, where, 0)
+    max_updates = _whole(raw, "max_updates", 10_000_000, where, 1)
+    return Study(
+        name, "until_optimal", seeds, (), 1.0, (), 4, epsilon, 0.0, 0.0, file, title, where,
+        tuple(scales), tuple(methods), alpha, gamma, planning_steps, theta, max_updates,
+    )  # fmt: skip
+
+
+def maze_states(scale: int) -> int:
+    """The open cells of the Dyna maze at ``scale`` (the book's number of states): 47 k².
+
+    >>> [maze_states(k) for k in (1, 2, 3)]
+    [47, 188, 423]
+    """
+    return 47 * scale * scale
+
+
+def _until_optimal_runs(
+    study: Study, stop: Callable[[], bool] | None
+) -> dict[tuple[str, int], list[Any]] | None:
+    from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
+    from cartpole_q.worlds.gridworlds import DynaMazeEnv
+
+    runs: dict[tuple[str, int], list[Any]] = {}
+    for scale in study.scales:
+        maze = maze_arrays(DynaMazeEnv(scale))
+        for method in study.methods:
+            settings = Settings(
+                method, study.alpha, study.gamma, study.epsilon, study.planning_steps,
+                study.theta, "random", np.iinfo(np.int64).max, study.max_updates,
+            )  # fmt: skip
+            results = []
+            for seed in study.seeds:
+                if stop is not None and stop():
+                    return None
+                results.append(until_optimal(maze, settings, seed))
+            runs[(method, scale)] = results
+    return runs
+
+
+def until_optimal_curves(study: Study, runs: Mapping[tuple[str, int], list[Any]]) -> list[Curve]:
+    """Per method, the mean updates over the seeds at each maze size, with the least and most."""
+    curves = []
+    x = np.array([float(maze_states(k)) for k in study.scales])
+    for method in study.methods:
+        rows = [np.array([float(r.updates) for r in runs[(method, k)]]) for k in study.scales]
+        mean = np.array([float(np.mean(row)) for row in rows])
+        low = np.array([float(np.min(row)) for row in rows])
+        high = np.array([float(np.max(row)) for row in rows])
+        curves.append(Curve(METHOD_LABELS[method], x, mean, low, high))
+    return curves
+
+
+def _panel(raw: Any, index: int, where: str) -> Panel:
+    here = f"{where}: panels[{index}]"
+    if not isinstance(raw, Mapping):
+        raise ConfigError(
+            f"{here}: must be a mapping {{states, branching, updates, every}}, got "
+            f"{shown_value(raw)}."
+        )
+    check_top_keys(raw, PANEL_KEYS, here)
+    for key in PANEL_KEYS:
+        if key not in raw:
+            raise ConfigError(f"{here}.{key}: is missing.")
+    states = _whole(raw, "states", None, here, 1)
+    branching = _branching(raw, here, 1)
+    updates = _whole(raw, "updates", None, here, 1)
+    every = _whole(raw, "every", None, here, 1)
+    if updates % every:
+        raise ConfigError(f"{here}.every: must divide updates ({updates:,}), got {every:,}.")
+    return Panel(states, branching, updates, every)
+
+
+def _averaged(label: str, x: np.ndarray, rows: np.ndarray, interval: bool) -> Curve:
+    """The mean over the rows (summed in order from 0.0) and, with ``interval``, mean ± z·s/√n."""
+    total = np.zeros(rows.shape[1])
+    for row in rows:
+        total = total + row
+    count = rows.shape[0]
+    mean = total / count
+    if not interval or count < 2:
+        return Curve(label, x, mean, None, None)
+    squares = np.zeros(rows.shape[1])
+    for row in rows:
+        squares = squares + (row - mean) * (row - mean)
+    half = Z_95 * np.sqrt(squares / (count - 1)) / math.sqrt(count)
+    return Curve(label, x, mean, mean - half, mean + half)
+
+
+def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome | None:
+    """Compute every curve; ``None`` when ``stop`` (asked before each task) says so."""
+    start = time.perf_counter()
+    if study.kind == "expected_vs_sample":
+        from cartpole_q.rl.planning_updates import rms_over_problems, sample_update_errors
+
+        curves, largest = [], 0.0
+        for branching in study.branching:
+            if stop is not None and stop():
+                return None
+            sample, expected = sample_update_errors(
+                list(study.seeds), branching, study.initial_error
+            )
+            largest = max(largest, float(np.max(np.abs(expected[:, branching:]))))
+            x = np.arange(2 * branching + 1) / branching
+            curves.append(Curve(f"b = {branching}", x, rms_over_problems(sample), None, None))
+        return Outcome([curves], largest, time.perf_counter() - start)
+    if study.kind == "until_optimal":
+        runs = _until_optimal_runs(study, stop)
+        if runs is None:
+            return None
+        curves = until_optimal_curves(study, runs)
+        return Outcome([curves], 0.0, time.perf_counter() - start, runs)
+    from cartpole_q.engines.trajectory import task_curves
+
+    panels = []
+    for panel in study.panels:
+        points = np.arange(panel.updates // panel.every + 1) * panel.every
+        curves = []
+        for branching in panel.branching:
+            uniform, on_policy = [], []
+            for seed in study.seeds:
+                if stop is not None and stop():
+                    return None
+                one, other = task_curves(
+                    seed, panel.states, study.actions, branching, panel.updates, panel.every,
+                    study.termination, study.epsilon, study.tolerance,
+                )  # fmt: skip
+                uniform.append(one)
+                on_policy.append(other)
+            curves.append(_averaged(f"b = {branching}, uniform", points, np.array(uniform), True))
+            curves.append(
+                _averaged(f"b = {branching}, on-policy", points, np.array(on_policy), True)
+            )
+        panels.append(curves)
+    return Outcome(panels, 0.0, time.perf_counter() - start)
+
+
+def _panel_name(panel: Panel) -> str:
+    return f"{panel.states:,} states"
+
+
+def summary(study: Study, outcome: Outcome) -> list[str]:
+    """Lines saying what ran and the key numbers of every curve."""
+    seeds = len(study.seeds)
+    if study.kind == "expected_vs_sample":
+        lines = [
+            f"{study.name}: {seeds} problems per branching factor, initial error "
+            f"{study.initial_error:g}, {outcome.seconds:.1f} s",
+            "  RMS error of sample updates after t computations; the book's sqrt((b-1)/(b t)) "
+            "in brackets:",
+        ]
+        for branching, curve in zip(study.branching, outcome.curves[0], strict=True):
+            shown = []
+            for t in sorted({1, max(1, branching // 10), branching, 2 * branching}):
+                formula = math.sqrt((branching - 1) / (branching * t))
+                shown.append(f"t = {_t_text(t, branching)}: {curve.mean[t]:.4f} [{formula:.4f}]")
+            lines.append(f"  b = {branching:,}: " + "; ".join(shown))
+        lines.append(
+            "  expected updates: error "
+            f"{study.initial_error:g} until b computations, then "
+            f"{outcome.largest_expected_error:g} (the largest |error| over every problem)"
+        )
+        return lines
+    if study.kind == "until_optimal":
+        return _until_optimal_summary(study, outcome)
+    lines = [
+        f"{study.name}: {seeds} tasks per curve, {study.actions} actions, epsilon "
+        f"{study.epsilon:g}, termination {study.termination:g}, {outcome.seconds:.1f} s"
+    ]
+    for panel, curves in zip(study.panels, outcome.curves, strict=True):
+        lines.append(f"  {_panel_name(panel)} (start state's greedy value, mean over tasks):")
+        marks = sorted({panel.updates // 10, panel.updates // 4, panel.updates // 2, panel.updates})
+        marks = [m - m % panel.every for m in marks]
+        for index in range(0, len(curves), 2):
+            uniform, on_policy = curves[index], curves[index + 1]
+            label = uniform.label.partition(",")[0]
+            values = "; ".join(
+                f"{m:,}: {on_policy.mean[m // panel.every]:.3f} vs {uniform.mean[m // panel.every]:.3f}"
+                for m in marks
+            )
+            lines.append(
+                f"    {label}, on-policy vs uniform at {values}; {_crossing(uniform, on_policy)}"
+            )
+    return lines
+
+
+def _until_optimal_summary(study: Study, outcome: Outcome) -> list[str]:
+    assert outcome.runs is not None
+    lines = [
+        f"{study.name}: {len(study.seeds)} runs per point, alpha {study.alpha:g}, gamma "
+        f"{study.gamma:g}, epsilon {study.epsilon:g}, {study.planning_steps} planning steps, "
+        f"theta {study.theta:g}, {outcome.seconds:.1f} s",
+        "  updates until the greedy path is shortest (mean over runs [least, most]):",
+    ]
+    for scale in study.scales:
+        shown = []
+        for method in study.methods:
+            updates = [r.updates for r in outcome.runs[(method, scale)]]
+            missed = sum(not r.reached for r in outcome.runs[(method, scale)])
+            note = f", {missed} not reached" if missed else ""
+            shown.append(
+                f"{METHOD_LABELS[method]} {np.mean(updates):,.0f} [{min(updates):,}, "
+                f"{max(updates):,}{note}]"
+            )
+        ratio = ""
+        if "prioritized_sweeping" in study.methods and "dyna_q" in study.methods:
+            sweeping = np.mean([r.updates for r in outcome.runs[("prioritized_sweeping", scale)]])
+            dyna = np.mean([r.updates for r in outcome.runs[("dyna_q", scale)]])
+            ratio = f"; Dyna-Q / prioritized sweeping {dyna / sweeping:.1f}"
+        lines.append(
+            f"  k = {scale} ({maze_states(scale):,} states, shortest path {14 * scale} steps): "
+            + "; ".join(shown)
+            + ratio
+        )
+    return lines
+
+
+def _t_text(t: int, branching: int) -> str:
+    if t == branching:
+        return "b"
+    if t == 2 * branching:
+        return "2b"
+    if t * 10 == branching:
+        return "b/10"
+    return f"{t:,}"
+
+
+def _crossing(uniform: Curve, on_policy: Curve) -> str:
+    """Where uniform catches up: the first point from which it stays at or above on-policy."""
+    below = np.flatnonzero(uniform.mean[1:] < on_policy.mean[1:])
+    if below.size == 0:
+        return "uniform at or above on-policy throughout"
+    last = int(below[-1]) + 1
+    if last == uniform.mean.shape[0] - 1:
+        return "on-policy still above at the end"
+    return f"uniform at or above on-policy from {int(uniform.x[last + 1]):,} updates on"
+
+
+def study_figure(study: Study, outcome: Outcome) -> Any:
+    """The study's figure (a :class:`~cartpole_q.figures.DataFigure`)."""
+    from cartpole_q import figures
+
+    if study.kind == "expected_vs_sample":
+        return figures.expected_vs_sample_figure(
+            [(b, curve.mean) for b, curve in zip(study.branching, outcome.curves[0], strict=True)],
+            study.initial_error,
+            study.title,
+        )
+    if study.kind == "until_optimal":
+        return figures.until_optimal_figure(
+            [(c.label, c.x, c.mean, c.low, c.high) for c in outcome.curves[0]], study.title
+        )
+    panels = []
+    for panel, curves in zip(study.panels, outcome.curves, strict=True):
+        drawn = [
+            figures.TrajectoryCurve(
+                curve.label, curve.x, curve.mean, curve.low, curve.high, "on-policy" in curve.label
+            )
+            for curve in curves
+        ]
+        panels.append((_panel_name(panel), drawn))
+    return figures.trajectory_sampling_figure(panels, study.title)
+
+
+def write_study(study: Study, outcome: Outcome, out: Path) -> Path:
+    """Write the figure with its data (``<figure>.csv``) beside it."""
+    from cartpole_q.store.figure_file import write_figure
+
+    return write_figure(out, study_figure(study, outcome))
+
+
+def check_outputs(out: Path, force: bool) -> None:
+    """Refuse, before any work, outputs that exist (without ``force``) or cannot be written."""
+    from cartpole_q.store.figure_file import check_figure_file
+
+    check_figure_file(out, "--out", force)
+
+
+def default_out(study: Study) -> Path:
+    """The figure file when ``--out`` is not given: the study's ``figure.file`` here."""
+    return Path(study.file)
