@@ -26,7 +26,7 @@ import math
 import numpy as np
 
 from cartpole_q.rl.algorithm import MemoryContext, Param
-from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable
+from cartpole_q.rl.tabular import Memory, Params, Rng, Table, compilable, weights_of
 
 POLICIES = ("random", "stick_20", "left", "greedy", "epsilon_greedy")
 """``agent.policy`` values, in the order of their codes: ``random`` is uniform over the
@@ -167,11 +167,12 @@ def value_error(q: Table, rows: np.ndarray, values: np.ndarray) -> float:
     >>> value_error(np.array([[0.25], [0.5]]), np.array([[0, 1]]), np.array([1.0]))  # tiles
     0.25
     """
+    weights = weights_of(q)  # the compiled loop on tiles hands (weights, features)
     total = 0.0
     for i in range(rows.shape[0]):
         estimate = 0.0
         for t in range(rows.shape[1]):
-            estimate += q[rows[i, t], 0]
+            estimate += weights[rows[i, t], 0]
         difference = estimate - values[i]
         total += difference * difference
     return math.sqrt(total / rows.shape[0])

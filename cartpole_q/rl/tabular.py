@@ -113,6 +113,12 @@ def visit(visits: np.ndarray, q: Table, state: int, action: int) -> None:
 
 
 @compilable
+def weights_of(q: Table) -> np.ndarray:
+    """The table's entries as one 2-D array: ``q`` itself (on tiles, its tiles' weights)."""
+    return q
+
+
+@compilable
 def with_weights(q: Table, weights: Table) -> Table:
     """Another table of ``q``'s shape addressed as ``q`` is (Double Q-learning's ``B``)."""
     return weights

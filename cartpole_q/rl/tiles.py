@@ -54,6 +54,7 @@ from cartpole_q.rl.tabular import (
     tiles_variant,
     value,
     visit,
+    weights_of,
     with_weights,
 )
 
@@ -145,6 +146,13 @@ def tiled_visit(visits: np.ndarray, q: Any, state: int, action: int) -> None:
     features = q[1]
     for t in range(features.shape[1]):
         visits[features[state, t], action] += 1
+
+
+@tiles_variant(weights_of)
+def tiled_weights_of(q: Any) -> np.ndarray:
+    """The tiles' weights (``q`` is ``(weights, features)``)."""
+    weights: np.ndarray = q[0]
+    return weights
 
 
 @tiles_variant(with_weights)
