@@ -22,9 +22,6 @@ from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame,
 from cartpole_q.errors import RunError
 from cartpole_q.profiles import profile_for
 
-SOLVE_WINDOW = 100
-"""episodes in the moving average of training returns compared with the reward threshold"""
-
 
 @dataclass(frozen=True)
 class EnvInfo:
