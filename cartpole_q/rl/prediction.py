@@ -98,7 +98,7 @@ def drawn_action(policy: np.ndarray, state: int, u: float) -> int:
 
     >>> import numpy as np
     >>> row = np.array([[0.05, 0.9, 0.05]])
-    >>> [drawn_action(row, 0, u) for u in (0.0, 0.05, 0.94, 0.95, 0.999)]
+    >>> [drawn_action(row, 0, u) for u in (0.0, 0.05, 0.94, 0.96, 0.999)]
     [0, 1, 1, 2, 2]
     """
     total = 0.0
