@@ -215,7 +215,12 @@ def _read_or_empty(directory: Path) -> list[Any]:
 @pytest.mark.slow
 def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path) -> None:
     """Two tune directories, one study in a shared journal file: the second one joins."""
-    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 16, "seeds": "0-9"})
+    # Enough work that the first process is still running trials when the second has
+    # started, however warm the cache: 40 trials of 1,000 episodes on 10 seeds, about 0.2 s
+    # each, against the second's 2-3 s start-up (16 trials of 60 episodes once all finished
+    # within it).
+    slow = {**BASE, "train": {"episodes": 1000, "eval_every": 0, "eval_episodes": 2}}
+    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "base": slow, "trials": 40, "seeds": "0-9"})
     journal = tmp_path / "shared.journal"
     first = _start(tmp_path, path, "--out", tmp_path / "one", "--storage", journal, "--workers", 1)
     deadline = time.monotonic() + 120
@@ -230,8 +235,8 @@ def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path
         assert process.wait(timeout=300) == 0, process.stderr.read() if process.stderr else ""
     trials = _storage_trials(journal, "small")
     complete = [t for t in trials if t.state.name == "COMPLETE"]
-    assert len(complete) == 16
-    assert len({t.number for t in complete}) == 16
+    assert len(complete) == 40
+    assert len({t.number for t in complete}) == 40
     owners = {t.user_attrs["owner"] for t in complete}
     assert len(owners) == 2, "both processes ran trials"
     assert not [t for t in trials if t.state.name == "RUNNING"]
