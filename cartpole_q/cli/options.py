@@ -84,3 +84,18 @@ MaxSteps = Annotated[
     int | None,
     typer.Option(metavar="N", min=1, help="Play with another time limit (env max_episode_steps)."),
 ]
+
+StudyFigureOut = Annotated[
+    Path | None,
+    typer.Option(
+        metavar="FILE",
+        help="The figure (.png, .svg or .pdf); the numbers it draws go beside it as .csv.",
+        show_default="the study's figure.file in the current directory",
+    ),
+]
+"""``--out`` of a study command that draws one figure (``bandit``, ``updates``)"""
+
+ReplaceFigure = Annotated[
+    bool, typer.Option("--force", help="Replace the figure and its .csv if they exist.")
+]
+"""``--force`` of a study command that draws one figure"""

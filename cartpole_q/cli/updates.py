@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from cartpole_q.cli.base import Command, app, exit_codes, exit_interrupted
+from cartpole_q.cli.options import ReplaceFigure, StudyFigureOut
 
 
 @app.command("updates", cls=Command)
@@ -22,17 +23,8 @@ def updates_command(
             show_default=False,
         ),
     ],
-    out: Annotated[
-        Path | None,
-        typer.Option(
-            metavar="FILE",
-            help="The figure (.png, .svg or .pdf); the numbers it draws go beside it as .csv.",
-            show_default="the study's figure.file in the current directory",
-        ),
-    ] = None,
-    force: Annotated[
-        bool, typer.Option("--force", help="Replace the figure and its .csv if they exist.")
-    ] = False,
+    out: StudyFigureOut = None,
+    force: ReplaceFigure = False,
 ) -> None:
     """Expected vs sample updates, or uniform vs on-policy updates; draw the figure, print its numbers."""
     with exit_codes():

@@ -28,6 +28,18 @@ from cartpole_q.rl.tabular import (
     update,
 )
 
+MODEL_NOT_ON_TILES = (
+    "its model is a table over states, and a tiled observation is not one of a finite set of states"
+)
+"""why the planning algorithms are refused on tiles (their ``not_on_tiles``)"""
+
+MODEL_MEMORY_NAMES = (
+    "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
+    "model_actions_taken", "model_actions_count", "model_counters",
+)  # fmt: skip
+"""the names of :func:`model_memory`'s arrays, in order (the start of a planning
+algorithm's ``memory_names``)"""
+
 PLANNING_STEPS = Param(
     "planning_steps", 10, "planning updates per real step (0: none)",
     kind="int", low=0, high=10_000,

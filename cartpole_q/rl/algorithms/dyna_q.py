@@ -20,7 +20,14 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.model import PLANNING_STEPS, model_memory, plan_dyna_q, remember
+from cartpole_q.rl.model import (
+    MODEL_MEMORY_NAMES,
+    MODEL_NOT_ON_TILES,
+    PLANNING_STEPS,
+    model_memory,
+    plan_dyna_q,
+    remember,
+)
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -58,14 +65,9 @@ ALGORITHM = Algorithm(
     name="dyna_q",
     description="Dyna-Q: Q-learning plus planning on a learned model (agent.planning_steps)",
     book="8.2",
-    not_on_tiles=(
-        "its model is a table over states, and a tiled observation is not one of a finite set of states"
-    ),
+    not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
     params=(PLANNING_STEPS,),
     memory=dyna_memory,
-    memory_names=(
-        "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
-        "model_actions_taken", "model_actions_count", "model_counters",
-    ),
+    memory_names=MODEL_MEMORY_NAMES,
 )  # fmt: skip

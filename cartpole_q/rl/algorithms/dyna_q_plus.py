@@ -23,7 +23,13 @@ import math
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
-from cartpole_q.rl.model import PLANNING_STEPS, model_memory, remember
+from cartpole_q.rl.model import (
+    MODEL_MEMORY_NAMES,
+    MODEL_NOT_ON_TILES,
+    PLANNING_STEPS,
+    model_memory,
+    remember,
+)
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -94,14 +100,9 @@ ALGORITHM = Algorithm(
     name="dyna_q_plus",
     description="Dyna-Q+: Dyna-Q with a bonus for pairs not tried for long (agent.kappa)",
     book="8.3",
-    not_on_tiles=(
-        "its model is a table over states, and a tiled observation is not one of a finite set of states"
-    ),
+    not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
     params=(PLANNING_STEPS, KAPPA),
     memory=dyna_plus_memory,
-    memory_names=(
-        "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
-        "model_actions_taken", "model_actions_count", "model_counters", "model_last_tried",
-    ),
+    memory_names=(*MODEL_MEMORY_NAMES, "model_last_tried"),
 )  # fmt: skip

@@ -28,7 +28,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
-from cartpole_q.rl.model import PLANNING_STEPS, model_memory, remember
+from cartpole_q.rl.model import (
+    MODEL_MEMORY_NAMES,
+    MODEL_NOT_ON_TILES,
+    PLANNING_STEPS,
+    model_memory,
+    remember,
+)
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -133,15 +139,10 @@ ALGORITHM = Algorithm(
     name="prioritized_sweeping",
     description="Prioritized sweeping: planning updates in order of priority (agent.theta)",
     book="8.4",
-    not_on_tiles=(
-        "its model is a table over states, and a tiled observation is not one of a finite set of states"
-    ),
+    not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
     params=(PLANNING_STEPS, THETA),
     memory=sweeping_memory,
-    memory_names=(
-        "model_next_states", "model_rewards", "model_terminals", "model_states_seen",
-        "model_actions_taken", "model_actions_count", "model_counters", "queue_priorities",
-        "sweep_updates",
-    ),
+    memory_names=(*MODEL_MEMORY_NAMES, "queue_priorities",
+        "sweep_updates"),
 )  # fmt: skip
