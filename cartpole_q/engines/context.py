@@ -31,14 +31,15 @@ class StepContextType(types.StructRef):
 
     def preprocess_fields(self, fields: Any) -> Any:
         """Store plain (non-literal) field types."""
-        return tuple((name, types.unliteral(typ)) for name, typ in fields)
+        # numba's own functions carry no annotations: the untyped calls below are its.
+        return tuple((name, types.unliteral(typ)) for name, typ in fields)  # type: ignore[no-untyped-call]
 
 
 class StepContext(structref.StructRefProxy):
     """Python-side proxy of the record; create it with :func:`step_context`."""
 
 
-structref.define_proxy(StepContext, StepContextType, list(FIELDS))
+structref.define_proxy(StepContext, StepContextType, list(FIELDS))  # type: ignore[no-untyped-call]
 
 
 @njit(cache=True)
@@ -59,8 +60,10 @@ def step_context(rng: Any, q: Any, visits: Any, memory: Any, params: Any, grid: 
                  gamma: float) -> StepContext:  # fmt: skip
     """The record of a run; keep ``rng`` and the arrays alive as long as it is used."""
     values = (rng, q, visits, memory, params, grid, gamma)
-    context_type = StepContextType(
-        [(name, numba.typeof(value)) for name, value in zip(FIELDS, values, strict=True)]
-    )
+    fields = [
+        (name, numba.typeof(value))  # type: ignore[no-untyped-call]
+        for name, value in zip(FIELDS, values, strict=True)
+    ]
+    context_type = StepContextType(fields)  # type: ignore[no-untyped-call]
     context: StepContext = _new(context_type, *values)
     return context
