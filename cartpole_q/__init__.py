@@ -65,20 +65,22 @@ def train(
     import sys
 
     from cartpole_q.config import Config, load_config
-    from cartpole_q.engines import compile_notice, resolve_engine
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines import compile_notice
+    from cartpole_q.engines.plan import plan_run
     from cartpole_q.training import train as train_config
 
     if not isinstance(config, Config):
         config = load_config(config)
-    env_info = options.pop("env_info", None) or inspect_env(config)
+    plan = plan_run(config, env_info=options.pop("env_info", None))
     if not quiet:
         resume = options.get("resume")
-        engine = resume.engine if resume is not None else resolve_engine(config, env_info)
-        notice = compile_notice(config, env_info, engine)
+        if resume is not None and resume.engine != plan.engine:
+            notice = compile_notice(config, plan.env_info, resume.engine)
+        else:
+            notice = compile_notice(config, plan.env_info, plan.engine, plan.twin)
         if notice is not None:
             print(notice, file=sys.stderr, flush=True)
-    return train_config(config, env_info=env_info, **options)
+    return train_config(plan, **options)
 
 
 # Every use of the package (the command line imports it too) can make the worlds' ids.

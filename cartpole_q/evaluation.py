@@ -223,7 +223,7 @@ def greedy_play(
                 f"--engine numba: {settings}; play in gymnasium.make (--engine gymnasium, "
                 "the default)."
             )
-        twin = make_engine("numba", config, env_info, env_seed=0)
+        twin = make_engine("numba", config, env_info, env_seed=0, twin=settings)
         return twin.evaluate
     params = AgentParams.from_config(config, env_info)
     step_cap = None if env_info.max_episode_steps else GREEDY_STEP_CAP

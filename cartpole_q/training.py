@@ -21,9 +21,10 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import Config
-from cartpole_q.engines import make_engine, resolve_engine
+from cartpole_q.engines import make_engine
 from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingState
-from cartpole_q.envs.gym import EnvInfo, inspect_env
+from cartpole_q.engines.plan import Plan, plan_run
+from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
 from cartpole_q.rl.algorithms import get as get_algorithm
@@ -204,7 +205,7 @@ class TrainResult:
 
 
 def train(
-    config: Config,
+    config: Config | Plan,
     *,
     env_info: EnvInfo | None = None,
     resume: Checkpoint | None = None,
@@ -218,8 +219,10 @@ def train(
     """Train a Q-table as the config says.
 
     Args:
-        config: a validated config (its ``train.seeds`` is ignored: one run, ``config.seed``).
-        env_info: the checked environment, if the caller already inspected it.
+        config: a validated config (its ``train.seeds`` is ignored: one run, ``config.seed``),
+            or its :class:`~cartpole_q.engines.plan.Plan` (then nothing is checked again).
+        env_info: the checked environment, if the caller already inspected it (without a
+            plan).
         resume: a checkpoint to continue from; the result is then byte-identical to an
             uninterrupted run.
         should_stop: polled between chunks of episodes, and between chunks of greedy
@@ -240,15 +243,18 @@ def train(
     Raises:
         ConfigError: the config does not fit its environment.
     """
-    env_info = env_info or inspect_env(config)
-    engine_name = resume.engine if resume is not None else resolve_engine(config, env_info)
+    plan = config if isinstance(config, Plan) else plan_run(config, env_info=env_info)
+    config, env_info = plan.config, plan.env_info
+    engine_name = resume.engine if resume is not None else plan.engine
+    twin = plan.twin if engine_name == plan.engine else None  # (a resumed run's own engine)
     agent_rng, env_seed, physics_rng = derive_generators(config.seed)
     state = TrainingState.fresh(config, env_info, agent_rng, physics_rng)
     if resume is not None:
         _restore(state, resume)
     engine = make_engine(
-        engine_name, config, env_info, env_seed, None if resume is None else resume.env_rng_state
-    )
+        engine_name, config, env_info, env_seed,
+        None if resume is None else resume.env_rng_state, twin,
+    )  # fmt: skip
     hooks = _Hooks(should_stop, on_progress, on_checkpoint, snapshot_every, on_snapshot)
     try:
         engine.warm_up(state)

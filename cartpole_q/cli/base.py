@@ -20,6 +20,7 @@ from typer.core import TyperCommand, TyperGroup
 from cartpole_q.errors import UserError, WriteError
 
 if TYPE_CHECKING:
+    from cartpole_q.engines.plan import Plan
     from cartpole_q.experiments.run import StopRequest
 
 EXIT_BAD_INPUT = 2
@@ -274,15 +275,15 @@ def backend_connection(
         yield
 
 
-def say_if_compiling(config: Any, prepared: Any = None) -> None:
-    """Tell the user when the first run will compile the training loop (seconds, once)."""
-    from cartpole_q.engines import compile_notice, resolve_engine
-    from cartpole_q.envs.gym import inspect_env
+def say_if_compiling(config: Any, plan: Plan | None = None) -> None:
+    """Tell the user when the first run will compile the training loop (seconds, once).
 
-    if prepared is None:
-        info = inspect_env(config)
-        notice = compile_notice(config, info, resolve_engine(config, info))
-    else:
-        notice = compile_notice(config, prepared.env_info, prepared.engine)
+    ``plan`` is the run's plan when the command has one (nothing is checked again).
+    """
+    from cartpole_q.engines import compile_notice
+    from cartpole_q.engines.plan import plan_run
+
+    plan = plan or plan_run(config)
+    notice = compile_notice(plan.config, plan.env_info, plan.engine, plan.twin)
     if notice is not None:
         typer.echo(notice, err=True)

@@ -7,18 +7,32 @@ this package costs nothing to import.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from cartpole_q.config import Config, ConfigError, Provenance, blame
 from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
+if TYPE_CHECKING:  # the registry loads when an engine is made, not when this is imported
+    from cartpole_q.envs.registry import TwinSettings
+
 
 def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance = "config") -> str:
     """Return the engine that will run: ``auto`` becomes numba where a twin exists.
 
-    A config with ``train.info_metric`` runs on the gymnasium engine: the compiled twins
-    report no ``info``, so ``auto`` takes gymnasium and ``numba`` is refused.
+    See :func:`engine_and_twin`, which also gives the twin's settings.
+    """
+    return engine_and_twin(config, env_info, source)[0]
+
+
+def engine_and_twin(
+    config: Config, env_info: EnvInfo, source: str | Provenance = "config"
+) -> tuple[str, TwinSettings | None]:
+    """The engine that will run (``auto`` resolved) and, on the numba engine, its twin.
+
+    ``auto`` becomes numba where a twin exists. A config with ``train.info_metric`` runs on
+    the gymnasium engine: the compiled twins report no ``info``, so ``auto`` takes
+    gymnasium and ``numba`` is refused.
 
     Raises:
         ConfigError: ``engine: numba`` was asked for an environment no twin reproduces, or
@@ -27,7 +41,7 @@ def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance =
     from cartpole_q.envs.registry import TwinSettings, twin_settings
 
     if config.engine == "gymnasium":
-        return "gymnasium"
+        return "gymnasium", None
     info_key = config.train.info_metric
     if info_key is not None:
         if config.engine == "numba":
@@ -36,18 +50,31 @@ def resolve_engine(config: Config, env_info: EnvInfo, source: str | Provenance =
                 f"({info_key}): the compiled twins report no info. Use engine: gymnasium (or "
                 "auto, which takes it for such a config), or leave train.info_metric out."
             )
-        return "gymnasium"
+        return "gymnasium", None
     settings = twin_settings(
         config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
     )
     if isinstance(settings, TwinSettings):
-        return "numba"
+        return "numba", settings
     if config.engine == "numba":
         raise ConfigError(
             f"{blame(source, 'engine')}: engine: numba cannot run this config: {settings}. Use engine: "
             "gymnasium (or auto, which falls back to it)."
         )
-    return "gymnasium"
+    return "gymnasium", None
+
+
+def _twin(config: Config, env_info: EnvInfo, twin: TwinSettings | None) -> TwinSettings:
+    """``twin``, or the config's twin settings when the caller has none."""
+    if twin is not None:
+        return twin
+    from cartpole_q.envs.registry import TwinSettings, twin_settings
+
+    settings = twin_settings(
+        config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
+    )
+    assert isinstance(settings, TwinSettings), settings  # engine_and_twin checked it
+    return settings
 
 
 def check_prediction(config: Config, env_info: EnvInfo) -> None:
@@ -74,20 +101,18 @@ def make_engine(
     env_info: EnvInfo,
     env_seed: int,
     env_rng_state: dict[str, Any] | None = None,
+    twin: TwinSettings | None = None,
 ) -> Engine:
     """Build the named engine for a config, seeding its environment with ``env_seed``.
 
-    ``env_rng_state`` restores a checkpointed environment generator instead.
+    ``env_rng_state`` restores a checkpointed environment generator instead; ``twin`` is
+    the twin's settings when the caller has them (a :class:`~cartpole_q.engines.plan.Plan`).
     """
     params = AgentParams.from_config(config, env_info)
     if name == "numba":
         from cartpole_q.engines.numba_engine import NumbaEngine
-        from cartpole_q.envs.registry import TwinSettings, twin_settings
 
-        settings = twin_settings(
-            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
-        )
-        assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
+        settings = _twin(config, env_info, twin)
         return NumbaEngine(settings, params, env_seed, env_rng_state, config.env.randomize)
     from cartpole_q.engines.gymnasium_engine import GymnasiumEngine
     from cartpole_q.envs.models import GREEDY_STEP_CAP
@@ -96,12 +121,14 @@ def make_engine(
     return GymnasiumEngine(config, params, env_seed, env_rng_state, step_cap)
 
 
-def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...]:
+def loop_names(
+    config: Config, env_info: EnvInfo, engine: str, twin: TwinSettings | None = None
+) -> tuple[str, ...]:
     """The compiled loops a run of ``config`` on ``engine`` calls, as numba's cache names them.
 
     On the numba engine, the training loops its epsilon plays over ``train.episodes`` (see
-    :func:`~cartpole_q.engines.base.loops_played`); on the gymnasium engine, its step
-    functions (named by the one that learns).
+    :func:`~cartpole_q.engines.base.loops_played`) on ``twin`` (the config's twin when
+    ``None``); on the gymnasium engine, its step functions (named by the one that learns).
     """
     from cartpole_q.engines.base import (
         epsilon_record,
@@ -115,12 +142,7 @@ def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...
     grid = config.discretization
     tiled = grid is not None and grid.tilings > 1
     if engine == "numba":
-        from cartpole_q.envs.registry import TwinSettings, twin_settings
-
-        settings = twin_settings(
-            config.env.id, config.env.kwargs, env_info.max_episode_steps, config.env.physics
-        )
-        assert isinstance(settings, TwinSettings), settings  # resolve_engine checked it
+        settings = _twin(config, env_info, twin)
         randomized = bool(config.env.randomize)
         played = loops_played(epsilon_record(config), 0, config.train.episodes)
         return tuple(
@@ -136,7 +158,9 @@ def loop_names(config: Config, env_info: EnvInfo, engine: str) -> tuple[str, ...
     return (step_function_name("next_step", algorithm.key, kind),)
 
 
-def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None:
+def compile_notice(
+    config: Config, env_info: EnvInfo, engine: str, twin: TwinSettings | None = None
+) -> str | None:
     """What to tell a user before a run whose compiled loop is not in numba's cache yet.
 
     Returns:
@@ -148,7 +172,7 @@ def compile_notice(config: Config, env_info: EnvInfo, engine: str) -> str | None
     from cartpole_q.numba_cache import is_cached
     from cartpole_q.rl.algorithms import get as get_algorithm
 
-    if all(is_cached(name) for name in loop_names(config, env_info, engine)):
+    if all(is_cached(name) for name in loop_names(config, env_info, engine, twin)):
         return None
     module = get_algorithm(config.agent.algorithm).step.__module__
     if module.partition(".")[0] != __name__.partition(".")[0]:
@@ -175,13 +199,11 @@ def precompile(config: Config, engine: str) -> None:
     import numpy as np
 
     from cartpole_q.engines.base import TrainingState
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import plan_run
 
-    config = dataclasses.replace(config, engine=engine)
-    info = inspect_env(config)
-    chosen = resolve_engine(config, info)
-    state = TrainingState.fresh(config, info, np.random.default_rng(0))
-    made = make_engine(chosen, config, info, env_seed=0)
+    plan = plan_run(dataclasses.replace(config, engine=engine))
+    state = TrainingState.fresh(plan.config, plan.env_info, np.random.default_rng(0))
+    made = make_engine(plan.engine, plan.config, plan.env_info, env_seed=0, twin=plan.twin)
     try:
         made.warm_up(state)
     finally:

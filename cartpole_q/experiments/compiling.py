@@ -17,11 +17,14 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from cartpole_q.config import Config, load_config
 from cartpole_q.experiments.workers import JobHandle, default_workers, execute
 from cartpole_q.rl.algorithms import names as algorithm_names
+
+if TYPE_CHECKING:
+    from cartpole_q.engines.plan import Plan
 
 ENGINE_CONFIGS = {
     "numba": ("default", "mountaincar", "acrobot", "frozenlake", "taxi", "blackjack"),
@@ -110,7 +113,7 @@ def compile_all(
 
 
 def compile_ahead(
-    configs: Sequence[Config],
+    configs: Sequence[Config | Plan],
     workers: int,
     should_stop: Callable[[], bool] | None = None,
     on_start: Callable[[int], None] | None = None,
@@ -122,7 +125,8 @@ def compile_ahead(
     the cache.
 
     Args:
-        configs: the configs of the runs about to start (validated).
+        configs: the configs of the runs about to start (validated), or their plans
+            (then their environments are not inspected again).
         workers: the worker processes the runs will use.
         should_stop: polled about ten times a second; once true, the loops being compiled
             are abandoned (their processes killed) and this returns at once.
@@ -131,7 +135,8 @@ def compile_ahead(
     Returns:
         How many loops were compiled.
     """
-    from cartpole_q.engines import loop_names, resolve_engine
+    from cartpole_q.engines import engine_and_twin, loop_names
+    from cartpole_q.engines.plan import Plan
     from cartpole_q.envs.gym import inspect_env
     from cartpole_q.numba_cache import is_cached
 
@@ -140,15 +145,19 @@ def compile_ahead(
     jobs: list[tuple[dict[str, Any], str]] = []
     counted: set[str] = set()
     seen: set[tuple[Any, ...]] = set()
-    for config in configs:
+    for given in configs:
+        config = given.config if isinstance(given, Plan) else given
         signature = _loop_signature(config)
         if signature in seen:
             continue
         seen.add(signature)
-        info = inspect_env(config)
-        engine = resolve_engine(config, info)
+        if isinstance(given, Plan):
+            info, engine, twin = given.env_info, given.engine, given.twin
+        else:
+            info = inspect_env(config)
+            engine, twin = engine_and_twin(config, info)
         missing = [
-            name for name in loop_names(config, info, engine)
+            name for name in loop_names(config, info, engine, twin)
             if name not in counted and not is_cached(name)
         ]  # fmt: skip
         if missing:

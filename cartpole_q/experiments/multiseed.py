@@ -17,11 +17,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cartpole_q.config import format_seeds, load_config
+from cartpole_q.config import Config, format_seeds, load_config
+from cartpole_q.engines.plan import Plan
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.run import (
-    Prepared,
     check_resumable,
     execute_run,
     outcome_line,
@@ -42,7 +42,7 @@ from cartpole_q.training import Checkpoint, TrainResult
 
 
 def run_seeds(
-    prepared: Prepared,
+    prepared: Plan,
     parent: Path,
     *,
     workers: int,
@@ -109,10 +109,12 @@ def run_seeds(
         # Several seeds per job: a worker loads the config and the compiled loop once per
         # job, not once per seed.
         items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
+        # This process's plan, for the jobs it runs itself and the workers it forks.
+        _PLANS[_plan_key(config)] = prepared
         size = chunk_size(len(items), workers)
         chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
         if len(chunks) > 1:  # compiled once before the workers start, not once per worker
-            compile_ahead([config], workers, should_stop)
+            compile_ahead([prepared], workers, should_stop)
         execute(
             _train_seeds, chunks, on_item,
             workers=workers, should_stop=should_stop, reporter=reporter,
@@ -145,23 +147,37 @@ def _train_seeds(
     Yields:
         ``(seed, interrupted)`` as each started seed ends; a stop leaves the rest out.
     """
-    env_info = None
     reporter = handle.reporter()
     for child, seed, resume in items:
         if handle.should_stop():
             return
         path = Path(child)
         config = load_config(path / rundir.CONFIG_FILE)
-        if env_info is None:
-            prepared = prepare(config, str(path / rundir.CONFIG_FILE))
-            env_info = prepared.env_info
-        else:
-            prepared = dataclasses.replace(prepared, config=config)
+        plan = _seed_plan(config, str(path / rundir.CONFIG_FILE))
         outcome = execute_run(
-            path, prepared, resume=resume, should_stop=handle.should_stop, reporter=reporter,
+            path, plan, resume=resume, should_stop=handle.should_stop, reporter=reporter,
             key=f"worker {os.getpid()}", label=f"seed {seed}", plot=plot,
         )  # fmt: skip
         yield seed, outcome.result.interrupted
+
+
+_PLANS: dict[str, Plan] = {}
+"""this process's plan of each multi-seed config it trains seeds of (by the config but its
+seed), so that a worker inspects the environment once for all the seeds it trains"""
+
+
+def _plan_key(config: Config) -> str:
+    """What a multi-seed config's seeds share: the config but its seed."""
+    return repr(config.for_seed(0).to_dict())
+
+
+def _seed_plan(config: Config, source: str) -> Plan:
+    """The plan of one seed's config: the process's plan of its config, planned once."""
+    key = _plan_key(config)
+    plan = _PLANS.get(key)
+    if plan is None:
+        plan = _PLANS[key] = prepare(config, source)
+    return plan.with_config(config)
 
 
 @dataclass(frozen=True)
@@ -177,7 +193,7 @@ class _TrainedSeed:
 
 
 def _train_remotely(
-    prepared: Prepared,
+    prepared: Plan,
     jobs: Sequence[tuple[int, Path, bool]],
     finished: list[int],
     workers: int,
@@ -229,12 +245,11 @@ def _train_seeds_in_memory(
     Yields:
         Each seed as it finishes.
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import plan_run
     from cartpole_q.store.checkpoint import checkpoint_bytes, checkpoint_from_bytes
     from cartpole_q.training import train
 
-    config = load_config(mapping)
-    env_info = inspect_env(config)
+    plan = plan_run(load_config(mapping))
     for seed, checkpoint in items:
         last: list[bytes] = []
 
@@ -242,7 +257,7 @@ def _train_seeds_in_memory(
             kept[:] = [checkpoint_bytes(snapshot)]
 
         resume = None if checkpoint is None else checkpoint_from_bytes(checkpoint, f"seed {seed}")
-        result = train(config.for_seed(seed), env_info=env_info, resume=resume, on_checkpoint=keep)
+        result = train(plan.for_seed(seed), resume=resume, on_checkpoint=keep)
         fields = {
             field.name: getattr(result, field.name)
             for field in dataclasses.fields(result)

@@ -31,7 +31,7 @@ from cartpole_q.config import (
     load_config,
     shown_value,
 )
-from cartpole_q.envs.gym import EnvInfo, inspect_env
+from cartpole_q.engines.plan import Plan, plan_run
 from cartpole_q.errors import RunError
 from cartpole_q.progress import NullReporter, Reporter
 from cartpole_q.results import RunSummary, SeedResult
@@ -44,17 +44,6 @@ from cartpole_q.store.checkpoint import (
     write_checkpoint,
 )
 from cartpole_q.training import Checkpoint, TrainResult, train
-
-
-@dataclass(frozen=True)
-class Prepared:
-    """A checked config with its environment and engine, ready to train."""
-
-    config: Config
-    env_info: EnvInfo
-    engine: str
-    source: str
-    """the config's file (or another label), for messages"""
 
 
 @dataclass(frozen=True)
@@ -110,18 +99,15 @@ class StopRequest:
         self._previous.clear()
 
 
-def prepare(config: Config, source: str | Provenance) -> Prepared:
-    """Check a config against its environment and pick its engine (no files touched).
+def prepare(config: Config, source: str | Provenance) -> Plan:
+    """Plan a run: check a config against its environment, pick its engine and twin.
+
+    No files are touched (see :func:`~cartpole_q.engines.plan.plan_run`).
 
     Raises:
         ConfigError: the config does not fit its environment or engine.
     """
-    from cartpole_q.engines import check_prediction, resolve_engine
-
-    env_info = inspect_env(config, source)
-    engine = resolve_engine(config, env_info, source)
-    check_prediction(config, env_info)
-    return Prepared(config, env_info, engine, str(source))
+    return plan_run(config, source)
 
 
 def prepare_new(
@@ -132,7 +118,7 @@ def prepare_new(
     seeds: str | None = None,
     episodes: int | None = None,
     engine: str | None = None,
-) -> Prepared:
+) -> Plan:
     """Load a new run's config from a file (or the default) and the command line's values.
 
     Args:
@@ -163,7 +149,7 @@ def prepare_new(
 
 
 @contextlib.contextmanager
-def new_run(prepared: Prepared, out: Path | None) -> Iterator[Path]:
+def new_run(prepared: Plan, out: Path | None) -> Iterator[Path]:
     """Create the run directory and write its ``config.yaml``, holding its lock inside.
 
     A failure before ``config.yaml`` is written (a full disk) removes the directory this
@@ -180,7 +166,7 @@ def new_run(prepared: Prepared, out: Path | None) -> Iterator[Path]:
         yield claim.path
 
 
-def start_run(prepared: Prepared, out: Path | None) -> Path:
+def start_run(prepared: Plan, out: Path | None) -> Path:
     """Create the run directory and write its ``config.yaml`` (its lock released on return).
 
     Raises:
@@ -192,7 +178,7 @@ def start_run(prepared: Prepared, out: Path | None) -> Path:
 
 def execute_run(
     run_dir: Path,
-    prepared: Prepared,
+    prepared: Plan,
     *,
     resume: bool = False,
     should_stop: Callable[[], bool] | None = None,
@@ -239,8 +225,7 @@ def execute_run(
         (run_dir / rundir.SUMMARY_FILE).unlink(missing_ok=True)
     reporter.start(key, label or run_dir.name, config.train.episodes)
     result = train(
-        config,
-        env_info=prepared.env_info,
+        prepared.with_config(config),
         resume=checkpoint,
         should_stop=should_stop,
         on_progress=lambda progress: reporter.update(key, progress),
@@ -283,7 +268,7 @@ def _greedy_viewer(
     return view
 
 
-def prepare_resume(run_dir: Path, episodes: int | None = None) -> Prepared:
+def prepare_resume(run_dir: Path, episodes: int | None = None) -> Plan:
     """Load a run's config for ``--resume``: an unfinished run, or one to extend.
 
     Args:

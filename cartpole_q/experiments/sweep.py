@@ -125,16 +125,16 @@ def run_task(
     Yields:
         Each run as it ends.
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import plan_run
     from cartpole_q.training import train
 
     for point, mapping, seeds in task:
         config = load_config(mapping)
-        env_info = inspect_env(config)
+        plan = plan_run(config)
         for seed in seeds:
             if handle.should_stop():
                 return
-            result = train(config.for_seed(seed), env_info=env_info)
+            result = train(plan.for_seed(seed))
             records = {}
             if result.info is not None:
                 records[f"{INFO_COLUMN_PREFIX}{config.train.info_metric}"] = result.info
