@@ -19,8 +19,9 @@ import numpy as np
 
 from cartpole_q.config import MAX_EPISODES, Config, ConfigError, load_config
 from cartpole_q.engines.base import AgentParams
+from cartpole_q.engines.plan import env_facts
 from cartpole_q.engines.play import FrameCallback, play_greedy
-from cartpole_q.envs.gym import EnvInfo, inspect_env, make_env
+from cartpole_q.envs.gym import EnvInfo, make_env
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.errors import RunError
 
@@ -108,7 +109,7 @@ def under_conditions(
     if max_steps is not None:
         overrides["env.kwargs.max_episode_steps"] = max_steps
         explicit = config.train.reward_threshold is not None
-        if explicit and max_steps != inspect_env(config).max_episode_steps:
+        if explicit and max_steps != env_facts(config).max_episode_steps:
             overrides["train.reward_threshold"] = None
     if not overrides:
         return config
@@ -172,7 +173,7 @@ def evaluate_tables(
         raise ConfigError(
             f"--episodes: must be between 1 and {MAX_EPISODES:,} greedy episodes, got {episodes:,}."
         )
-    env_info = inspect_env(config)
+    env_info = env_facts(config)
     for number, q_table in enumerate(q_tables):
         name = "the Q-table" if len(q_tables) == 1 else f"Q-table {number + 1}"
         check_q_table(q_table, env_info.state_shape, env_info.n_actions, name)

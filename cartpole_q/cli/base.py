@@ -161,6 +161,7 @@ def exit_codes() -> Iterator[None]:
     :func:`stoppable`); once interrupted, further signals are ignored while it exits.
     """
     import signal
+    import sys
     import threading
 
     def interrupt(signum: int, frame: object) -> None:
@@ -169,6 +170,9 @@ def exit_codes() -> Iterator[None]:
     main = threading.current_thread() is threading.main_thread()
     previous = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     interrupted = False
+    planning = sys.modules.get("cartpole_q.engines.plan")
+    if planning is not None:  # (not imported yet: nothing kept) an earlier command's facts
+        planning.forget_plans()
     if main:
         signal.signal(signal.SIGTERM, interrupt)
     try:

@@ -199,11 +199,13 @@ def precompile(config: Config, engine: str) -> None:
     import numpy as np
 
     from cartpole_q.engines.base import TrainingState
-    from cartpole_q.engines.plan import plan_run
+    from cartpole_q.envs.gym import inspect_env
 
-    plan = plan_run(dataclasses.replace(config, engine=engine))
-    state = TrainingState.fresh(plan.config, plan.env_info, np.random.default_rng(0))
-    made = make_engine(plan.engine, plan.config, plan.env_info, env_seed=0, twin=plan.twin)
+    config = dataclasses.replace(config, engine=engine)
+    info = inspect_env(config)
+    chosen, twin = engine_and_twin(config, info)
+    state = TrainingState.fresh(config, info, np.random.default_rng(0))
+    made = make_engine(chosen, config, info, env_seed=0, twin=twin)
     try:
         made.warm_up(state)
     finally:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from cartpole_q.config import Config, Provenance
-from cartpole_q.envs.gym import EnvInfo, inspect_env
+from cartpole_q.envs.gym import EnvInfo, inspect_env, inspected_fields
 
 if TYPE_CHECKING:  # the registry loads when an engine is made
     from cartpole_q.envs.registry import TwinSettings
@@ -72,3 +72,67 @@ def plan_run(
     engine, twin = engine_and_twin(config, env_info, source)
     check_prediction(config, env_info)
     return Plan(config, env_info, engine, str(source), twin)
+
+
+_KEPT: dict[str, Plan] = {}
+"""this process's plans, by their config but its seed (see :func:`planned`)"""
+_FACTS: dict[str, EnvInfo] = {}
+"""the environment facts of those plans, by what :func:`inspect_env` reads of a config"""
+
+
+def _plan_key(config: Config) -> str:
+    """What the configs that share a plan share: everything but the seed."""
+    return repr(config.for_seed(0).to_dict())
+
+
+def planned(config: Config, source: str | Provenance = "config") -> Plan:
+    """The plan of ``config``, made once per process for all the configs that share it.
+
+    A study runs one config on many seeds, often in the same process (or in workers it
+    forks, which inherit its plans): they share a plan, made by :func:`plan_run` the first
+    time and kept, so that the environment is inspected once per study, not once per run.
+    Configs that differ in more than their seed have plans of their own, but share the
+    environment's facts where :func:`~cartpole_q.envs.gym.inspect_env` reads the same
+    (a sweep over ``agent.alpha``).
+
+    Raises:
+        ConfigError: the config does not fit its environment or engine (nothing is kept).
+    """
+    key = _plan_key(config)
+    plan = _KEPT.get(key)
+    if plan is None:
+        plan = _KEPT[key] = plan_run(config, source, env_facts(config, source))
+    return plan.with_config(config)
+
+
+def env_facts(config: Config, source: str | Provenance = "config") -> EnvInfo:
+    """The environment's facts for ``config``, inspected once per process and command.
+
+    Configs that agree in what :func:`~cartpole_q.envs.gym.inspect_env` reads (the
+    environment, the grid, the table's size limit, the info metric and the threshold)
+    share them; a command forgets them when it starts (:func:`forget_plans`).
+
+    Raises:
+        ConfigError: the config does not fit its environment (nothing is kept).
+    """
+    key = inspected_fields(config)
+    facts = _FACTS.get(key)
+    if facts is None:
+        facts = _FACTS[key] = inspect_env(config, source)
+    return facts
+
+
+def keep_plan(plan: Plan) -> None:
+    """Keep ``plan`` for this process's runs of its config on any seed (see :func:`planned`)."""
+    _KEPT[_plan_key(plan.config)] = plan
+    _FACTS[inspected_fields(plan.config)] = plan.env_info
+
+
+def forget_plans() -> None:
+    """Forget the kept plans and facts: a command starts afresh.
+
+    Between commands of one process an environment may have been registered anew, or a
+    world's file changed; the command line's commands call this as they start.
+    """
+    _KEPT.clear()
+    _FACTS.clear()

@@ -274,6 +274,23 @@ def info_value(info: Mapping[str, Any], key: str, env_id: str) -> float:
     )
 
 
+def inspected_fields(config: Config) -> str:
+    """What :func:`inspect_env` reads of a config, as text: configs alike here share its facts.
+
+    Keep it in step with :func:`inspect_env` (a study reuses the facts of one point for
+    the points that agree here; tests compare the two for many configs).
+    """
+    return repr(
+        (
+            config.env,
+            config.discretization,
+            config.agent.max_q_table_bytes,
+            config.train.info_metric,
+            config.train.reward_threshold,
+        )
+    )
+
+
 def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
     """Make the config's environment once and check that the config can train on it.
 

@@ -136,8 +136,7 @@ def compile_ahead(
         How many loops were compiled.
     """
     from cartpole_q.engines import engine_and_twin, loop_names
-    from cartpole_q.engines.plan import Plan
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import Plan, env_facts
     from cartpole_q.numba_cache import is_cached
 
     # A config's loops are compiled by one job (the numba engine's two side by side); a
@@ -154,7 +153,7 @@ def compile_ahead(
         if isinstance(given, Plan):
             info, engine, twin = given.env_info, given.engine, given.twin
         else:
-            info = inspect_env(config)
+            info = env_facts(config)
             engine, twin = engine_and_twin(config, info)
         missing = [
             name for name in loop_names(config, info, engine, twin)

@@ -91,7 +91,8 @@ def evaluate_run(
         ConfigError: ``physics`` or ``max_steps`` do not fit the environment, or the
             environment has no twin under them (``numba``).
     """
-    from cartpole_q.envs.gym import display_problem, inspect_env
+    from cartpole_q.engines.plan import env_facts
+    from cartpole_q.envs.gym import display_problem
 
     if engine != "gymnasium" and (render or video is not None):
         raise UserError(
@@ -101,7 +102,7 @@ def evaluate_run(
     threshold = run.result.reward_threshold
     if physics or max_steps is not None:
         run = dataclasses.replace(run, config=under_conditions(run.config, physics, max_steps))
-        threshold = inspect_env(run.config).reward_threshold
+        threshold = env_facts(run.config).reward_threshold
     if render and video is not None:
         raise UserError("--render and --video cannot be combined: choose one.")
     if render and (problem := display_problem()) is not None:
@@ -207,7 +208,7 @@ def evaluate_seeds(
         ``notes`` (what was left out or is unfinished) and ``note`` (them as one line, or
         None), ``played_in`` (``gymnasium`` or ``twin``).
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
     runs = run_set.runs
     if engine == "gymnasium":
@@ -222,7 +223,7 @@ def evaluate_seeds(
     reward_threshold = run_set.reward_threshold
     if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
         conditions = under_conditions(run_set.config, physics, max_steps)
-        reward_threshold = inspect_env(conditions).reward_threshold
+        reward_threshold = env_facts(conditions).reward_threshold
     means = [result["mean"] for result in results]
     exact = exact_summary(results)
     return {
@@ -317,7 +318,7 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
         UserError: ``gamma`` is 1, a key is not an env key, or the environment has no model.
         ConfigError: the id or an argument is unknown.
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
     if gamma is not None and gamma >= 1.0:
         raise UserError(
@@ -334,7 +335,7 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
             )
         overrides[key] = value
     config = load_config(overrides=overrides, override_source=COMMAND_LINE)
-    inspect_env(config)  # an unknown id or argument: a config error naming it
+    env_facts(config)  # an unknown id or argument: a config error naming it
     exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
     if isinstance(exact, str):
         raise UserError(
@@ -378,7 +379,7 @@ def policy_values(
         ConfigError: the id, an argument or the policy is unknown.
     """
     from cartpole_q.engines.base import exact_values
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
     overrides: dict[str, Any] = {"env.id": env_id}
     for key, value in assignments:
@@ -390,7 +391,7 @@ def policy_values(
         overrides[key] = value
     overrides |= {"agent.algorithm": "td", "agent.policy": policy, "agent.gamma": gamma}
     config = load_config(overrides=overrides, override_source=COMMAND_LINE)
-    info = inspect_env(config)
+    info = env_facts(config)
     try:
         truth = exact_values(config, info)
     except ValueError as error:

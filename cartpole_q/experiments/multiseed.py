@@ -17,15 +17,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from cartpole_q.config import Config, format_seeds, load_config
-from cartpole_q.engines.plan import Plan
+from cartpole_q.config import format_seeds, load_config
+from cartpole_q.engines.plan import Plan, forget_plans, keep_plan, planned
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.run import (
     check_resumable,
     execute_run,
     outcome_line,
-    prepare,
 )
 from cartpole_q.experiments.workers import (
     JobHandle,
@@ -110,7 +109,8 @@ def run_seeds(
         # job, not once per seed.
         items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
         # This process's plan, for the jobs it runs itself and the workers it forks.
-        _PLANS[_plan_key(config)] = prepared
+        forget_plans()
+        keep_plan(prepared)
         size = chunk_size(len(items), workers)
         chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
         if len(chunks) > 1:  # compiled once before the workers start, not once per worker
@@ -153,31 +153,12 @@ def _train_seeds(
             return
         path = Path(child)
         config = load_config(path / rundir.CONFIG_FILE)
-        plan = _seed_plan(config, str(path / rundir.CONFIG_FILE))
+        plan = planned(config, str(path / rundir.CONFIG_FILE))
         outcome = execute_run(
             path, plan, resume=resume, should_stop=handle.should_stop, reporter=reporter,
             key=f"worker {os.getpid()}", label=f"seed {seed}", plot=plot,
         )  # fmt: skip
         yield seed, outcome.result.interrupted
-
-
-_PLANS: dict[str, Plan] = {}
-"""this process's plan of each multi-seed config it trains seeds of (by the config but its
-seed), so that a worker inspects the environment once for all the seeds it trains"""
-
-
-def _plan_key(config: Config) -> str:
-    """What a multi-seed config's seeds share: the config but its seed."""
-    return repr(config.for_seed(0).to_dict())
-
-
-def _seed_plan(config: Config, source: str) -> Plan:
-    """The plan of one seed's config: the process's plan of its config, planned once."""
-    key = _plan_key(config)
-    plan = _PLANS.get(key)
-    if plan is None:
-        plan = _PLANS[key] = prepare(config, source)
-    return plan.with_config(config)
 
 
 @dataclass(frozen=True)

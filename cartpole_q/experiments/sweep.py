@@ -125,12 +125,12 @@ def run_task(
     Yields:
         Each run as it ends.
     """
-    from cartpole_q.engines.plan import plan_run
+    from cartpole_q.engines.plan import planned
     from cartpole_q.training import train
 
     for point, mapping, seeds in task:
         config = load_config(mapping)
-        plan = plan_run(config)
+        plan = planned(config)
         for seed in seeds:
             if handle.should_stop():
                 return
@@ -166,9 +166,10 @@ def check_points(spec: SweepSpec, where: str) -> None:
     Raises:
         ConfigError: naming the point.
     """
-    from cartpole_q.experiments.run import prepare
+    from cartpole_q.engines.plan import forget_plans, planned
 
     check_tensorboard([point.config for point in spec.points])
+    forget_plans()  # a command starts afresh; the plans made here serve the sweep's runs
     checked: dict[str, None] = {}
     for point in spec.points:
         env_part = repr(
@@ -176,7 +177,7 @@ def check_points(spec: SweepSpec, where: str) -> None:
         )
         if env_part in checked:
             continue  # the same environment, bins and engine: checked already
-        prepare(point.config, f"{where}: point {spec.point_id(point.index)}")
+        planned(point.config, f"{where}: point {spec.point_id(point.index)}")
         checked[env_part] = None
 
 
@@ -330,9 +331,11 @@ def run_sweep(
     ]
     if backend == "local":  # before the progress bar: its thread would stop forking
         points = {point for point, _ in missing}
-        configs = [point.config for point in spec.points if point.index in points]
+        from cartpole_q.engines.plan import planned
+
+        plans = [planned(point.config) for point in spec.points if point.index in points]
         try:
-            compile_ahead(configs, workers, should_stop, on_compile)
+            compile_ahead(plans, workers, should_stop, on_compile)
         except KeyboardInterrupt:
             raise SweepInterrupted(directory, book.saved, spec.runs) from None
     progress.start(spec.runs, len(book.rows), len(spec.points), book.points_done())
@@ -494,12 +497,12 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     With ``figure.distribution`` the on-policy distribution is shaded on a second axis.
     """
     from cartpole_q.engines.base import prediction_distribution, prediction_truth
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
-    info = inspect_env(first)
+    info = env_facts(first)
     if profile_for(first.env.id).policy_map == "blackjack":  # Figure 5.1's value surfaces
         maps = []
         for label, path in zip(labels, paths, strict=True):
@@ -526,7 +529,7 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         lines.append(("initial values", states, start, start, start))
     for point, label, path in zip(spec.points, labels, paths, strict=True):
         # Each point reads its own tables' rows (its discretization: tiles, groups).
-        rows = prediction_truth(point.config, inspect_env(point.config)).rows
+        rows = prediction_truth(point.config, env_facts(point.config)).rows
         if rows.shape[0] != len(states):
             raise RunError(
                 f"figure.metric: values draws every point against the same true states, but "
@@ -615,12 +618,12 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     point's world, from its rules (Sutton & Barto Figure 5.2). Each point's label says how
     many of the 200 states' greedy actions are optimal.
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
-    info = inspect_env(first)
+    info = env_facts(first)
     q_star, optimal, v_star = blackjack_optimum(first)
     maps = []
     for label, path in zip(labels, paths, strict=True):
@@ -825,10 +828,10 @@ def sweep_png(
 
 def _threshold(spec: SweepSpec) -> float | None:
     """The base config's reward threshold (for the profile's reference line)."""
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import planned
 
     try:
-        return inspect_env(spec.points[0].config).reward_threshold
+        return planned(spec.points[0].config).env_info.reward_threshold
     except ConfigError:
         return None
 

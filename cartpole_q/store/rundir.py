@@ -497,9 +497,9 @@ def _with_threshold(result: SeedResult, config: Config) -> SeedResult:
 
 def config_threshold(config: Config) -> float | None:
     """The reward threshold a config's runs are judged by (``None`` without one)."""
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
 
-    return inspect_env(config).reward_threshold
+    return env_facts(config).reward_threshold
 
 
 def load_array(path: Path, dtype: type, check: ShapeCheck | None = None) -> np.ndarray:

@@ -124,7 +124,7 @@ def check_tables(run_set: RunSet) -> EnvInfo:
         RunError: a table's shape is not ``(*states, n_actions)`` of the environment, or the
             run is a prediction run (its ``V`` is no policy to play or draw).
     """
-    from cartpole_q.envs.gym import inspect_env
+    from cartpole_q.engines.plan import env_facts
     from cartpole_q.evaluation import check_q_table_shape
 
     if any(run.predicts for run in run_set.runs):
@@ -134,7 +134,7 @@ def check_tables(run_set: RunSet) -> EnvInfo:
             "is no greedy policy to evaluate, map or test. `cartpole-q plot "
             f"{run_set.path}` draws its curves; metrics.csv holds its rms_error."
         )
-    info = inspect_env(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
+    info = env_facts(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
     for run in run_set.runs:
         file = run.path / rundir.Q_TABLE_FILE  # a sweep point's seeds have none of their own
         where = str(file) if file.is_file() else f"{run.path}: its Q-table"
