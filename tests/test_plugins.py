@@ -75,6 +75,35 @@ def test_a_parameter_named_like_a_key_every_algorithm_has_is_refused(key: str) -
         register(clashing)
 
 
+def test_a_prediction_algorithm_must_declare_its_policy_first() -> None:
+    """The compiled policy reads ``agent.policy`` at ``params[POLICY_AT]`` (0)."""
+    from cartpole_q.rl.algorithms import get
+    from cartpole_q.rl.prediction import POLICY_AT
+
+    td = get("td")
+    assert POLICY_AT == 0 and td.params[POLICY_AT].key == "policy"
+    swapped = dataclasses.replace(td, name="td_policy_second", params=td.params[::-1])
+    with pytest.raises(ValueError, match=r"declares agent\.policy .* as its first parameter"):
+        register(swapped)
+
+
+def test_hooks_read_their_parameters_by_name() -> None:
+    """Each ``X_AT`` constant is where its parameter stands in the tuple the hooks get."""
+    import importlib
+
+    from cartpole_q.rl.algorithms import algorithms
+
+    checked = 0
+    for algorithm in algorithms():
+        module = importlib.import_module(algorithm.step.__module__)
+        for name, value in vars(module).items():
+            if name.endswith("_AT") and isinstance(value, int) and name != "POLICY_AT":
+                key = getattr(module, name[: -len("_AT")]).key
+                assert algorithm.params[value].key == key, (algorithm.name, name)
+                checked += 1
+    assert checked >= 20
+
+
 def test_the_reserved_keys_are_the_agent_section_s_fields() -> None:
     assert {field.name for field in dataclasses.fields(AgentConfig)} == RESERVED_KEYS
 

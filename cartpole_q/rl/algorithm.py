@@ -121,6 +121,23 @@ def same_table(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
     return q
 
 
+def param_index(params: Sequence[Param], param: Param) -> int:
+    """Where ``param`` stands in the ``params`` tuple the hooks get, by its key.
+
+    A hook reads its parameters by name through module constants made with it,
+    ``LAMBDA_AT = param_index(PARAMS, LAMBDA)`` then ``params[LAMBDA_AT]``: numba reads the
+    constant at compile time, and the declaration order can change without a hook reading
+    another parameter.
+
+    >>> param_index((Param("n", 1, ""), Param("lambda", 0.9, "")), Param("lambda", 0.5, ""))
+    1
+    """
+    keys = [declared.key for declared in params]
+    if param.key not in keys:
+        raise ValueError(f"{param.key!r} is not among the parameters {keys}")
+    return keys.index(param.key)
+
+
 @dataclass(frozen=True)
 class Algorithm:
     """An algorithm: its name, its config keys, its memory and its compiled hooks."""

@@ -48,6 +48,10 @@ POLICY = Param(
 )  # fmt: skip
 """``agent.policy`` of every prediction algorithm (its first parameter)"""
 
+POLICY_AT = 0
+"""where ``agent.policy`` stands in a prediction algorithm's ``params``: first (the
+registry refuses a prediction algorithm that declares it elsewhere)"""
+
 POLICY_RUN = Param(
     "policy_run", "",
     "agent.policy greedy or epsilon_greedy: the run directory whose q_table.npy gives the "
@@ -78,9 +82,9 @@ def policy_action(policy: np.ndarray, state: int, params: Params, rng: Rng) -> i
     action of positive probability if rounding leaves none); a rule or ``greedy``: the
     lowest action of the row's largest probability (no draw).
     """
-    if params[0] == 0.0:
+    if params[POLICY_AT] == 0.0:
         return int(rng.integers(0, policy.shape[1]))
-    if params[0] == DRAWN:
+    if params[POLICY_AT] == DRAWN:
         return drawn_action(policy, state, rng.random())
     chosen = 0
     for action in range(1, policy.shape[1]):

@@ -66,12 +66,19 @@ def register(algorithm: Algorithm) -> Algorithm:
         The registered algorithm, its :attr:`~Algorithm.key` set.
 
     Raises:
-        ValueError: another algorithm has this name, or a parameter's name is used by a
-            config key every algorithm has.
+        ValueError: another algorithm has this name, a parameter's name is used by a
+            config key every algorithm has, or a prediction algorithm does not declare
+            ``agent.policy`` first.
     """
     clash = [param.key for param in algorithm.params if param.key in RESERVED_KEYS]
     if clash:
         raise ValueError(f"algorithm {algorithm.name!r}: parameter {clash[0]!r} is a base key")
+    if algorithm.predicts and [param.key for param in algorithm.params[:1]] != ["policy"]:
+        # the compiled policy reads it at params[POLICY_AT] (cartpole_q.rl.prediction)
+        raise ValueError(
+            f"algorithm {algorithm.name!r}: a prediction algorithm declares agent.policy "
+            "(cartpole_q.rl.prediction.POLICY) as its first parameter"
+        )
     keyed = _with_key(algorithm)
     existing = _REGISTRY.get(algorithm.name)
     if existing is not None and existing.step.__module__ != algorithm.step.__module__:

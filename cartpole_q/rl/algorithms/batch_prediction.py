@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -62,7 +62,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     counters[0] = kept + 1
     if not (terminated or truncated or counters[0] - counters[1] == counters[2]):
         return policy_action(policy, next_state, params, rng)
-    if params[1] == 1.0:  # mc: the returns of this episode, backwards
+    if params[TARGET_AT] == 1.0:  # mc: the returns of this episode, backwards
         total_return = 0.0
         weight = 0.0 if terminated else 1.0
         for i in range(kept, counters[1] - 1, -1):
@@ -70,7 +70,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
             weight = gamma * weight
             targets[i], bootstraps[i], weights[i] = total_return, next_state, weight
     counters[1] = kept + 1
-    tolerance, max_passes = params[2], int(params[3])
+    tolerance, max_passes = params[TOLERANCE_AT], int(params[MAX_PASSES_AT])
     for _ in range(max_passes):
         for s in range(increments.shape[0]):
             increments[s] = 0.0
@@ -120,6 +120,13 @@ MAX_PASSES = Param(
     "max_passes", 100_000, "the most passes over the batch after an episode", kind="int", low=1
 )
 
+PARAMS = (POLICY, TARGET, TOLERANCE, MAX_PASSES, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+TARGET_AT = param_index(PARAMS, TARGET)
+TOLERANCE_AT = param_index(PARAMS, TOLERANCE)
+MAX_PASSES_AT = param_index(PARAMS, MAX_PASSES)
+
+
 ALGORITHM = Algorithm(
     name="batch_prediction",
     description="batch updating: TD(0) or constant-alpha MC on all episodes seen, to convergence",
@@ -128,7 +135,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its sums are kept per state",
     step=step,
     start=first_policy_action,
-    params=(POLICY, TARGET, TOLERANCE, MAX_PASSES, *POLICY_SOURCE),
+    params=PARAMS,
     memory=batch_memory,
     memory_names=(
         "policy", "batch_states", "batch_targets", "batch_bootstrap_states",

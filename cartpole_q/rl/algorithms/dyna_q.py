@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.model import (
     MODEL_MEMORY_NAMES,
     MODEL_NOT_ON_TILES,
@@ -50,7 +50,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         target = reward + gamma * best_value(q, next_state)
     update(q, state, action, target, alpha)
     remember(memory, state, action, next_state, reward, terminated, action_count(q))
-    plan_dyna_q(q, memory, int(params[0]), alpha, gamma, rng)
+    plan_dyna_q(q, memory, int(params[PLANNING_STEPS_AT]), alpha, gamma, rng)
     if terminated or truncated:
         return ENDED
     return behaviour_action(q, params, next_state, epsilon, rng)
@@ -61,13 +61,18 @@ def dyna_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     return model_memory(context.n_states, context.n_actions)
 
 
+PARAMS = (PLANNING_STEPS,)
+"""the parameters, in the order the hooks get them"""
+PLANNING_STEPS_AT = param_index(PARAMS, PLANNING_STEPS)
+
+
 ALGORITHM = Algorithm(
     name="dyna_q",
     description="Dyna-Q: Q-learning plus planning on a learned model (agent.planning_steps)",
     book="8.2",
     not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
-    params=(PLANNING_STEPS,),
+    params=PARAMS,
     memory=dyna_memory,
     memory_names=MODEL_MEMORY_NAMES,
 )  # fmt: skip

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.model import (
     MODEL_MEMORY_NAMES,
     MODEL_NOT_ON_TILES,
@@ -82,7 +82,9 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         target = reward + gamma * best_value(q, next_state)
     update(q, state, action, target, alpha)
     remember(memory, state, action, next_state, reward, terminated, n_actions)
-    plan_with_bonus(q, memory, last_tried, int(params[0]), params[1], alpha, gamma, rng)
+    plan_with_bonus(
+        q, memory, last_tried, int(params[PLANNING_STEPS_AT]), params[KAPPA_AT], alpha, gamma, rng
+    )
     if terminated or truncated:
         return ENDED
     return behaviour_action(q, params, next_state, epsilon, rng)
@@ -96,13 +98,19 @@ def dyna_plus_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
 
 KAPPA = Param("kappa", 0.001, "the exploration bonus kappa * sqrt(steps since tried)", low=0.0)
 
+PARAMS = (PLANNING_STEPS, KAPPA)
+"""the parameters, in the order the hooks get them"""
+PLANNING_STEPS_AT = param_index(PARAMS, PLANNING_STEPS)
+KAPPA_AT = param_index(PARAMS, KAPPA)
+
+
 ALGORITHM = Algorithm(
     name="dyna_q_plus",
     description="Dyna-Q+: Dyna-Q with a bonus for pairs not tried for long (agent.kappa)",
     book="8.3",
     not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
-    params=(PLANNING_STEPS, KAPPA),
+    params=PARAMS,
     memory=dyna_plus_memory,
     memory_names=(*MODEL_MEMORY_NAMES, "model_last_tried"),
 )  # fmt: skip

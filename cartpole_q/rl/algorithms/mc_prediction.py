@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -52,7 +52,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return policy_action(policy, next_state, params, rng)
-    averaging, every_visit = params[1] == 1.0, params[2] == 0.0
+    averaging, every_visit = params[UPDATE_AT] == 1.0, params[VISIT_AT] == 0.0
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value
         target = value(q, next_state, 0)
@@ -93,6 +93,12 @@ VISIT = Param(
     kind="choice", choices=VISITS,
 )  # fmt: skip
 
+PARAMS = (POLICY, UPDATE, VISIT, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+UPDATE_AT = param_index(PARAMS, UPDATE)
+VISIT_AT = param_index(PARAMS, VISIT)
+
+
 ALGORITHM = Algorithm(
     name="mc_prediction",
     description="Monte Carlo prediction: the state values of agent.policy from episodes' returns",
@@ -101,7 +107,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its counts and first visits are kept per state",
     step=step,
     start=first_policy_action,
-    params=(POLICY, UPDATE, VISIT, *POLICY_SOURCE),
+    params=PARAMS,
     memory=mc_prediction_memory,
     memory_names=(
         "policy", "episode_states", "episode_rewards", "visit_counts", "first_visits",

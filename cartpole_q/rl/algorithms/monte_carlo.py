@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -57,7 +57,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return behaviour_action(q, params, next_state, epsilon, rng)
-    averaging = params[0] == 0.0
+    averaging = params[UPDATE_AT] == 0.0
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value under the policy
         target = expected_value(q, next_state, epsilon)
@@ -96,6 +96,11 @@ UPDATE = Param(
     kind="choice", choices=UPDATES,
 )  # fmt: skip
 
+PARAMS = (UPDATE,)
+"""the parameters, in the order the hooks get them"""
+UPDATE_AT = param_index(PARAMS, UPDATE)
+
+
 ALGORITHM = Algorithm(
     name="monte_carlo",
     description="Monte Carlo control: on-policy, first-visit, epsilon-soft (agent.update)",
@@ -104,7 +109,7 @@ ALGORITHM = Algorithm(
         "its first-visit marks and sample averages count states, and a tiled observation is not one of a finite set of states"
     ),
     step=step,
-    params=(UPDATE,),
+    params=PARAMS,
     memory=mc_memory,
     memory_names=(
         "episode_states", "episode_actions", "episode_rewards", "visit_counts",

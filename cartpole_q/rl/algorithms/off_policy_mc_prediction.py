@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.algorithms.mc_prediction import VISIT
 from cartpole_q.rl.prediction import POLICY, POLICY_SOURCE, policy_table
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
@@ -56,7 +56,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return int(rng.integers(0, pi.shape[1]))
-    ordinary, every_visit = params[1] == 0.0, params[2] == 0.0
+    ordinary, every_visit = params[SAMPLING_AT] == 0.0, params[VISIT_AT] == 0.0
     b = 1.0 / pi.shape[1]
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value
@@ -99,6 +99,12 @@ SAMPLING = Param(
     kind="choice", choices=SAMPLINGS,
 )  # fmt: skip
 
+PARAMS = (POLICY, SAMPLING, VISIT, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+SAMPLING_AT = param_index(PARAMS, SAMPLING)
+VISIT_AT = param_index(PARAMS, VISIT)
+
+
 ALGORITHM = Algorithm(
     name="off_policy_mc_prediction",
     description="off-policy Monte Carlo prediction: V of agent.policy from a uniform policy's play",
@@ -107,7 +113,7 @@ ALGORITHM = Algorithm(
     not_on_tiles="its sums of weights and first visits are kept per state",
     step=step,
     start=behaviour_action,
-    params=(POLICY, SAMPLING, VISIT, *POLICY_SOURCE),
+    params=PARAMS,
     memory=off_policy_memory,
     memory_names=(
         "policy", "episode_states", "episode_actions", "episode_rewards", "weight_sums",

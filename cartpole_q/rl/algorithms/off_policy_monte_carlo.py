@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -63,7 +63,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return behaviour_action(q, params, next_state, epsilon, rng)
-    averaging = params[0] == 0.0
+    averaging = params[UPDATE_AT] == 0.0
     target = 0.0
     if not terminated:  # cut by a time limit: the tail's value under the greedy target
         target = best_value(q, next_state)
@@ -103,6 +103,11 @@ UPDATE = Param(
     kind="choice", choices=UPDATES,
 )  # fmt: skip
 
+PARAMS = (UPDATE,)
+"""the parameters, in the order the hooks get them"""
+UPDATE_AT = param_index(PARAMS, UPDATE)
+
+
 ALGORITHM = Algorithm(
     name="off_policy_monte_carlo",
     description="Off-policy Monte Carlo control: weighted importance sampling, greedy target",
@@ -111,7 +116,7 @@ ALGORITHM = Algorithm(
         "its importance-sampling weights are summed per state, and a tiled observation is not one of a finite set of states"
     ),
     step=step,
-    params=(UPDATE,),
+    params=PARAMS,
     # W / b_t: an exploratory action's b_t = epsilon / n must not round to 0 in float64
     # (docs/algorithms.md, "No division by zero").
     epsilon_floor=1e-300,

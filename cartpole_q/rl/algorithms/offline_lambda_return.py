@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -47,7 +47,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     length[0] = t + 1
     if not (terminated or truncated or length[0] == states.shape[0]):
         return policy_action(policy, next_state, params, rng)
-    lam = params[1]
+    lam = params[LAMBDA_AT]
     last = length[0] - 1
     tail = 0.0 if terminated else value(q, next_state, 0)
     target = rewards[last] + gamma * tail
@@ -72,6 +72,11 @@ def lambda_return_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     )
 
 
+PARAMS = (POLICY, LAMBDA, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+LAMBDA_AT = param_index(PARAMS, LAMBDA)
+
+
 ALGORITHM = Algorithm(
     name="offline_lambda_return",
     description="the offline lambda-return algorithm: V toward each step's lambda-return after the episode",
@@ -79,7 +84,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA, *POLICY_SOURCE),
+    params=PARAMS,
     memory=lambda_return_memory,
     memory_names=(
         "policy",

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.model import (
     MODEL_MEMORY_NAMES,
     MODEL_NOT_ON_TILES,
@@ -107,14 +107,16 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
          epsilon: float, rng: Rng) -> int:  # fmt: skip
     """Remember the step, queue it by its priority, sweep, then draw the next action."""
     n_actions = action_count(q)
-    theta = params[1]
+    theta = params[THETA_AT]
     remember(memory, state, action, next_state, reward, terminated, n_actions)
     target = reward
     if not terminated:
         target = reward + gamma * best_value(q, next_state)
     priorities = memory[QUEUE]
     queue(priorities, state * n_actions + action, abs(target - value(q, state, action)), theta)
-    sweep(q, memory, priorities, int(params[0]), theta, alpha, gamma, memory[UPDATES])
+    sweep(
+        q, memory, priorities, int(params[PLANNING_STEPS_AT]), theta, alpha, gamma, memory[UPDATES]
+    )
     if terminated or truncated:
         return ENDED
     return behaviour_action(q, params, next_state, epsilon, rng)
@@ -135,13 +137,19 @@ THETA = Param(
     low=0.0,
 )  # fmt: skip
 
+PARAMS = (PLANNING_STEPS, THETA)
+"""the parameters, in the order the hooks get them"""
+PLANNING_STEPS_AT = param_index(PARAMS, PLANNING_STEPS)
+THETA_AT = param_index(PARAMS, THETA)
+
+
 ALGORITHM = Algorithm(
     name="prioritized_sweeping",
     description="Prioritized sweeping: planning updates in order of priority (agent.theta)",
     book="8.4",
     not_on_tiles=MODEL_NOT_ON_TILES,
     step=step,
-    params=(PLANNING_STEPS, THETA),
+    params=PARAMS,
     memory=sweeping_memory,
     memory_names=(*MODEL_MEMORY_NAMES, "queue_priorities",
         "sweep_updates"),

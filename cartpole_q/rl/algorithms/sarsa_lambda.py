@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -48,7 +48,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
          epsilon: float, rng: Rng) -> int:  # fmt: skip
     """Draw ``a'``, give ``(s, a)`` its trace, move every traced pair, decay the traces."""
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
-    decay, kind = gamma * params[0], int(params[1])
+    decay, kind = gamma * params[LAMBDA_AT], int(params[TRACE_AT])
     n_actions = action_count(q)
     next_action = ENDED
     target = reward
@@ -70,12 +70,18 @@ def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     return trace_memory(context.n_states, context.n_actions)
 
 
+PARAMS = (LAMBDA, TRACE)
+"""the parameters, in the order the hooks get them"""
+LAMBDA_AT = param_index(PARAMS, LAMBDA)
+TRACE_AT = param_index(PARAMS, TRACE)
+
+
 ALGORITHM = Algorithm(
     name="sarsa_lambda",
     description="SARSA(lambda): SARSA with eligibility traces (agent.lambda, agent.trace)",
     book="12.7",
     step=step,
-    params=(LAMBDA, TRACE),
+    params=PARAMS,
     memory=memory,
     memory_names=("trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count"),
 )

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -49,7 +49,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """Give ``s`` its trace, move every traced state, decay the traces."""
     policy = memory[0]
     values, states, actions, slots, count = memory[1], memory[2], memory[3], memory[4], memory[5]
-    decay, kind = gamma * params[1], int(params[2])
+    decay, kind = gamma * params[LAMBDA_AT], int(params[TRACE_AT])
     target = reward
     if not terminated:
         target = reward + gamma * value(q, next_state, 0)
@@ -68,6 +68,12 @@ def td_lambda_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     return (policy_table(context), *trace_memory(context.n_states, 1))
 
 
+PARAMS = (POLICY, LAMBDA, TRACE, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+LAMBDA_AT = param_index(PARAMS, LAMBDA)
+TRACE_AT = param_index(PARAMS, TRACE)
+
+
 ALGORITHM = Algorithm(
     name="td_lambda",
     description="TD(lambda) prediction: the state values of agent.policy with eligibility traces",
@@ -75,7 +81,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA, TRACE, *POLICY_SOURCE),
+    params=PARAMS,
     memory=td_lambda_memory,
     memory_names=(
         "policy", "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count",

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -50,7 +50,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """The true online update with dutch traces and the ``q_old`` correction."""
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     q_old_cell = memory[5]
-    lam = params[0]
+    lam = params[LAMBDA_AT]
     n_actions = action_count(q)
     next_action = ENDED
     q_next = 0.0
@@ -79,12 +79,17 @@ def true_online_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     return (*trace_memory(context.n_states, context.n_actions), np.zeros(1, dtype=np.float64))
 
 
+PARAMS = (LAMBDA,)
+"""the parameters, in the order the hooks get them"""
+LAMBDA_AT = param_index(PARAMS, LAMBDA)
+
+
 ALGORITHM = Algorithm(
     name="true_online_sarsa_lambda",
     description="True online SARSA(lambda): dutch traces with the exact online lambda-return",
     book="12.8",
     step=step,
-    params=(LAMBDA,),
+    params=PARAMS,
     memory=true_online_memory,
     memory_names=(
         "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count", "q_old",

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithm import Algorithm, MemoryContext, param_index
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -47,7 +47,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     policy = memory[0]
     values, states, actions, slots, count = memory[1], memory[2], memory[3], memory[4], memory[5]
     v_old_cell = memory[6]
-    lam = params[1]
+    lam = params[LAMBDA_AT]
     v_next = 0.0
     if not terminated:
         v_next = value(q, next_state, 0)
@@ -77,6 +77,11 @@ def true_online_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
     )
 
 
+PARAMS = (POLICY, LAMBDA, *POLICY_SOURCE)
+"""the parameters, in the order the hooks get them"""
+LAMBDA_AT = param_index(PARAMS, LAMBDA)
+
+
 ALGORITHM = Algorithm(
     name="true_online_td_lambda",
     description="True online TD(lambda): dutch traces with the exact online lambda-return",
@@ -84,7 +89,7 @@ ALGORITHM = Algorithm(
     task="prediction",
     step=step,
     start=first_policy_action,
-    params=(POLICY, LAMBDA, *POLICY_SOURCE),
+    params=PARAMS,
     memory=true_online_memory,
     memory_names=(
         "policy", "trace_values", "trace_states", "trace_actions", "trace_slots", "trace_count",
