@@ -30,6 +30,7 @@ import numpy as np
 import yaml
 
 from cartpole_q.config import load_config, parse_seeds
+from cartpole_q.engines.plan import plan_run
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.training import train
 
@@ -59,11 +60,12 @@ def bound(gammas: list[float], seeds: tuple[int, ...]) -> float:
     sample = gammas[:: max(1, len(gammas) // 10)]
     configs = [load_config(None, {"agent.gamma": gamma}) for gamma in sample]
     info = inspect_env(configs[0])
-    train(configs[0].for_seed(seeds[0]), env_info=info)  # load the compiled loop first
+    plans = [plan_run(config, env_info=info) for config in configs]
+    train(plans[0].for_seed(seeds[0]))  # load the compiled loop first
     started = time.perf_counter()
-    for config in configs:
+    for plan in plans:
         for seed in seeds:
-            train(config.for_seed(seed), env_info=info)
+            train(plan.for_seed(seed))
     return len(configs) * len(seeds) / (time.perf_counter() - started)
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from cartpole_q.config import Config
 from cartpole_q.engines import make_engine
 from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingState
-from cartpole_q.engines.plan import Plan, plan_run
+from cartpole_q.engines.plan import Plan, env_facts, plan_run
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
@@ -221,8 +221,8 @@ def train(
     Args:
         config: a validated config (its ``train.seeds`` is ignored: one run, ``config.seed``),
             or its :class:`~cartpole_q.engines.plan.Plan` (then nothing is checked again).
-        env_info: the checked environment, if the caller already inspected it (without a
-            plan).
+        env_info: the checked environment, if the caller already inspected it (with a
+            config; a plan has its own).
         resume: a checkpoint to continue from; the result is then byte-identical to an
             uninterrupted run.
         should_stop: polled between chunks of episodes, and between chunks of greedy
@@ -243,7 +243,14 @@ def train(
     Raises:
         ConfigError: the config does not fit its environment.
     """
-    plan = config if isinstance(config, Plan) else plan_run(config, env_info=env_info)
+    if isinstance(config, Plan):
+        if env_info is not None:
+            raise TypeError("train: give env_info with a config, not with a plan (it has one)")
+        plan = config
+    elif resume is not None:  # the checkpoint's engine runs: no other is chosen
+        plan = Plan(config, env_info or env_facts(config), resume.engine, "config")
+    else:
+        plan = plan_run(config, env_info=env_info)
     config, env_info = plan.config, plan.env_info
     engine_name = resume.engine if resume is not None else plan.engine
     twin = plan.twin if engine_name == plan.engine else None  # (a resumed run's own engine)

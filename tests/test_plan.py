@@ -14,7 +14,7 @@ import pytest
 
 import cartpole_q.envs.gym
 from cartpole_q.config import load_config
-from cartpole_q.engines.plan import env_facts, forget_plans, plan_run, planned
+from cartpole_q.engines.plan import env_facts, plan_run, planned, planning
 from cartpole_q.envs.gym import inspect_env, inspected_fields
 from tests.conftest import invoke, write_yaml
 
@@ -105,6 +105,25 @@ def test_a_sweep_inspects_its_environment_once(tmp_path: Path, inspections: list
     assert inspections == ["CartPole-v1"]
 
 
+def test_a_tune_inspects_its_environment_once(tmp_path: Path, inspections: list[str]) -> None:
+    """Its trials differ in alpha only: they share the environment's facts."""
+    pytest.importorskip("optuna")
+    study = write_yaml(
+        tmp_path / "tune.yaml",
+        {
+            "name": "alpha",
+            "base": {"train": {"episodes": 3}, "eval": {"episodes": 1}},
+            "seeds": "0-1",
+            "trials": 3,
+            "space": {"agent.alpha": {"low": 0.05, "high": 1.0}},
+            "sampler": {"type": "tpe", "seed": 3},
+        },
+    )
+    result = invoke("tune", study, "--out", tmp_path / "out", "--workers", "1", "--quiet")
+    assert result.exit_code == 0, result.output
+    assert inspections == ["CartPole-v1"]
+
+
 def test_a_plan_carries_the_twin_the_numba_engine_runs() -> None:
     plan = plan_run(load_config())
     assert (plan.engine, plan.twin is not None) == ("numba", True)
@@ -114,17 +133,28 @@ def test_a_plan_carries_the_twin_the_numba_engine_runs() -> None:
     assert plan.for_seed(7).config.seed == 7 and plan.for_seed(7).twin is plan.twin
 
 
-def test_plans_are_kept_per_config_but_its_seed_and_forgotten_per_command() -> None:
-    forget_plans()
+def test_plans_are_kept_per_config_but_its_seed_inside_a_planning_scope() -> None:
     config = load_config()
-    first = planned(config)
-    assert planned(config.for_seed(5)).env_info is first.env_info
-    assert planned(config.for_seed(5)).config.seed == 5
-    other = planned(load_config(overrides={"agent.alpha": 0.3}))
-    assert other.env_info is first.env_info  # inspect_env reads nothing of alpha
-    assert other.config.agent.alpha.start == 0.3
-    forget_plans()
-    assert planned(config).env_info is not first.env_info
+    with planning():
+        first = planned(config)
+        assert planned(config.for_seed(5)).env_info is first.env_info
+        assert planned(config.for_seed(5)).config.seed == 5
+        other = planned(load_config(overrides={"agent.alpha": 0.3}))
+        assert other.env_info is first.env_info  # inspect_env reads nothing of alpha
+        assert other.config.agent.alpha.start == 0.3
+        with planning():  # an inner scope shares the outer one's
+            assert planned(config).env_info is first.env_info
+        assert planned(config).env_info is first.env_info
+    with planning():  # the outermost scope closed: forgotten
+        assert planned(config).env_info is not first.env_info
+
+
+def test_outside_a_planning_scope_nothing_is_kept(inspections: list[str]) -> None:
+    """A long-lived program may register an environment anew between two calls."""
+    config = load_config()
+    env_facts(config)
+    planned(config)
+    assert inspections == ["CartPole-v1", "CartPole-v1"]
 
 
 @pytest.mark.parametrize(
@@ -162,8 +192,7 @@ def test_configs_alike_in_what_inspect_env_reads_have_the_same_facts(
 def test_configs_that_differ_in_what_inspect_env_reads_do_not_share_facts(
     overrides: dict[str, Any],
 ) -> None:
-    forget_plans()
     base, varied = load_config(), load_config(overrides=overrides)
     assert inspected_fields(base) != inspected_fields(varied)
-    assert env_facts(base) is not env_facts(varied)
-    forget_plans()
+    with planning():
+        assert env_facts(base) is not env_facts(varied)

@@ -161,7 +161,6 @@ def exit_codes() -> Iterator[None]:
     :func:`stoppable`); once interrupted, further signals are ignored while it exits.
     """
     import signal
-    import sys
     import threading
 
     def interrupt(signum: int, frame: object) -> None:
@@ -170,13 +169,14 @@ def exit_codes() -> Iterator[None]:
     main = threading.current_thread() is threading.main_thread()
     previous = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
     interrupted = False
-    planning = sys.modules.get("cartpole_q.engines.plan")
-    if planning is not None:  # (not imported yet: nothing kept) an earlier command's facts
-        planning.forget_plans()
     if main:
         signal.signal(signal.SIGTERM, interrupt)
+    # One planning scope per command: a config is planned, its environment inspected, once.
+    from cartpole_q.engines.plan import planning
+
     try:
-        yield
+        with planning():
+            yield
     except UserError as error:
         typer.echo(f"error: {error}", err=True)
         raise typer.Exit(EXIT_BAD_INPUT) from None
@@ -285,9 +285,9 @@ def say_if_compiling(config: Any, plan: Plan | None = None) -> None:
     ``plan`` is the run's plan when the command has one (nothing is checked again).
     """
     from cartpole_q.engines import compile_notice
-    from cartpole_q.engines.plan import plan_run
+    from cartpole_q.engines.plan import planned
 
-    plan = plan or plan_run(config)
+    plan = plan or planned(config)
     notice = compile_notice(plan.config, plan.env_info, plan.engine, plan.twin)
     if notice is not None:
         typer.echo(notice, err=True)

@@ -4,12 +4,15 @@ Checking a config against its environment makes and resets a real Gymnasium envi
 (:func:`~cartpole_q.envs.gym.inspect_env`), and choosing the engine reads the twin's
 settings (:func:`~cartpole_q.envs.registry.twin_settings`). :func:`plan_run` does both once;
 every consumer downstream (training, the engines, multi-seed runs, the command line's
-compile notice) takes the :class:`Plan` instead of deriving its parts again.
+compile notice) takes the :class:`Plan` instead of deriving its parts again. Inside a
+:func:`planning` scope (a command), plans and environment facts are kept and shared.
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -38,13 +41,6 @@ class Plan:
         """The same plan for one seed of a multi-seed run (the facts do not depend on it)."""
         return dataclasses.replace(self, config=self.config.for_seed(seed))
 
-    def with_config(self, config: Config) -> Plan:
-        """The plan of ``config``, a config of the same environment, engine and twin.
-
-        For the seeds of a multi-seed run, which differ from each other only by their seed.
-        """
-        return dataclasses.replace(self, config=config)
-
     def loop_names(self) -> tuple[str, ...]:
         """The compiled loops the run calls, as numba's cache names them."""
         from cartpole_q.engines import loop_names
@@ -60,7 +56,8 @@ def plan_run(
     Args:
         config: a validated config.
         source: the config's file (or another label), for error messages.
-        env_info: the environment's facts, when the caller has already checked them.
+        env_info: the environment's facts, when the caller has already checked them
+            (otherwise :func:`env_facts`: inspected, or the planning scope's).
 
     Raises:
         ConfigError: the config does not fit its environment or engine.
@@ -68,16 +65,42 @@ def plan_run(
     from cartpole_q.engines import check_prediction, engine_and_twin
 
     if env_info is None:
-        env_info = inspect_env(config, source)
+        env_info = env_facts(config, source)
     engine, twin = engine_and_twin(config, env_info, source)
     check_prediction(config, env_info)
     return Plan(config, env_info, engine, str(source), twin)
 
 
+MOST_KEPT = 64
+"""plans kept at most (a study of many trials keeps its latest)"""
+
 _KEPT: dict[str, Plan] = {}
-"""this process's plans, by their config but its seed (see :func:`planned`)"""
+"""the plans of the planning scope, by their config but its seed (see :func:`planned`)"""
 _FACTS: dict[str, EnvInfo] = {}
-"""the environment facts of those plans, by what :func:`inspect_env` reads of a config"""
+"""the environment facts of the planning scope, by what :func:`inspect_env` reads"""
+_SCOPES = [0]
+"""how many :func:`planning` scopes are open in this process (a forked worker inherits
+its parent's, and the plans and facts kept in them)"""
+
+
+@contextlib.contextmanager
+def planning() -> Iterator[None]:
+    """A scope (a command, a study) inside which plans and facts are kept and shared.
+
+    Inside it, :func:`planned` and :func:`env_facts` plan a config and inspect its
+    environment once, however many runs ask; when the outermost scope closes, everything
+    is forgotten. Outside any scope nothing is kept (an environment may be registered anew
+    between two calls of a long-lived program), and they plan and inspect each time. The
+    command line opens one per command; forked workers inherit it.
+    """
+    _SCOPES[0] += 1
+    try:
+        yield
+    finally:
+        _SCOPES[0] -= 1
+        if _SCOPES[0] == 0:
+            _KEPT.clear()
+            _FACTS.clear()
 
 
 def _plan_key(config: Config) -> str:
@@ -86,35 +109,40 @@ def _plan_key(config: Config) -> str:
 
 
 def planned(config: Config, source: str | Provenance = "config") -> Plan:
-    """The plan of ``config``, made once per process for all the configs that share it.
+    """The plan of ``config``, made once per planning scope for the configs that share it.
 
     A study runs one config on many seeds, often in the same process (or in workers it
-    forks, which inherit its plans): they share a plan, made by :func:`plan_run` the first
-    time and kept, so that the environment is inspected once per study, not once per run.
-    Configs that differ in more than their seed have plans of their own, but share the
-    environment's facts where :func:`~cartpole_q.envs.gym.inspect_env` reads the same
-    (a sweep over ``agent.alpha``).
+    forks, which inherit its plans): inside a :func:`planning` scope they share a plan,
+    made by :func:`plan_run` the first time and kept, so that the environment is inspected
+    once per study, not once per run. Configs that differ in more than their seed have
+    plans of their own, but share the environment's facts (:func:`env_facts`).
 
     Raises:
         ConfigError: the config does not fit its environment or engine (nothing is kept).
     """
+    if not _SCOPES[0]:
+        return plan_run(config, source)
     key = _plan_key(config)
     plan = _KEPT.get(key)
     if plan is None:
-        plan = _KEPT[key] = plan_run(config, source, env_facts(config, source))
-    return plan.with_config(config)
+        plan = plan_run(config, source)
+        _keep(key, plan)
+    return dataclasses.replace(plan, config=config)
 
 
 def env_facts(config: Config, source: str | Provenance = "config") -> EnvInfo:
-    """The environment's facts for ``config``, inspected once per process and command.
+    """The environment's facts for ``config``, inspected once per planning scope.
 
     Configs that agree in what :func:`~cartpole_q.envs.gym.inspect_env` reads (the
-    environment, the grid, the table's size limit, the info metric and the threshold)
-    share them; a command forgets them when it starts (:func:`forget_plans`).
+    environment, the grid, the table's size limit, the info metric and the threshold:
+    :func:`~cartpole_q.envs.gym.inspected_fields`) share them inside a :func:`planning`
+    scope; outside one, this inspects the environment each time.
 
     Raises:
         ConfigError: the config does not fit its environment (nothing is kept).
     """
+    if not _SCOPES[0]:
+        return inspect_env(config, source)
     key = inspected_fields(config)
     facts = _FACTS.get(key)
     if facts is None:
@@ -123,16 +151,17 @@ def env_facts(config: Config, source: str | Provenance = "config") -> EnvInfo:
 
 
 def keep_plan(plan: Plan) -> None:
-    """Keep ``plan`` for this process's runs of its config on any seed (see :func:`planned`)."""
-    _KEPT[_plan_key(plan.config)] = plan
-    _FACTS[inspected_fields(plan.config)] = plan.env_info
+    """Keep ``plan`` for the scope's runs of its config on any seed (see :func:`planned`).
 
-
-def forget_plans() -> None:
-    """Forget the kept plans and facts: a command starts afresh.
-
-    Between commands of one process an environment may have been registered anew, or a
-    world's file changed; the command line's commands call this as they start.
+    Outside a :func:`planning` scope nothing is kept.
     """
-    _KEPT.clear()
-    _FACTS.clear()
+    if _SCOPES[0]:
+        _keep(_plan_key(plan.config), plan)
+        _FACTS[inspected_fields(plan.config)] = plan.env_info
+
+
+def _keep(key: str, plan: Plan) -> None:
+    """Keep a plan, forgetting the oldest beyond :data:`MOST_KEPT`."""
+    _KEPT[key] = plan
+    while len(_KEPT) > MOST_KEPT:
+        del _KEPT[next(iter(_KEPT))]

@@ -30,6 +30,7 @@ import numpy as np
 
 from cartpole_q.engines.compile import specialise
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
+from cartpole_q.rl.algorithms.dyna_q import PLANNING_STEPS_AT
 from cartpole_q.rl.tabular import ENDED, best_action, compilable
 
 ALGORITHM_START: Any = None
@@ -42,7 +43,7 @@ UPDATES_MADE: Any = None
 @compilable
 def direct_and_planning(memory: Any, params: Any, steps: int) -> int:
     """``dyna_q``: its direct update and ``planning_steps`` planning updates per real step."""
-    return steps * (int(params[0]) + 1)
+    return steps * (int(params[PLANNING_STEPS_AT]) + 1)
 
 
 @compilable

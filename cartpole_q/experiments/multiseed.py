@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from cartpole_q.config import format_seeds, load_config
-from cartpole_q.engines.plan import Plan, forget_plans, keep_plan, planned
+from cartpole_q.engines.plan import Plan, keep_plan, planned, planning
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.run import (
@@ -40,6 +40,7 @@ from cartpole_q.store.runsets import seed_dir
 from cartpole_q.training import Checkpoint, TrainResult
 
 
+@planning()  # one plan for every seed
 def run_seeds(
     prepared: Plan,
     parent: Path,
@@ -108,11 +109,9 @@ def run_seeds(
         # Several seeds per job: a worker loads the config and the compiled loop once per
         # job, not once per seed.
         items = [(str(child), seed, child_resume) for seed, child, child_resume in jobs]
-        # This process's plan, for the jobs it runs itself and the workers it forks.
-        forget_plans()
-        keep_plan(prepared)
         size = chunk_size(len(items), workers)
         chunks = [(items[i : i + size], seed_plots) for i in range(0, len(items), size)]
+        keep_plan(prepared)  # the seeds' jobs here and in forked workers share it
         if len(chunks) > 1:  # compiled once before the workers start, not once per worker
             compile_ahead([prepared], workers, should_stop)
         execute(

@@ -225,7 +225,7 @@ def execute_run(
         (run_dir / rundir.SUMMARY_FILE).unlink(missing_ok=True)
     reporter.start(key, label or run_dir.name, config.train.episodes)
     result = train(
-        prepared.with_config(config),
+        prepared,
         resume=checkpoint,
         should_stop=should_stop,
         on_progress=lambda progress: reporter.update(key, progress),

@@ -28,6 +28,7 @@ from cartpole_q.config import (
     load_config,
     shown_value,
 )
+from cartpole_q.engines.plan import env_facts, planned, planning
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
@@ -125,7 +126,6 @@ def run_task(
     Yields:
         Each run as it ends.
     """
-    from cartpole_q.engines.plan import planned
     from cartpole_q.training import train
 
     for point, mapping, seeds in task:
@@ -166,19 +166,9 @@ def check_points(spec: SweepSpec, where: str) -> None:
     Raises:
         ConfigError: naming the point.
     """
-    from cartpole_q.engines.plan import forget_plans, planned
-
     check_tensorboard([point.config for point in spec.points])
-    forget_plans()  # a command starts afresh; the plans made here serve the sweep's runs
-    checked: dict[str, None] = {}
-    for point in spec.points:
-        env_part = repr(
-            (point.config.env, point.config.discretization, point.config.engine, point.config.agent)
-        )
-        if env_part in checked:
-            continue  # the same environment, bins and engine: checked already
+    for point in spec.points:  # (inside a command's planning scope, each plan is kept)
         planned(point.config, f"{where}: point {spec.point_id(point.index)}")
-        checked[env_part] = None
 
 
 def check_tensorboard(configs: Sequence[Config]) -> None:
@@ -289,6 +279,7 @@ def check_unchanged(spec: SweepSpec, directory: Path) -> None:
             )
 
 
+@planning()  # one plan per point for all its seeds
 def run_sweep(
     spec: SweepSpec,
     directory: Path,
@@ -331,8 +322,6 @@ def run_sweep(
     ]
     if backend == "local":  # before the progress bar: its thread would stop forking
         points = {point for point, _ in missing}
-        from cartpole_q.engines.plan import planned
-
         plans = [planned(point.config) for point in spec.points if point.index in points]
         try:
             compile_ahead(plans, workers, should_stop, on_compile)
@@ -497,7 +486,6 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     With ``figure.distribution`` the on-policy distribution is shaded on a second axis.
     """
     from cartpole_q.engines.base import prediction_distribution, prediction_truth
-    from cartpole_q.engines.plan import env_facts
 
     figure = spec.figure
     assert figure is not None
@@ -618,8 +606,6 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     point's world, from its rules (Sutton & Barto Figure 5.2). Each point's label says how
     many of the 200 states' greedy actions are optimal.
     """
-    from cartpole_q.engines.plan import env_facts
-
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
@@ -828,8 +814,6 @@ def sweep_png(
 
 def _threshold(spec: SweepSpec) -> float | None:
     """The base config's reward threshold (for the profile's reference line)."""
-    from cartpole_q.engines.plan import planned
-
     try:
         return planned(spec.points[0].config).env_info.reward_threshold
     except ConfigError:
