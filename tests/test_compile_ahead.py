@@ -55,6 +55,18 @@ def test_loop_name_is_what_numba_caches_once_trained(
     assert is_cached(name)
 
 
+def test_every_world_but_tiles_shares_the_gymnasium_engines_step_functions() -> None:
+    """Observations come as float64 values: one compilation per algorithm for every world."""
+    names = set()
+    for env_id in ("CartPole-v1", "FrozenLake-v1", "Blackjack-v1", "cartpole_q/RandomWalk-v0"):
+        config = _config(**{"env.id": env_id, "engine": "gymnasium"})
+        (name,) = loop_names(config, inspect_env(config), "gymnasium")
+        names.add(name)
+    assert names == {next(iter(names))} and next(iter(names)).endswith("__values")
+    tiled = _config(engine="gymnasium", **TILES)
+    assert loop_names(tiled, inspect_env(tiled), "gymnasium")[0].endswith("__tiles")
+
+
 def test_compile_ahead_asks_once_per_distinct_loop_and_fills_the_cache(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

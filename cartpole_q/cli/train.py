@@ -275,7 +275,8 @@ def compile_command(
         typer.Option(
             "--all",
             help="Compile every algorithm on every environment with a compiled twin, and on "
-            "the gymnasium engine for each observation kind.",
+            "the gymnasium engine (one compilation per algorithm serves every environment "
+            "but tile-coded ones).",
         ),
     ] = False,
     workers: Workers = None,

@@ -149,12 +149,7 @@ def loop_names(
             kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy)
             for greedy in played
         )
-    if tiled:
-        kind = "tiles"
-    elif grid is not None:
-        kind = "box"
-    else:  # a Discrete observation has one start, a Tuple one per component
-        kind = "tuple" if len(env_info.index_starts or ()) > 1 else "discrete"
+    kind = "tiles" if tiled else "values"  # (every other observation as float64 values)
     return (step_function_name("next_step", algorithm.key, kind),)
 
 

@@ -11,7 +11,6 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-from gymnasium import spaces
 
 from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, TrainingState, step_function_name
@@ -70,8 +69,9 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
 
     Args:
         algorithm: the algorithm whose hooks they call.
-        kind: the observation kind (``box``, ``discrete`` or ``tuple``; ``tiles``: a Box
-            observation on tiles; see :data:`~cartpole_q.engines.rows.STATE_RULES`).
+        kind: how observations come (``values``: any observation's values as a float64
+            array; ``tiles``: a Box observation on tiles; see
+            :data:`~cartpole_q.engines.rows.STATE_RULES`).
 
     They take the run's step context (see :mod:`~cartpole_q.engines.context`) and call the
     algorithm's hooks as the numba engine's loop does; cached on disk under the algorithm's
@@ -92,21 +92,14 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
     return compiled(first_step), compiled(next_step), compiled(end_episode)
 
 
-def observation_kind(space: Any) -> str:
-    """``box``, ``discrete`` or ``tuple``: how an observation of ``space`` becomes a row."""
-    if isinstance(space, spaces.Tuple):
-        return "tuple"
-    if isinstance(space, spaces.Discrete):
-        return "discrete"
-    return "box"
-
-
 class GymnasiumEngine:
     """Trains in ``gymnasium.make(env.id, **env.kwargs)``; works for any env ``inspect_env`` accepts.
 
     The environment is seeded once, at its first reset, with ``env_seed``; a resumed run
     instead restores the environment generator's saved state. Observations go to compiled
-    code as they come: an array (Box), an integer (Discrete) or a tuple of integers.
+    code as a float64 array of its values: a Box observation's float32 values widened (as the
+    binning rule widens them), a Discrete or Tuple one's integer components. So one
+    compilation per algorithm serves every world (tiles apart).
     """
 
     name = "gymnasium"
@@ -129,11 +122,15 @@ class GymnasiumEngine:
             generator.bit_generator.state = env_rng_state
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
-        kind = "tiles" if params.tiled else observation_kind(self._env.observation_space)
+        kind = "tiles" if params.tiled else "values"
         self._first, self._next, self._end = step_functions(params.algorithm, kind)
         self._has_end = params.algorithm.end is not no_episode_end
-        # Tuple observations as plain integers: one compiled specialisation for any env.
-        self._as_ints = isinstance(self._env.observation_space, spaces.Tuple)
+        # Every observation but tiles' is copied into this array (float64 values), which the
+        # step functions read at once: the same compiled code for every world.
+        self._values: np.ndarray | None = None
+        if kind == "values":
+            size = len(params.grid.starts) if params.grid.indexed else len(params.grid.bins)
+            self._values = np.zeros(size, dtype=np.float64)
         self._step_cap = step_cap
         self._info_key = config.train.info_metric
         self._value_error: Any = jit(value_error) if params.truth.measured else None
@@ -162,7 +159,7 @@ class GymnasiumEngine:
         env, metrics = self._env, state.metrics
         context = self._step_context(state)
         randomize = self._config.env.randomize
-        first, following, as_ints = self._first, self._next, self._as_ints
+        first, following, values = self._first, self._next, self._values
         info_key, info_sums, env_id = self._info_key, state.info, self._config.env.id
         truth, errors, measure = self._params.truth, state.errors, self._value_error
         for episode in range(state.episode, stop):
@@ -175,14 +172,16 @@ class GymnasiumEngine:
                 set_physics(env, drawn)
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
-            if as_ints:
-                observation = tuple(map(int, observation))
+            if values is not None:
+                values[:] = observation
+                observation = values
             s, a = first(context, observation, epsilon)
             episode_return, length, info_sum = 0.0, 0, 0.0
             while a != ENDED:
                 observation, reward, terminated, truncated, info = env.step(a)
-                if as_ints:
-                    observation = tuple(map(int, observation))
+                if values is not None:
+                    values[:] = observation
+                    observation = values
                 length += 1
                 episode_return += reward
                 if info_key is not None:
@@ -211,11 +210,9 @@ class GymnasiumEngine:
         """
         p = self._params
         grid = p.grid
-        space = self._env.observation_space
-        observation: Any = grid.low.astype(space.dtype)
-        if grid.indexed:
-            starts = tuple(int(start) for start in grid.starts)
-            observation = starts if isinstance(space, spaces.Tuple) else starts[0]
+        observation: Any = grid.low.astype(self._env.observation_space.dtype)
+        if self._values is not None:
+            observation = (grid.starts if grid.indexed else grid.low).astype(np.float64)
         q, visits, memory = state.tables
         scratch = step_context(
             np.random.default_rng(0), p.hook_table(q.copy()), visits.copy(),

@@ -2,9 +2,10 @@
 
 An engine knows its environment's observation space before it compiles anything, so it
 binds the rule of that kind into its compiled step functions: no branch on the kind is
-left at run time, and no typing-time dispatch is needed. The gymnasium engine passes the
-observation as Gymnasium returns it (:data:`STATE_RULES`); a compiled twin writes it into an
-array, float32 values (Box) or int64 integers (Discrete, Tuple of Discrete), and the numba
+left at run time, and no typing-time dispatch is needed. The gymnasium engine passes every
+observation as a float64 array of its values (a Box's float32 values widened, a Discrete or
+Tuple one's integer components) and applies the rule of the grid it has, so that one
+compilation serves every world (:data:`STATE_RULES`); a compiled twin writes it into an array, float32 values (Box) or int64 integers (Discrete, Tuple of Discrete), and the numba
 engine's loop takes the grid's arrays one by one (:data:`ARRAY_STATE_RULES`). Both apply the
 same rule: the binning rule of :func:`~cartpole_q.rl.binning.state_index`, or
 :func:`indexed_row`. On tile coding (:mod:`cartpole_q.rl.tiles`) the state a hook gets is a
@@ -37,23 +38,6 @@ def indexed_row(components: Any, bins: Any, starts: Any) -> int:
 def binned_row(observation: Any, grid: Any) -> int:
     """A Box observation: the binning rule on ``grid``'s edges."""
     row: int = state_index(observation, grid.low, grid.high, grid.bins)
-    return row
-
-
-@compilable
-def discrete_row(observation: Any, grid: Any) -> int:
-    """A ``Discrete(n, start)`` observation (an integer): ``obs - start``.
-
-    :func:`indexed_row` of one component, without making a tuple of the integer.
-    """
-    row: int = observation - grid.starts[0]
-    return row
-
-
-@compilable
-def tuple_row(observation: Any, grid: Any) -> int:
-    """A ``Tuple`` of ``Discrete`` (integers): :func:`indexed_row` of its components."""
-    row: int = indexed_row(observation, grid.bins, grid.starts)
     return row
 
 
@@ -91,21 +75,25 @@ def tile_state(q: Any, observation: Any, low: Any, high: Any, bins: Any, previou
 
 
 @compilable
-def binned_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
-    """A Box observation's row (``q`` and ``previous`` are for the tiles rule)."""
+def component_row(components: Any, bins: Any, starts: Any) -> int:
+    """:func:`indexed_row` of integer components held as float64 values (exact below 2**53)."""
+    index = 0
+    for k in range(len(starts)):
+        index = index * bins[k] + (int(components[k]) - starts[k])
+    return index
+
+
+@compilable
+def observation_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
+    """Any observation but tiles', as the gymnasium engine passes it (float64 values): its row.
+
+    A Box observation's float32 values widened to float64 (the binning rule widens them
+    anyway, so the row is the same), or a Discrete or Tuple observation's integer
+    components: one rule, so that one compilation serves every world.
+    """
+    if grid.starts.size:
+        return component_row(observation, grid.bins, grid.starts)
     return binned_row(observation, grid)
-
-
-@compilable
-def discrete_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
-    """A Discrete observation's row."""
-    return discrete_row(observation, grid)
-
-
-@compilable
-def tuple_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
-    """A Tuple observation's row."""
-    return tuple_row(observation, grid)
 
 
 @compilable
@@ -114,10 +102,10 @@ def tiled_state(q: Any, observation: Any, grid: Any, previous: int) -> int:
     return tile_state(q, observation, grid.low, grid.high, grid.bins, previous)
 
 
-STATE_RULES = {"box": binned_state, "discrete": discrete_state, "tuple": tuple_state,
-               "tiles": tiled_state}  # fmt: skip
-"""observation kind (``tiles``: a Box observation on tiles) -> the state rule of the gymnasium
-engine's step functions"""
+STATE_RULES = {"values": observation_state, "tiles": tiled_state}
+"""how the gymnasium engine passes observations (``values``: any observation's values as a
+float64 array, see :func:`observation_state`; ``tiles``: a Box observation on tiles) -> the
+state rule of its step functions"""
 
 
 @compilable
