@@ -1,8 +1,9 @@
 """Compiling a study's loops once, before its runs: the names numba caches them under.
 
 The loops here (Q-learning and SARSA on CartPole's twin, with and without ``env.randomize``,
-on tiles, and on the gymnasium engine for a Box, a Discrete and a Tuple) are loops the rest
-of the suite compiles anyway, so on a cold cache they cost no extra compilation.
+on tiles, and on the gymnasium engine, whose one loop per algorithm takes a Box, a Discrete
+and a Tuple alike) are loops the rest of the suite compiles anyway, so on a cold cache they
+cost no extra compilation.
 """
 
 from __future__ import annotations

@@ -63,7 +63,16 @@ class ShiftedEnv(gymnasium.Env):  # type: ignore[type-arg]
         return self._observation(), reward, terminated, False, {}
 
 
+class FarEnv(ShiftedEnv):
+    """ShiftedEnv's walk numbered from 2**53 - 6: its last observations are not float64-exact."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.observation_space = spaces.Discrete(12, start=2**53 - 6)
+
+
 gymnasium.register("ShiftedDiscrete-v0", entry_point=ShiftedEnv, max_episode_steps=30)
+gymnasium.register("FarDiscrete-v0", entry_point=FarEnv, max_episode_steps=30)
 gymnasium.register(
     "ShiftedTuple-v0", entry_point=ShiftedEnv, max_episode_steps=30, kwargs={"tuple_obs": True}
 )
@@ -156,6 +165,13 @@ def test_a_grid_for_discrete_observations_is_refused_with_the_reason() -> None:
     with pytest.raises(
         ConfigError, match=r"discretization: .*Discrete\(16\).*leave discretization out"
     ):
+        inspect_env(config)
+
+
+def test_observations_beyond_float64_exact_integers_are_refused() -> None:
+    """The gymnasium engine takes observations as float64 values: 2**53 - 6 + 11 is too far."""
+    config = load_config(overrides={"env.id": "FarDiscrete-v0", "discretization": None})
+    with pytest.raises(ConfigError, match=r"env\.id: 'FarDiscrete-v0' .* reach 9007199254740997"):
         inspect_env(config)
 
 

@@ -432,5 +432,5 @@ def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
     # the default's epsilon reaches 0 at episode 90: both loops
     for kind in ("exploring", "greedy"):
         assert is_cached(f"train_{kind}__{get('q_learning').key}__{twin.key}")
-    assert is_cached(f"next_step__{get('q_learning').key}__box")
+    assert is_cached(f"next_step__{get('q_learning').key}__values")
     assert_refused(invoke("compile", "-c", "default", "--all"), "not both")

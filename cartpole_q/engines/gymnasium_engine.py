@@ -27,8 +27,8 @@ from cartpole_q.rl.tabular import ENDED, no_episode_end, visit
 
 configure_numba_cache()  # before any cache=True function is defined
 
-# Placeholders, bound per algorithm and observation kind by specialise(); never called as
-# they are.
+# Placeholders, bound per algorithm (and for tiles or every other observation) by
+# specialise(); never called as they are.
 ALGORITHM_START: Any = None
 ALGORITHM_STEP: Any = None
 ALGORITHM_END: Any = None
@@ -210,9 +210,10 @@ class GymnasiumEngine:
         """
         p = self._params
         grid = p.grid
-        observation: Any = grid.low.astype(self._env.observation_space.dtype)
         if self._values is not None:
-            observation = (grid.starts if grid.indexed else grid.low).astype(np.float64)
+            observation: Any = (grid.starts if grid.indexed else grid.low).astype(np.float64)
+        else:  # tiles: a Box observation as it comes
+            observation = grid.low.astype(self._env.observation_space.dtype)
         q, visits, memory = state.tables
         scratch = step_context(
             np.random.default_rng(0), p.hook_table(q.copy()), visits.copy(),

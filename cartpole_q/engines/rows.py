@@ -1,15 +1,16 @@
 """The Q-table row of an observation, for each kind of observation the engines take.
 
-An engine knows its environment's observation space before it compiles anything, so it
-binds the rule of that kind into its compiled step functions: no branch on the kind is
-left at run time, and no typing-time dispatch is needed. The gymnasium engine passes every
-observation as a float64 array of its values (a Box's float32 values widened, a Discrete or
-Tuple one's integer components) and applies the rule of the grid it has, so that one
-compilation serves every world (:data:`STATE_RULES`); a compiled twin writes it into an array, float32 values (Box) or int64 integers (Discrete, Tuple of Discrete), and the numba
-engine's loop takes the grid's arrays one by one (:data:`ARRAY_STATE_RULES`). Both apply the
-same rule: the binning rule of :func:`~cartpole_q.rl.binning.state_index`, or
-:func:`indexed_row`. On tile coding (:mod:`cartpole_q.rl.tiles`) the state a hook gets is a
-handle whose tiles the rule writes into the table's features (:func:`tile_state`).
+The numba engine knows its twin's observation kind before it compiles anything, so it
+binds that kind's rule into its loop (:data:`ARRAY_STATE_RULES`): no branch on the kind is
+left at run time. A compiled twin writes the observation into an array, float32 values
+(Box) or int64 integers (Discrete, Tuple of Discrete), and the loop takes the grid's arrays
+one by one. The gymnasium engine passes every observation but tiles' as a float64 array of
+its values (a Box's float32 values widened, a Discrete or Tuple one's integer components)
+and picks the grid's rule at run time (:func:`observation_state`), so that one compilation
+per algorithm serves every world (:data:`STATE_RULES`). Both apply the same rule: the
+binning rule of :func:`~cartpole_q.rl.binning.state_index`, or :func:`indexed_row`. On tile
+coding (:mod:`cartpole_q.rl.tiles`) the state a hook gets is a handle whose tiles the rule
+writes into the table's features (:func:`tile_state`).
 """
 
 from __future__ import annotations

@@ -340,6 +340,17 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
                 f"{(*state_shape, int(action_space.n))}); a grid bins only Box observations, "
                 "so leave discretization out (or set it to null)."
             )
+        largest = max(
+            max(abs(start), abs(start + n - 1))
+            for start, n in zip(index_starts, state_shape, strict=True)
+        )
+        if largest >= EXACT_INTEGERS:
+            raise ConfigError(
+                f"{blame(source, 'env.id')}: env.id: {env_id!r} has observation space "
+                f"{observation_space}, whose values reach {largest}; the engines take "
+                "observations as float64 values, exact only below 2**53, so number them "
+                "closer to 0 (a Discrete's start)."
+            )
         field = "env.id"
     elif isinstance(observation_space, spaces.Box) and len(observation_space.shape) == 1:
         observation_dim = int(observation_space.shape[0])
@@ -400,6 +411,11 @@ def _check_info_metric(env: Any, key: str, env_id: str, source: str | Provenance
         info_value(info, key, env_id)
     except RunError as error:
         raise ConfigError(f"{blame(source, 'train.info_metric')}: {error}") from None
+
+
+EXACT_INTEGERS = 2**53
+"""Discrete observations must stay below this in magnitude: the gymnasium engine passes every
+observation to compiled code as float64 values, exact only below 2**53"""
 
 
 def _index_starts(space: Any) -> tuple[int, ...] | None:
