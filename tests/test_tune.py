@@ -483,7 +483,9 @@ def test_a_storage_that_cannot_be_used_is_refused_before_anything_starts(tmp_pat
 
 @pytest.mark.slow
 def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path: Path) -> None:
-    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 40, "seeds": "0-19"})
+    # So many trials that the first writer is still writing when the second one starts (it
+    # is killed below); 40 could all finish first on a warm cache, and the resume succeed.
+    path = write_yaml(tmp_path / "s.yaml", {**TUNE, "trials": 10_000, "seeds": "0-19"})
     out = tmp_path / "out"
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
