@@ -70,6 +70,9 @@ class FarEnv(ShiftedEnv):
         super().__init__()
         self.observation_space = spaces.Discrete(12, start=2**53 - 6)
 
+    def _observation(self) -> Any:
+        return self.state + 2**53 - 6
+
 
 gymnasium.register("ShiftedDiscrete-v0", entry_point=ShiftedEnv, max_episode_steps=30)
 gymnasium.register("FarDiscrete-v0", entry_point=FarEnv, max_episode_steps=30)
