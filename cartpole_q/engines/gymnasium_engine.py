@@ -11,6 +11,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 
 from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, TrainingState, step_function_name
@@ -160,6 +161,9 @@ class GymnasiumEngine:
         context = self._step_context(state)
         randomize = self._config.env.randomize
         first, following, values = self._first, self._next, self._values
+        # A Discrete observation is one integer: item assignment is several times cheaper
+        # than a slice's (which a Box or Tuple needs).
+        scalar = values is not None and isinstance(self._env.observation_space, spaces.Discrete)
         info_key, info_sums, env_id = self._info_key, state.info, self._config.env.id
         truth, errors, measure = self._params.truth, state.errors, self._value_error
         for episode in range(state.episode, stop):
@@ -173,14 +177,20 @@ class GymnasiumEngine:
             observation, _ = env.reset(seed=self._first_reset_seed)
             self._first_reset_seed = None
             if values is not None:
-                values[:] = observation
+                if scalar:
+                    values[0] = observation
+                else:
+                    values[:] = observation
                 observation = values
             s, a = first(context, observation, epsilon)
             episode_return, length, info_sum = 0.0, 0, 0.0
             while a != ENDED:
                 observation, reward, terminated, truncated, info = env.step(a)
                 if values is not None:
-                    values[:] = observation
+                    if scalar:
+                        values[0] = observation
+                    else:
+                        values[:] = observation
                     observation = values
                 length += 1
                 episode_return += reward
