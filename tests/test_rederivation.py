@@ -8,10 +8,11 @@ worlds (FrozenLake, Taxi, CliffWalking) and a Tuple world (Blackjack), on every 
 world has, and compared with the re-derivation: the kept ``q_table`` bytes, the visits, the
 returns, the lengths and the solve episode.
 
-Every algorithm runs on both engines on FrozenLake (its table twin, both numba loops) and on
-the gymnasium engine on CartPole and each kind of observation; on CartPole's twin (with and
-without ``env.physics`` and ``env.randomize``) and the other twins the numba engine runs a
-few algorithms: a twin's own exactness is proven in ``test_twins_classic.py``,
+Every algorithm runs on both engines on FrozenLake (its table twin) and on the gymnasium
+engine on CartPole and each kind of observation. CartPole's twin runs the one-step methods
+and the algorithms of the shipped CartPole configs, both of the numba engine's loops (the
+exploring and the greedy one); FrozenLake's the other algorithms' greedy loop; the other
+twins run a few algorithms: a twin's own exactness is proven in ``test_twins_classic.py``,
 ``test_twins_tabular.py`` and ``test_engines.py``, and each new (algorithm, twin) pair costs
 compilations of several seconds. Physics options run the one-step methods and one
 algorithm of each other family.
@@ -305,9 +306,21 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 400,
         "seed": 7,
     },
-    # FrozenLake again, epsilon 0 from episode 199 on: every algorithm runs both of the numba
-    # engine's loops here (the exploring and the greedy one, see engines/kernel.py).
+    # FrozenLake again, where every algorithm runs on both engines: exploring throughout.
     "lake": {
+        "env": {"id": "FrozenLake-v1"},
+        "agent": {
+            "gamma": 0.99,
+            "alpha": {"type": "exponential", "start": 0.5, "decay": 0.995, "end": 0.05},
+            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.99, "end": 0.05},
+            "q_init": 0.0,
+        },
+        "episodes": 300,
+        "seed": 7,
+    },
+    # And with epsilon 0 from episode 199 on: the numba engine's greedy loop (engines/kernel.py)
+    # of the algorithms CartPole's twin does not run below.
+    "lake_greedy": {
         "env": {"id": "FrozenLake-v1"},
         "agent": {
             "gamma": 0.99,
@@ -381,18 +394,37 @@ NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physic
 NUMBA_WORLDS |= {"walk5", "walk19", "walk1000"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
-NUMBA_WORLDS |= {"frozenlake", "lake", "taxi", "cliffwalking", "blackjack", "blackjack_es"}
+NUMBA_WORLDS |= {
+    "frozenlake",
+    "lake",
+    "lake_greedy",
+    "taxi",
+    "cliffwalking",
+    "blackjack",
+    "blackjack_es",
+}
 # The numba engine compiles two loops per (algorithm, twin), 5-25 s each on a cold cache, so
-# it runs every variant on one world only: FrozenLake's table twin ("lake", where epsilon
-# reaches 0, so both loops of every algorithm run). The algorithms' hooks are the same code
-# on every twin, and the gymnasium engine runs every variant on CartPole and on each kind of
-# observation. On the other twins, CartPole included, the numba engine runs a few
-# algorithms, most of them loops the shipped configs and the book's studies compile anyway
-# (each twin is also proven step by step in test_twins_*.py and test_engines.py).
+# it runs every variant on one world only: FrozenLake's table twin ("lake"; "lake_greedy"
+# adds the greedy loop of the algorithms CartPole's twin does not run). The algorithms'
+# hooks are the same code on every twin, and the gymnasium engine runs every variant on
+# CartPole and on each kind of observation. CartPole's twin runs the algorithms whose loops
+# the suite compiles anyway (the one-step methods, and those whose shipped CartPole configs
+# tests/test_learning.py trains), its default epsilon reaching 0 (both loops); the other
+# twins a few algorithms, most of them loops the shipped configs and the book's studies
+# compile anyway (each twin is also proven step by step in test_twins_*.py and
+# test_engines.py).
+CARTPOLE_CONFIGS = (
+    "n_step_sarsa", "n_step_tree_backup", "sarsa_lambda", "watkins_q_lambda",
+    "true_online_sarsa_lambda", "dyna_q", "dyna_q_plus", "monte_carlo",
+)  # fmt: skip
+"""the algorithms of configs/*.yaml that test_learning.py trains on CartPole's twin"""
 CARTPOLE_NUMBA = {
-    *ONE_STEP,
+    *(v for v, (name, _) in VARIANTS.items() if name in (*ONE_STEP, *CARTPOLE_CONFIGS)),
     *(f"{name}-random-ties" for name in ("q_learning", "sarsa", "double_q_learning")),
 }
+LAKE_GREEDY = [v for v in VARIANTS if v not in CARTPOLE_NUMBA]
+"""the variants whose greedy loop CartPole's twin does not run (off-policy and ES Monte
+Carlo, prioritized sweeping)"""
 OTHER_TWIN_VARIANTS = {
     **{world: CARTPOLE_NUMBA for world in ("cartpole", "cartpole_physics", "cartpole_randomize")},
     "mountaincar": {"q_learning", "off_policy_monte_carlo-constant_alpha"},
@@ -660,12 +692,16 @@ def test_cartpole_default_grid(world: str, variant: str, engine: str) -> None:
 
 @pytest.mark.parametrize(
     ("world", "variant", "engine"),
-    _params(["lake", "taxi", "blackjack"], list(VARIANTS)),
+    [
+        *_params(["lake", "taxi", "blackjack"], list(VARIANTS)),
+        *_params(["lake_greedy"], LAKE_GREEDY),
+    ],
 )
 def test_discrete_and_tuple_worlds(world: str, variant: str, engine: str) -> None:
     """Discrete observations (FrozenLake, Taxi) and a Tuple of Discrete (Blackjack).
 
-    On FrozenLake every variant runs on both engines, both numba loops included.
+    On FrozenLake every variant runs on both engines; the greedy loops of those CartPole's
+    twin does not run too.
     """
     _assert_same(world, variant, engine)
 
