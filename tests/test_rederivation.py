@@ -306,31 +306,6 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 400,
         "seed": 7,
     },
-    # FrozenLake again, where every algorithm runs on both engines: exploring throughout.
-    "lake": {
-        "env": {"id": "FrozenLake-v1"},
-        "agent": {
-            "gamma": 0.99,
-            "alpha": {"type": "exponential", "start": 0.5, "decay": 0.995, "end": 0.05},
-            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.99, "end": 0.05},
-            "q_init": 0.0,
-        },
-        "episodes": 300,
-        "seed": 7,
-    },
-    # And with epsilon 0 from episode 199 on: the numba engine's greedy loop (engines/kernel.py)
-    # of the algorithms CartPole's twin does not run below.
-    "lake_greedy": {
-        "env": {"id": "FrozenLake-v1"},
-        "agent": {
-            "gamma": 0.99,
-            "alpha": {"type": "exponential", "start": 0.5, "decay": 0.995, "end": 0.05},
-            "epsilon": {"type": "log", "k": 20, "start": 1.0, "end": 0.0},
-            "q_init": 0.0,
-        },
-        "episodes": 300,
-        "seed": 7,
-    },
     "taxi": {
         "env": {"id": "Taxi-v4"},
         "agent": {
@@ -389,6 +364,20 @@ CASES: dict[str, dict[str, Any]] = {
         "seed": 13,
     },
 }
+
+
+def _frozenlake_with(epsilon: dict[str, Any]) -> dict[str, Any]:
+    """The frozenlake case over 300 episodes, with another epsilon schedule."""
+    lake = CASES["frozenlake"]
+    return {**lake, "agent": {**lake["agent"], "epsilon": epsilon}, "episodes": 300}
+
+
+# FrozenLake again, where every algorithm runs on both engines: exploring throughout; and
+# with epsilon 0 from episode 199 on, for the numba engine's greedy loop (engines/kernel.py)
+# of the algorithms CartPole's twin does not run below.
+CASES["lake"] = _frozenlake_with({"type": "exponential", "start": 1.0, "decay": 0.99, "end": 0.05})
+CASES["lake_greedy"] = _frozenlake_with({"type": "log", "k": 20, "start": 1.0, "end": 0.0})
+
 # Worlds with a compiled twin train on both engines.
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
 NUMBA_WORLDS |= {"walk5", "walk19", "walk1000"}
