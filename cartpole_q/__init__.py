@@ -10,7 +10,7 @@ The Python API, for notebooks and scripts (imported lazily, so the command line 
 - :func:`write_run` / :func:`load_run` -- save a result as a run directory, read one back.
 
 Importing the package registers Sutton & Barto's worlds (``cartpole_q/WindyGridworld-v0``
-and others, :mod:`cartpole_q.worlds`) with Gymnasium, once Gymnasium is imported.
+and others, :mod:`cartpole_q.families`) with Gymnasium, once Gymnasium is imported.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from cartpole_q.worlds import register_when_gymnasium_is_imported
+from cartpole_q.families.registration import register_when_gymnasium_is_imported
 
 __version__ = "0.1.0"
 __all__ = ["__version__", "evaluate", "load_config", "load_run", "train", "write_run"]

@@ -22,8 +22,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 
+from cartpole_q.families import profile_for
 from cartpole_q.learning_curves import AGGREGATE_NAMES, aggregate_band, smooth
-from cartpole_q.profiles import profile_for
 from cartpole_q.rl.solve import SOLVE_WINDOW
 
 DPI = 100

@@ -15,8 +15,8 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from cartpole_q.profiles import EnvProfile, register_profile
-from cartpole_q.profiles.base import GridCells
+from cartpole_q.families import EnvProfile, register_profile
+from cartpole_q.families.base import GridCells
 
 ENV_ID = "cartpole_q_tests/Corridor-v0"
 LENGTH = 6

@@ -25,7 +25,7 @@ from cartpole_q.engines.bandit import (
     play_run_numba,
     run_generators,
 )
-from cartpole_q.envs.twins.bandit import ArmedTestbed, reset_testbed, step_testbed
+from cartpole_q.families.bandit.twin import ArmedTestbed, reset_testbed, step_testbed
 from cartpole_q.rl.bandits import RULES, BanditAgent
 from tests.conftest import REPO, invoke, write_yaml
 from tests.reference_bandits import Learner, reference_run

@@ -24,14 +24,18 @@ from gymnasium.utils.env_checker import check_env
 from cartpole_q.config import ConfigError, load_config
 from cartpole_q.envs.gym import make_env
 from cartpole_q.envs.models import grid_layout
-from cartpole_q.profiles import profile_for
+from cartpole_q.families import book_mdps, gridworlds, profile_for, walks
+from cartpole_q.families.book_mdps.bias import END, A, B, MaximizationBiasEnv
+from cartpole_q.families.gridworlds.worlds import (
+    BARRIER_OPEN_BOTH,
+    BARRIER_OPEN_LEFT,
+    BARRIER_OPEN_RIGHT,
+)
 from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
 from cartpole_q.training import Checkpoint, train
-from cartpole_q.worlds import WORLDS
-from cartpole_q.worlds.bias import END, A, B, MaximizationBiasEnv
-from cartpole_q.worlds.gridworlds import BARRIER_OPEN_BOTH, BARRIER_OPEN_LEFT, BARRIER_OPEN_RIGHT
 from tests.conftest import invoke, write_yaml
 
+WORLDS = (*gridworlds.WORLDS, *book_mdps.WORLDS, *walks.WORLDS)
 IDS = [world.id for world in WORLDS]
 DETERMINISTIC = [
     "cartpole_q/WindyGridworld-v0", "cartpole_q/KingsWindyGridworld-v0", "cartpole_q/DynaMaze-v0",

@@ -24,8 +24,8 @@ from cartpole_q.engines.base import prediction_truth
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.models import EnvModel, env_model
 from cartpole_q.envs.registry import twin_settings
-from cartpole_q.envs.twins import transition_table
 from cartpole_q.experiments.run import execute_run, prepare, start_run
+from cartpole_q.families.tables import twin as transition_table
 from cartpole_q.rl.value_iteration import on_policy_distribution, reachable_states
 from cartpole_q.store import rundir
 from cartpole_q.training import train
@@ -97,7 +97,7 @@ def test_the_model_maps_each_state_to_its_group_and_the_twin_plays_it() -> None:
     assert model.row_of_state[[0, 1, 50, 51, 1000, 1001]].tolist() == [0, 0, 0, 1, 19, 19]
     settings = twin_settings(WALK, {"groups": 20}, 10_000)
     assert not isinstance(settings, str)
-    assert settings.twin.name == "aggregated_table"
+    assert settings.twin.name == "tables_aggregated"
     assert settings.params[-1].tolist() == model.row_of_state.tolist()
     # The plain table twin would observe the states: it refuses a world that groups them.
     refused = transition_table.twin_params({"groups": 20}, WALK)

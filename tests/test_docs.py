@@ -163,7 +163,7 @@ def test_blocks_are_found_with_their_titles_and_reasons(tmp_path: Path) -> None:
 
 
 def test_every_tutorial_has_commands_and_skips_only_what_it_must() -> None:
-    assert len(TUTORIALS) == 7
+    assert len(TUTORIALS) == 8
     for page in TUTORIALS:
         found = blocks(page)
         assert any(block.runs for block in found), f"{page.name} runs no command"

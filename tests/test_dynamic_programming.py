@@ -21,9 +21,9 @@ from hypothesis import strategies as st
 
 from cartpole_q.config import load_config
 from cartpole_q.envs.models import PlanningModel, planning_model
+from cartpole_q.families.planning import WORLDS as PLANNING_WORLDS
 from cartpole_q.figures import book_round
 from cartpole_q.rl import dynamic_programming as dp
-from cartpole_q.worlds import PLANNING_WORLDS
 from tests.conftest import REPO, invoke, write_yaml
 
 BOOK = REPO / "examples" / "book"
@@ -348,7 +348,7 @@ def test_the_gambler_plays_its_stakes_and_ends() -> None:
 
 
 def test_the_car_rental_model_is_exact_and_sums_to_one() -> None:
-    from cartpole_q.worlds.car_rental import day_at_location
+    from cartpole_q.families.planning.car_rental import day_at_location
 
     following, rented = day_at_location(3.0, 3.0, 20)
     np.testing.assert_allclose(following.sum(axis=1), 1.0, atol=1e-12)
@@ -431,7 +431,7 @@ def test_each_dp_study_agrees_with_the_book_and_the_docs_data(name: str, tmp_pat
 
 def test_the_planning_worlds_have_profiles_for_maps_and_models() -> None:
     from cartpole_q.envs.models import grid_layout
-    from cartpole_q.profiles import profile_for
+    from cartpole_q.families import profile_for
 
     config = load_config({"env": {"id": "cartpole_q/SmallGridworld-v0"}})
     layout = grid_layout(config.env)

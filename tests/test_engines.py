@@ -11,7 +11,7 @@ from cartpole_q.config import ConfigError, load_config
 from cartpole_q.engines import make_engine, resolve_engine
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.registry import TwinSettings, twin_settings
-from cartpole_q.envs.twins import cartpole as twin
+from cartpole_q.families.cartpole import twin
 from cartpole_q.store.rundir import atomic_save_npy, metrics_csv
 from cartpole_q.training import derive_generators, train
 from tests.conftest import CONFIGS
@@ -252,14 +252,20 @@ def test_warm_up_touches_no_state_and_draws_nothing(name: str, algorithm: str) -
     assert state.episode == 0
 
 
-def test_every_twin_the_profiles_name_is_one_mypy_checks() -> None:
-    """envs/registry.py checks TWIN_MODULES against the twin interface; a new twin joins it."""
-    from cartpole_q.envs.registry import TWIN_MODULES
-    from cartpole_q.profiles import all_profiles
+def test_every_package_twin_loads_through_a_function_mypy_checks() -> None:
+    """Each family's profiles load their twins through functions typed ``TwinModule`` (mypy
+    checks the module they return against the interface), from the family or the tables."""
+    from cartpole_q.families import FAMILIES
 
-    named = {
-        profile.twin.rpartition(".")[2]
-        for profile in all_profiles()
-        if profile.twin is not None and profile.twin.startswith("cartpole_q.envs.twins.")
-    }
-    assert named == set(TWIN_MODULES)
+    loaded = set()
+    for family in FAMILIES:
+        for profile in family.PROFILES:
+            if profile.twin is None:
+                continue
+            assert callable(profile.twin), profile.name  # not a module's name
+            module = profile.twin()
+            assert module.__name__.startswith(
+                (f"{family.__name__}.", "cartpole_q.families.tables.")
+            ), (profile.name, module.__name__)
+            loaded.add(module.__name__)
+    assert len(loaded) == 8  # cartpole, mountaincar, acrobot, tables (2), taxi, blackjack (2)

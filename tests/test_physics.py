@@ -9,7 +9,7 @@ from gymnasium.utils import seeding
 from cartpole_q.config import ConfigError, load_config
 from cartpole_q.envs.gym import make_env
 from cartpole_q.envs.registry import TwinSettings, twin_settings
-from cartpole_q.envs.twins import cartpole as twin
+from cartpole_q.families.cartpole import twin
 from cartpole_q.store.rundir import metrics_csv
 from cartpole_q.training import train
 

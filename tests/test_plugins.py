@@ -155,8 +155,8 @@ WORLD = {"env": {"id": plugin_world.ENV_ID}, "agent": {"epsilon": 0.3, "q_init":
 
 
 def test_its_profile_is_found_by_id_and_names_its_actions() -> None:
+    from cartpole_q.families import profile_for
     from cartpole_q.figures import action_names
-    from cartpole_q.profiles import profile_for
 
     assert profile_for(plugin_world.ENV_ID) is plugin_world.PROFILE
     assert action_names(plugin_world.ENV_ID, 2) == ["left", "right"]

@@ -17,7 +17,8 @@ import pytest
 from gymnasium.utils import seeding
 from numba import njit
 
-from cartpole_q.envs.twins import acrobot, mountaincar
+from cartpole_q.families.acrobot import twin as acrobot
+from cartpole_q.families.mountaincar import twin as mountaincar
 
 # For each twin: the observation index a swing-up heuristic follows (push with the car's
 # velocity, or with the second link's), which makes episodes reach the goal.
@@ -26,9 +27,9 @@ HEURISTIC_INDEX = {mountaincar: 1, acrobot: 5}
 
 def _ids(twin):  # type: ignore[no-untyped-def]
     """The ids a twin module reproduces, as its profile names them."""
-    from cartpole_q.profiles import all_profiles
+    from cartpole_q.families import all_profiles
 
-    return next(p.ids for p in all_profiles() if p.twin == twin.__name__)
+    return next(p.ids for p in all_profiles() if callable(p.twin) and p.twin() is twin)
 
 
 def _make_recorder(twin: ModuleType) -> Any:

@@ -31,7 +31,9 @@ from cartpole_q import load_config, train
 from cartpole_q.engines import resolve_engine
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.envs.registry import TwinSettings, twin_settings
-from cartpole_q.envs.twins import blackjack, taxi, transition_table
+from cartpole_q.families.blackjack import twin as blackjack
+from cartpole_q.families.tables import twin as transition_table
+from cartpole_q.families.toy_text import taxi_twin as taxi
 from cartpole_q.rl.value_iteration import TabularModel, value_iteration
 from cartpole_q.store.rundir import metrics_csv
 

@@ -10,13 +10,13 @@ import gymnasium
 import numpy as np
 import pytest
 
-import cartpole_q.worlds  # noqa: F401  (registers the worlds)
+import cartpole_q  # noqa: F401  (registers the worlds)
 from cartpole_q.config import ConfigError
 from cartpole_q.engines import until_optimal as loop
 from cartpole_q.engines.until_optimal import Settings, greedy_path_length, maze_arrays
 from cartpole_q.experiments import updates
+from cartpole_q.families.gridworlds.worlds import DynaMazeEnv, scaled_cells, shortest_path
 from cartpole_q.rl.algorithms import prioritized_sweeping
-from cartpole_q.worlds.gridworlds import DynaMazeEnv, scaled_cells, shortest_path
 from tests.conftest import invoke
 
 STUDY = Path(__file__).resolve().parents[1] / "examples/book/example8_4_prioritized_sweeping.yaml"

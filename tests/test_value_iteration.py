@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from cartpole_q.config import load_config
-from cartpole_q.envs.models import blackjack_model, env_model
+from cartpole_q.envs.models import env_model
+from cartpole_q.families.blackjack.model import blackjack_model
 from cartpole_q.rl.value_iteration import (
     TabularModel,
     finite_horizon,

@@ -432,7 +432,7 @@ def optimum_command(
         from cartpole_q.cli.exact_text import exact_lines, policy_grid, state_label
         from cartpole_q.config import parse_assignment
         from cartpole_q.experiments.evaluate_runs import optimum, policy_values
-        from cartpole_q.profiles import profile_for
+        from cartpole_q.families import profile_for
 
         assignments = [parse_assignment(text) for text in set_values or []]
         if policy is not None:

@@ -33,7 +33,7 @@ from cartpole_q.config.overrides import (
 from cartpole_q.config.schema import Config
 from cartpole_q.config.validation import read_config
 from cartpole_q.config.yaml_io import default_raw, read_yaml_mapping, resolve_config_path
-from cartpole_q.profiles import profile_for
+from cartpole_q.families import profile_for
 
 ConfigSource = str | os.PathLike[str] | Mapping[str, Any]
 """What :func:`load_config` reads: a YAML file, a shipped config's name, or a mapping."""

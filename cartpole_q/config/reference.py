@@ -19,7 +19,7 @@ import yaml
 
 from cartpole_q.config.schema import Config, Key, key_of, sections
 from cartpole_q.config.yaml_io import default_raw
-from cartpole_q.profiles import all_profiles
+from cartpole_q.families import all_profiles
 from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.algorithms import algorithms
 from cartpole_q.rl.algorithms import names as algorithm_names

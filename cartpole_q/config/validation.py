@@ -39,8 +39,8 @@ from cartpole_q.config.schema import (
     key_of,
 )
 from cartpole_q.errors import ConfigError
+from cartpole_q.families import Physics, PhysicsRange, all_profiles, profile_for
 from cartpole_q.learning_curves import INFO_KEY_PATTERN
-from cartpole_q.profiles import Physics, PhysicsRange, all_profiles, profile_for
 from cartpole_q.rl.algorithm import Param, ParamValue
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.algorithms import names as algorithm_names
@@ -147,7 +147,7 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
     Either gives an action per table row (the worlds that declare a rule have Discrete
     observations: no grid, no tiles); ``agent.policy_run`` is read by a run's policy alone.
     """
-    from cartpole_q.profiles import profile_for
+    from cartpole_q.families import profile_for
 
     if not get_algorithm(agent.algorithm).predicts:
         return

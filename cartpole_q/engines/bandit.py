@@ -6,7 +6,7 @@ optimal, averaged over the runs. Two engines play a run, with the same compiled 
 (:mod:`cartpole_q.rl.bandits`) and the same draws:
 
 - ``numba``: one compiled call per run plays the testbed's twin
-  (:mod:`cartpole_q.envs.twins.bandit`);
+  (:mod:`cartpole_q.families.bandit.twin`);
 - ``gymnasium``: a Python loop over ``gymnasium.make("cartpole_q/Bandit-v0")``, the rules
   compiled, one call per step each.
 
@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.engines.compile import specialise
-from cartpole_q.envs.twins.bandit import ArmedTestbed, reset_testbed, step_testbed
+from cartpole_q.families.bandit.twin import ArmedTestbed, reset_testbed, step_testbed
 from cartpole_q.rl.bandits import BanditAgent, choose, learn, new_memory
 
 BANDIT_ID = "cartpole_q/Bandit-v0"
@@ -127,7 +127,7 @@ def make_env(testbed: ArmedTestbed, steps: int | None = None) -> Any:
     """
     import gymnasium
 
-    import cartpole_q.worlds  # noqa: F401  (the ids are registered with the package)
+    import cartpole_q.families.registration  # noqa: F401  (the ids are registered with the package)
 
     return gymnasium.make(
         BANDIT_ID, max_episode_steps=steps, k=testbed.k, mean=testbed.mean,

@@ -20,7 +20,7 @@ import yaml
 from cartpole_q.config import Config, ConfigError, Schedule
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
-from cartpole_q.profiles import profile_for
+from cartpole_q.families import profile_for
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table

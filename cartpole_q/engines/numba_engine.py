@@ -24,9 +24,9 @@ from cartpole_q.engines.base import (
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
+from cartpole_q.families import profile_for
 from cartpole_q.numba_cache import is_cached
 from cartpole_q.processes import leave_signals_to_parent
-from cartpole_q.profiles import profile_for
 
 _NO_ERRORS = np.zeros(0, dtype=np.float64)
 """the per-episode errors of a run that measures none"""

@@ -1,6 +1,6 @@
 """Example 8.4's measure, compiled: updates until the greedy path from the start is shortest.
 
-One run of a planning algorithm on a deterministic maze (a :class:`~cartpole_q.worlds.table.
+One run of a planning algorithm on a deterministic maze (a :class:`~cartpole_q.families.tables.world.
 TableWorld` whose every ``P[s][a]`` has one outcome), played from its table as arrays: per
 episode, from the start state, the algorithm's ``start``, then per step the maze's outcome
 and the algorithm's ``step`` (truncated after ``limit`` steps), then its ``end``, exactly as
@@ -8,7 +8,7 @@ the engines' loop calls the hooks (:mod:`cartpole_q.engines.kernel`; no visit co
 metrics). After each episode the greedy path is checked: from the start, the greedy action
 (:func:`~cartpole_q.rl.tabular.best_action`, the lowest on ties) of each state, at most
 ``shortest`` steps; the run stops at the first episode after which that path reaches the goal
-in ``shortest`` steps (the BFS length, :func:`~cartpole_q.worlds.gridworlds.shortest_path`),
+in ``shortest`` steps (the BFS length, :func:`~cartpole_q.families.gridworlds.worlds.shortest_path`),
 or once ``max_updates`` updates are made (then it did not get there).
 
 **Updates** are every change of ``Q`` (every call of ``update``), real and planning alike:
@@ -147,8 +147,8 @@ class Maze:
 
 
 def maze_arrays(world: Any) -> Maze:
-    """The arrays of a deterministic :class:`~cartpole_q.worlds.table.TableWorld`."""
-    from cartpole_q.worlds.gridworlds import shortest_path
+    """The arrays of a deterministic :class:`~cartpole_q.families.tables.world.TableWorld`."""
+    from cartpole_q.families.gridworlds.worlds import shortest_path
 
     n_states, n_actions = len(world.P), len(world.P[0])
     next_states = np.zeros(n_states * n_actions, dtype=np.int64)

@@ -20,7 +20,7 @@ import numpy as np
 
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame, shorten, shown
 from cartpole_q.errors import RunError
-from cartpole_q.profiles import profile_for
+from cartpole_q.families import profile_for
 
 
 @dataclass(frozen=True)

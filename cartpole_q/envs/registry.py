@@ -2,10 +2,11 @@
 
 A twin is a module of compiled functions (``reset``, ``step``, and ``randomized`` where the
 environment has physics to randomise) with its sizes and the plain function that turns
-``gymnasium.make`` arguments into its parameters; :class:`Twin` is what the engines bind into
-their compiled loops (see :mod:`cartpole_q.engines.kernel`). An environment's profile names
-its twin's module (:attr:`cartpole_q.profiles.base.EnvProfile.twin`): a new twin is one
-module and that one line.
+``gymnasium.make`` arguments into its parameters (:class:`~cartpole_q.families.base.TwinModule`);
+:class:`Twin` is what the engines bind into their compiled loops (see
+:mod:`cartpole_q.engines.kernel`). An environment's profile loads its twin's module
+(:attr:`cartpole_q.families.base.EnvProfile.twin`): a new twin is one module in its family
+and the function that imports it.
 """
 
 from __future__ import annotations
@@ -16,42 +17,14 @@ import inspect
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, cast
+from typing import Any, cast
 
 import numpy as np
 from numba import njit
 
-from cartpole_q.envs.twins import TwinModule
+from cartpole_q.families import EnvProfile, all_profiles, profile_for
+from cartpole_q.families.base import TwinModule
 from cartpole_q.numba_cache import configure as configure_numba_cache
-from cartpole_q.profiles import EnvProfile, all_profiles, profile_for
-
-if TYPE_CHECKING:  # mypy checks that each twin module meets the interface (never imported here)
-    from cartpole_q.envs.twins import (
-        acrobot,
-        aggregated_table,
-        blackjack,
-        blackjack_es,
-        cartpole,
-        mountaincar,
-        taxi,
-        transition_table,
-    )
-
-    # One assignment per module, so that mypy names the one that does not meet it.
-    _checked: TwinModule = acrobot
-    _checked = aggregated_table
-    _checked = blackjack
-    _checked = blackjack_es
-    _checked = cartpole
-    _checked = mountaincar
-    _checked = taxi
-    _checked = transition_table
-TWIN_MODULES = (
-    "acrobot", "aggregated_table", "blackjack", "blackjack_es", "cartpole", "mountaincar",
-    "taxi", "transition_table",
-)  # fmt: skip
-"""the twin modules mypy checks against :class:`~cartpole_q.envs.twins.TwinModule` (a test
-keeps this list equal to the modules the profiles name)"""
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -70,7 +43,7 @@ class Twin:
     """A compiled twin: what the compiled loops call, and what sizes them."""
 
     name: str
-    """the module's name (``cartpole``)"""
+    """the module's name in its family (``cartpole``, ``tables``, ``toy_text_taxi``)"""
     key: str
     """the name and a digest of the module's source (compiled loops are cached under it)"""
     env_ids: tuple[str, ...]
@@ -99,7 +72,7 @@ class Twin:
     def of(cls, module: TwinModule, profile: EnvProfile) -> Twin:
         """The twin a module defines (see :mod:`cartpole_q.envs.twins`) for a profile."""
         source = cast(ModuleType, module)
-        name = source.__name__.rpartition(".")[2]
+        name = twin_name(source.__name__)
         digest = hashlib.sha256(inspect.getsource(source).encode()).hexdigest()[:12]
         return cls(
             name=name,
@@ -118,16 +91,31 @@ class Twin:
         )
 
 
+def twin_name(module_name: str) -> str:
+    """A twin's short name, from its module's: its path in its family, ``twin`` left out.
+
+    >>> twin_name("cartpole_q.families.cartpole.twin"), twin_name("cartpole_q.families.tables.twin")
+    ('cartpole', 'tables')
+    >>> twin_name("cartpole_q.families.toy_text.taxi_twin"), twin_name("my_plugin.twins.maze")
+    ('toy_text_taxi', 'my_plugin_twins_maze')
+    """
+    path = module_name.removeprefix("cartpole_q.families.").split(".")
+    return "_".join(part.removesuffix("_twin") for part in path if part != "twin")
+
+
 _LOADED: dict[str, Twin] = {}
 
 
 def _twin_of(profile: EnvProfile) -> Twin | None:
-    """The twin a profile names (its module imported, and the record made, once)."""
+    """The twin a profile loads (its module imported, and the record made, once)."""
     if profile.twin is None:
         return None
     if profile.name not in _LOADED:
-        # The package's twins are checked by mypy (CHECKED_TWINS); a plug-in's at its own risk.
-        module = cast(TwinModule, importlib.import_module(profile.twin))
+        if isinstance(profile.twin, str):
+            # A plug-in's module by name: it meets the interface at its own risk.
+            module = cast(TwinModule, importlib.import_module(profile.twin))
+        else:  # the package's families: a loader whose return type mypy checks
+            module = profile.twin()
         _LOADED[profile.name] = Twin.of(module, profile)
     return _LOADED[profile.name]
 

@@ -396,7 +396,7 @@ def run_study(
     import time
 
     from cartpole_q.engines.bandit import play_curve
-    from cartpole_q.envs.twins.bandit import ArmedTestbed
+    from cartpole_q.families.bandit.twin import ArmedTestbed
 
     start = time.perf_counter()
     testbed = ArmedTestbed(*study.testbed)

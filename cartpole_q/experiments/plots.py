@@ -18,6 +18,7 @@ import numpy as np
 from cartpole_q.config import Config, format_seeds
 from cartpole_q.errors import RunError, UserError
 from cartpole_q.experiments.compare import Comparison, compare_figure_data
+from cartpole_q.families import profile_for
 from cartpole_q.figures import (
     Curve,
     GridMap,
@@ -42,7 +43,6 @@ from cartpole_q.learning_curves import (
     seed_curves,
     smoothed,
 )
-from cartpole_q.profiles import profile_for
 from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
 from cartpole_q.store.figure_file import check_figure_file, write_figure

@@ -22,8 +22,8 @@ from cartpole_q.engines.plan import env_facts
 from cartpole_q.envs.registry import twin_for
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import under_conditions
+from cartpole_q.families import Physics, profile_for
 from cartpole_q.figures import robustness_figure
-from cartpole_q.profiles import Physics, profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.store.atomic import atomic_write_text, check_output_file
 from cartpole_q.store.figure_file import check_figure_file, write_figure

@@ -34,6 +34,7 @@ from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
 from cartpole_q.experiments.sweep_spec import POLICY_FIGURE, VALUES_FIGURE, SweepSpec, load_sweep
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
+from cartpole_q.families import profile_for
 from cartpole_q.figures import (
     DataFigure,
     blackjack_optimal_figure,
@@ -41,7 +42,6 @@ from cartpole_q.figures import (
     summary_line_figure,
 )
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
-from cartpole_q.profiles import profile_for
 from cartpole_q.progress import NullSweepProgress, SweepProgress
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
@@ -565,7 +565,8 @@ def blackjack_optimum(config: Config) -> tuple[np.ndarray, np.ndarray, np.ndarra
         ``q*`` per observation row and action, the optimal policy (the lowest action among
         the maxima: stick on ties) and ``v*``, each shaped by the observation.
     """
-    from cartpole_q.envs.models import BLACKJACK_SHAPE, env_model
+    from cartpole_q.envs.models import env_model
+    from cartpole_q.families.blackjack.model import BLACKJACK_SHAPE
     from cartpole_q.rl.value_iteration import finite_horizon
 
     exact = env_model(config.env)

@@ -310,7 +310,7 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
     from cartpole_q.rl.algorithms import get as get_algorithm
 
     if metric == POLICY_FIGURE:
-        from cartpole_q.profiles import profile_for
+        from cartpole_q.families import profile_for
 
         for point in points:
             config = point.config

@@ -287,7 +287,7 @@ def _until_optimal_runs(
     study: Study, stop: Callable[[], bool] | None
 ) -> dict[tuple[str, int], list[Any]] | None:
     from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
-    from cartpole_q.worlds.gridworlds import DynaMazeEnv
+    from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
 
     runs: dict[tuple[str, int], list[Any]] = {}
     for scale in study.scales:

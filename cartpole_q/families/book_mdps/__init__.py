@@ -1,0 +1,63 @@
+"""The book's small MDPs: the one-state MDP (Example 5.5) and the maximization bias (6.7).
+
+Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state` and
+:mod:`~cartpole_q.families.book_mdps.bias`.
+
+Both have a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
+exactly. The one-state MDP plays on the compiled twin of any table world; the
+maximization-bias world draws a normal reward, which no twin reproduces, so it plays on the
+gymnasium engine, and needs no time limit (every episode ends within two steps).
+"""
+
+from __future__ import annotations
+
+from types import MappingProxyType
+
+from cartpole_q.families.base import NAMESPACE, EnvProfile, World
+from cartpole_q.families.tables import load_twin as load_table_twin
+
+_BIAS = "cartpole_q.families.book_mdps.bias"
+_ONE_STATE = "cartpole_q.families.book_mdps.one_state"
+ONE_STATE_TIME_LIMIT = 1_000
+"""steps before an episode of the one-state MDP is truncated (left comes back with
+probability 0.9: ten steps on average)"""
+
+
+MAXIMIZATION_BIAS = EnvProfile(
+    name="MaximizationBias",
+    description="left from A to B's noisy rewards (mean -0.1) or right to 0 "
+    "(Sutton & Barto's Example 6.7)",
+    ids=("cartpole_q/MaximizationBias-v0",),
+    entry_points=(f"{_BIAS}:MaximizationBiasEnv",),
+    model="transition_table",
+)
+
+
+def always_left(state_shape: tuple[int, ...]) -> list[int]:
+    """The one-state MDP's target policy (Example 5.5): left (0) in every state.
+
+    >>> always_left((2,))
+    [0, 0]
+    """
+    return [0] * state_shape[0]
+
+
+ONE_STATE = EnvProfile(
+    name="OneState",
+    description="left comes back (0.9) or ends with +1, right ends with 0 (Sutton & Barto's "
+    "Example 5.5)",
+    ids=("cartpole_q/OneState-v0",),
+    entry_points=(f"{_ONE_STATE}:OneStateEnv",),
+    action_names=("left", "right"),
+    model="transition_table",
+    twin=load_table_twin,
+    policies=MappingProxyType({"left": always_left}),
+)
+
+PROFILES = (MAXIMIZATION_BIAS, ONE_STATE)
+"""the family's profiles"""
+WORLDS: tuple[World, ...] = (
+    World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
+    World(f"{NAMESPACE}/OneState-v0", f"{_ONE_STATE}:OneStateEnv", ONE_STATE_TIME_LIMIT),
+)
+"""the worlds it registers"""
