@@ -50,7 +50,7 @@ from pathlib import Path
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 
-COMPILED_PACKAGES = ("rl", "envs", "engines")
+COMPILED_PACKAGES = ("rl", "families", "envs", "engines")
 """the subpackages whose functions numba compiles, or whose constants and functions the
 compiled code inlines: every module in them is hashed (and ``config/schema.py``)"""
 
