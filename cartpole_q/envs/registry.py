@@ -70,7 +70,7 @@ class Twin:
 
     @classmethod
     def of(cls, module: TwinModule, profile: EnvProfile) -> Twin:
-        """The twin a module defines (see :mod:`cartpole_q.envs.twins`) for a profile."""
+        """The twin a module defines (see :class:`~cartpole_q.families.base.TwinModule`) for a profile."""
         source = cast(ModuleType, module)
         name = twin_name(source.__name__)
         digest = hashlib.sha256(inspect.getsource(source).encode()).hexdigest()[:12]
