@@ -190,3 +190,13 @@ def test_its_policy_map_is_drawn_as_its_grid(tmp_path: Path) -> None:
 
     layout = grid_layout(load_config(WORLD).env)
     assert layout is not None and layout.cells[-1] == "G" and layout.arrows() == "<>"
+
+
+def test_a_plugin_written_before_the_families_still_imports_the_profiles() -> None:
+    """``cartpole_q.profiles`` (the profiles' home before the families) re-exports them."""
+    import cartpole_q.families as families
+    import cartpole_q.profiles as profiles
+
+    for name in profiles.__all__:
+        assert getattr(profiles, name) is getattr(families, name), name
+    assert profiles.profile_for(plugin_world.ENV_ID) is plugin_world.PROFILE
