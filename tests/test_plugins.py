@@ -200,3 +200,10 @@ def test_a_plugin_written_before_the_families_still_imports_the_profiles() -> No
     for name in profiles.__all__:
         assert getattr(profiles, name) is getattr(families, name), name
     assert profiles.profile_for(plugin_world.ENV_ID) is plugin_world.PROFILE
+
+
+def test_a_plugin_id_written_with_its_module_finds_its_profile() -> None:
+    """``module:Name-v0`` (Gymnasium imports the module) is the id ``Name-v0``'s profile."""
+    from cartpole_q.families import profile_for
+
+    assert profile_for(f"tests.plugin_world:{plugin_world.ENV_ID}") is plugin_world.PROFILE

@@ -95,11 +95,17 @@ def all_profiles() -> Iterator[EnvProfile]:
 def profile_for(env_id: str) -> EnvProfile:
     """The profile of ``env_id``: by id, else by its registered entry point, else UNKNOWN.
 
+    An id written ``module:Name-v0`` (Gymnasium imports the module, which registers the
+    id) is looked up as ``Name-v0``.
+
     >>> profile_for("CartPole-v1").name, profile_for("NoSuchEnv-v0").name
     ('CartPole', 'unknown')
+    >>> profile_for("gymnasium.envs:CartPole-v1").name
+    'CartPole'
     """
+    name = env_id.rpartition(":")[2]
     for profile in _PROFILES:
-        if env_id in profile.ids:
+        if name in profile.ids:
             return profile
     entry_point = _entry_point(env_id)
     if entry_point is not None:
