@@ -250,6 +250,8 @@ class Agent:
         rng: The agent's generator (every draw of every algorithm).
         epsilon: The current episode's epsilon.
         alpha: The current episode's alpha.
+        counts: ``agent.alpha: sample_average``'s update counts, ``counts[x][b]`` (None
+            under a schedule).
         params: The algorithm's extra keys (``n``, ``lambda``, ``trace``, ...).
     """
 
@@ -268,6 +270,7 @@ class Agent:
         self.rng = rng
         self.epsilon = 0.0
         self.alpha = 0.0
+        self.counts: list[list[float]] | None = None
         self.params = params
 
     # -- reading the table
@@ -367,7 +370,15 @@ class Agent:
         return lowest
 
     def update(self, x: int, b: int, y: float) -> None:
-        """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))`` (on tiles: ``add``'s split)."""
+        """``Q(x, b) = Q(x, b) + alpha * (y - Q(x, b))`` (on tiles: ``add``'s split).
+
+        docs/algorithms.md, "Sample averages": under ``agent.alpha: sample_average``,
+        ``N(x, b) = N(x, b) + 1.0`` then ``Q(x, b) = Q(x, b) + (y - Q(x, b)) / N(x, b)``.
+        """
+        if self.counts is not None:
+            self.counts[x][b] = self.counts[x][b] + 1.0
+            self.add(x, b, (y - self.value(x, b)) / self.counts[x][b])
+            return
         self.add(x, b, self.alpha * (y - self.value(x, b)))
 
     # -- what the algorithms override
@@ -1349,7 +1360,7 @@ def reference_train(
     *,
     algorithm: str,
     gamma: float,
-    alpha: float | Mapping[str, Any] | Schedule,
+    alpha: float | str | Mapping[str, Any] | Schedule,
     epsilon: float | Mapping[str, Any] | Schedule,
     q_init: float,
     episodes: int,
@@ -1368,7 +1379,8 @@ def reference_train(
         env_id: The Gymnasium id.
         algorithm: ``agent.algorithm``.
         gamma: ``agent.gamma``.
-        alpha: ``agent.alpha``: a number, a schedule mapping or a schedule function.
+        alpha: ``agent.alpha``: a number, a schedule mapping, a schedule function, or
+            ``"sample_average"``.
         epsilon: ``agent.epsilon``, as ``alpha``.
         q_init: ``agent.q_init``.
         episodes: ``train.episodes``.
@@ -1386,7 +1398,9 @@ def reference_train(
     Returns:
         The kept table, the visits, the returns and lengths, the solve episode.
     """
-    alpha_of, epsilon_of = schedule(alpha), schedule(epsilon)
+    averaged = alpha == "sample_average"
+    alpha_of = constant(math.nan) if averaged else schedule(alpha)  # type: ignore[arg-type]
+    epsilon_of = schedule(epsilon)
     env = gymnasium.make(env_id, **dict(kwargs or {}))
     state_shape, row = make_indexer(env.observation_space, discretization)
     assert isinstance(env.action_space, spaces.Discrete)
@@ -1412,6 +1426,8 @@ def reference_train(
         n_states, n, weight_init, float(gamma), rng,
         {**defaults, **(params or {}), "tilings": tilings},
     )  # fmt: skip
+    if averaged:  # docs/algorithms.md, "Sample averages": one count per table entry
+        agent.counts = [[0.0] * len(row) for row in agent.q]
     measured: list[Any] = []
     truth: list[float] = []
     errors: list[float] | None = None

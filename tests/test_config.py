@@ -109,6 +109,51 @@ def test_schedule_forms(value: object, expected: Schedule) -> None:
     assert load_config(overrides={"agent.alpha": value}).agent.alpha == expected
 
 
+@pytest.mark.parametrize("value", ["sample_average", {"type": "sample_average"}])
+def test_alpha_may_be_the_sample_average_and_round_trips(tmp_path: Path, value: object) -> None:
+    config = load_config(overrides={"agent.alpha": value})
+    assert config.agent.alpha == Schedule("sample_average", 0.0, 0.0)
+    assert config.agent.alpha.averages and not config.agent.epsilon.averages
+    assert yaml.safe_load(config.to_yaml())["agent"]["alpha"] == "sample_average"
+    path = tmp_path / "resolved.yaml"
+    path.write_text(config.to_yaml(), encoding="utf-8")
+    assert load_config(path) == config
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        (
+            {"agent.epsilon": "sample_average"},
+            r"agent\.epsilon: cannot be sample_average: only agent\.alpha",
+        ),
+        (
+            {"agent.alpha": {"type": "sample_average", "start": 1.0}},
+            r"agent\.alpha.*start",
+        ),
+        (
+            {"agent.algorithm": "sarsa_lambda"},
+            r"agent\.alpha: sample_average does not apply to agent\.algorithm sarsa_lambda: every "
+            r"step moves every traced entry",
+        ),
+        (
+            {"agent.algorithm": "double_q_learning"},
+            r"agent\.alpha: sample_average does not apply .* two tables",
+        ),
+        (
+            {"discretization.tilings": 4},
+            r"agent\.alpha: sample_average counts the updates .* tiles",
+        ),
+    ],
+)
+def test_sample_averages_are_refused_where_they_have_no_meaning(
+    overrides: dict[str, object], message: str
+) -> None:
+    """Only agent.alpha, only algorithms whose updates move one entry toward a target, no tiles."""
+    with pytest.raises(ConfigError, match=message):
+        load_config(overrides={"agent.alpha": "sample_average", **overrides})
+
+
 def test_yaml_reads_5e_minus_4_as_a_string_and_we_take_the_number(tmp_path: Path) -> None:
     path = tmp_path / "c.yaml"
     path.write_text(

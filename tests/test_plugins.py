@@ -40,6 +40,12 @@ def test_configs_take_its_name_and_its_key() -> None:
     assert load_config(overrides={"agent.behaviour": 0.5}).agent.params == {}
 
 
+def test_sample_averages_are_refused_until_it_declares_them() -> None:
+    """A plug-in whose hooks may use ``alpha`` as a number is not handed the counts."""
+    with pytest.raises(ConfigError, match=r"agent\.alpha: sample_average .* does not declare"):
+        load_config(overrides={**SETTINGS, "agent.alpha": "sample_average"})
+
+
 @pytest.mark.parametrize("engine", ["numba", "gymnasium"])
 def test_it_trains_on_both_engines_to_the_same_bytes_and_resumes(
     engine: str, tmp_path: Path

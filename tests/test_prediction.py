@@ -709,3 +709,21 @@ def test_optimum_evaluates_a_runs_greedy_policy(tmp_path: Path) -> None:
     assert values["0"] == pytest.approx(float(optimum.values[0]), abs=1e-12)
     refused = invoke("optimum", "FrozenLake-v1", "--policy", "greedy", "--set", "agent.alpha=0.1")
     assert refused.exit_code == 2 and "agent.policy_run=RUN_DIR" in refused.stderr
+
+
+def test_the_sample_averages_example_shows_what_its_comment_measures() -> None:
+    """examples/book/example6_2_sample_averages.yaml, its first 20 seeds: sample averages
+    fall faster than a constant alpha at first (TD(0)) and end lower (Monte Carlo)."""
+    from cartpole_q.experiments.sweep_spec import load_sweep
+
+    study = Path(__file__).resolve().parents[1] / "examples/book/example6_2_sample_averages.yaml"
+    points = load_sweep(study).points
+    assert [point.config.agent.alpha.averages for point in points] == [False, True, False, True]
+    errors = []
+    for point in points:
+        runs = [train(point.config.for_seed(seed), final_eval=False) for seed in range(20)]
+        assert all(run.errors is not None for run in runs)
+        errors.append(np.mean([run.errors for run in runs], axis=0))
+    td, td_averaged, mc, mc_averaged = errors
+    assert td_averaged[9] < td[9]  # episode 10
+    assert mc_averaged[99] < mc[99]  # episode 100

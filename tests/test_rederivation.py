@@ -165,6 +165,28 @@ PREDICTION_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         {"target": "mc", "alpha": 0.005, "tolerance": 1e-9, "max_passes": 10},
     ),
 }
+# docs/algorithms.md, "Sample averages": agent.alpha: sample_average for every algorithm it
+# applies to (each update of an entry by 1 / N, N the entry's update count).
+AVERAGED = {"alpha": "sample_average"}
+SAMPLE_AVERAGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
+    f"{variant}-averaged": (name, {**params, **AVERAGED})
+    for variant, (name, params) in {
+        "q_learning": ("q_learning", {}),
+        "sarsa": ("sarsa", {}),
+        "expected_sarsa": ("expected_sarsa", {}),
+        "n_step_sarsa": ("n_step_sarsa", {"n": 3}),
+        "n_step_tree_backup": ("n_step_tree_backup", {"n": 3}),
+        "dyna_q": ("dyna_q", {"planning_steps": 5}),
+        "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
+        "prioritized_sweeping": ("prioritized_sweeping", {"planning_steps": 5, "theta": 0.001}),
+        "monte_carlo": ("monte_carlo", {"update": "constant_alpha"}),
+        "monte_carlo_es": ("monte_carlo_es", {"update": "constant_alpha"}),
+        "td": ("td", {}),
+        "n_step_td": ("n_step_td", {"n": 3}),
+        "mc_prediction": ("mc_prediction", {"update": "constant_alpha"}),
+        "offline_lambda_return": ("offline_lambda_return", {"lambda": 0.8}),
+    }.items()
+}
 ES_VARIANTS = [
     "monte_carlo_es-sample_average",
     "monte_carlo_es-constant_alpha",
@@ -177,7 +199,7 @@ AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init"}
 """keys a variant may give that are the agent's own, not its algorithm's"""
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
 LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")
-ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS, **PREDICTION_VARIANTS}
+ALL_VARIANTS = {**VARIANTS, **EDGE_VARIANTS, **PREDICTION_VARIANTS, **SAMPLE_AVERAGE_VARIANTS}
 
 # The worlds: name -> everything but the algorithm (env, grid, agent, episodes, seed, ...).
 CASES: dict[str, dict[str, Any]] = {
@@ -663,6 +685,46 @@ def test_exploring_starts(world: str, variant: str, engine: str) -> None:
         assert started.min() > 0  # all 400 pairs taken
     else:  # epsilon-greedy first actions: this seed leaves some pair untried
         assert started.min() == 0
+
+
+AVERAGED_CONTROL = [
+    variant
+    for variant, (name, _) in SAMPLE_AVERAGE_VARIANTS.items()
+    if name not in {"td", "n_step_td", "mc_prediction", "offline_lambda_return"}
+]
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"),
+    [
+        *_params(["lake"], AVERAGED_CONTROL),
+        *_params(["walk19"], [v for v in SAMPLE_AVERAGE_VARIANTS if v not in AVERAGED_CONTROL]),
+    ],
+)
+def test_sample_averages(world: str, variant: str, engine: str) -> None:
+    """``agent.alpha: sample_average``: control on FrozenLake, prediction on the 19-state walk."""
+    _assert_same(world, variant, engine)
+
+
+def test_sample_averages_cover_every_algorithm_that_takes_them() -> None:
+    """Every algorithm without a ``no_sample_average`` reason is re-derived with it."""
+    takes = {module.ALGORITHM.name for module in PACKAGE if not module.ALGORITHM.no_sample_average}
+    assert {name for name, _ in SAMPLE_AVERAGE_VARIANTS.values()} == takes
+
+
+@pytest.mark.parametrize("algorithm", ["monte_carlo", "mc_prediction"])
+def test_monte_carlos_constant_alpha_at_sample_averages_is_its_sample_average(
+    algorithm: str,
+) -> None:
+    """``agent.update: constant_alpha`` with ``alpha: sample_average`` is, byte for byte,
+    ``agent.update: sample_average`` (docs/algorithms.md states both as one rule)."""
+    world = "lake" if algorithm == "monte_carlo" else "walk19"
+    averaged = _config(CASES[world], algorithm, {"update": "constant_alpha", **AVERAGED}, "numba")
+    averaging = _config(CASES[world], algorithm, {"update": "sample_average"}, "numba")
+    first, second = train(averaged), train(averaging)
+    assert first.q_table.tobytes() == second.q_table.tobytes()
+    assert first.returns.tolist() == second.returns.tolist()
+    assert np.isnan(first.metrics.alphas).all()
 
 
 def test_every_package_algorithm_is_re_derived() -> None:

@@ -101,6 +101,32 @@ def test_interrupted_run_is_complete_and_resumes_byte_identically(
     _assert_same_results(run, reference)
 
 
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_a_sample_average_run_resumes_byte_identically(tmp_path: Path, engine: str) -> None:
+    """``agent.alpha: sample_average``: the update counts are checkpointed with the memory."""
+    overrides = {
+        "engine": engine, "seed": 3, "env.id": "FrozenLake-v1", "discretization": None,
+        "agent.alpha": "sample_average", "agent.epsilon": 0.2, "agent.q_init": 0.0,
+        "agent.gamma": 0.95, "train.episodes": 300, "train.stop_when_solved": False,
+        "train.checkpoint_every": 25, "train.eval_every": 0,
+    }  # fmt: skip
+    reference = _reference(tmp_path, overrides)
+    prepared = prepare(load_config(overrides=overrides), "test")
+    run = start_run(prepared, tmp_path / "run")
+    polls = iter(range(10**9))
+    outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= 2)
+    assert outcome.result.interrupted
+    checkpoint = np.load(run / rundir.CHECKPOINT_FILE)
+    counts = checkpoint["memory_0"]  # q_learning keeps no memory of its own: the counts
+    assert counts.shape == (16, 4) and counts.sum() > 0
+    # Q-learning updates the pair of each step once: its update counts are its visits
+    assert counts.tolist() == checkpoint["visits"].reshape(16, 4).astype(np.float64).tolist()
+
+    result = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    _assert_same_results(run, reference)
+
+
 def test_resume_refuses_a_finished_run_and_other_options(tmp_path: Path) -> None:
     reference = _reference(tmp_path, {"train.episodes": 5})
     runner = CliRunner()

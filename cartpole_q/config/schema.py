@@ -23,9 +23,12 @@ from typing import Any, Literal
 import yaml
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.schedules import SCHEDULE_KINDS
+from cartpole_q.rl.schedules import STEP_SIZE_KINDS
 from cartpole_q.rl.tabular import TIE_BREAKS
 from cartpole_q.rl.tiles import tile_shape
+
+SAMPLE_AVERAGE_KIND = STEP_SIZE_KINDS[-1]
+"""``agent.alpha: sample_average``: the step size of an update is ``1 / N``, not a schedule's"""
 
 ENGINES = ("auto", "numba", "gymnasium")
 """``engine`` values"""
@@ -76,6 +79,9 @@ class Key:
     nullable: bool = False
     """``null`` is a value of its own: the single top-level seed, the environment's
     threshold, no grid"""
+    sample_average: bool = False
+    """a ``schedule`` that may also be ``sample_average`` (a step size per update, not per
+    episode: ``agent.alpha``)"""
 
     @property
     def interval(self) -> str:
@@ -99,9 +105,10 @@ def spec(
     low_open: bool = False,
     choices: tuple[str, ...] = (),
     nullable: bool = False,
+    sample_average: bool = False,
 ) -> dict[str, Key]:
     """A field's metadata: ``field(metadata=spec("float", "discount", low=0.0, high=1.0))``."""
-    return {_KEY: Key(kind, doc, low, high, low_open, choices, nullable)}
+    return {_KEY: Key(kind, doc, low, high, low_open, choices, nullable, sample_average)}
 
 
 def key_of(item: dataclasses.Field[Any]) -> Key:
@@ -120,11 +127,14 @@ class Schedule:
     - ``exponential``: ``max(end, start * rate ** e)``; the blog's ``epsilon *= 0.995``
       down to 0.01 is ``start=1.0, rate=0.995, end=0.01``;
     - ``log``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the
-      constant ``k``; with ``start=1`` this is the classic tabular CartPole schedule.
+      constant ``k``; with ``start=1`` this is the classic tabular CartPole schedule;
+    - ``sample_average`` (``agent.alpha`` only): no value per episode; each update of a
+      table entry moves it by ``1 / N``, ``N`` the entry's update count (``start``, ``end``
+      0, unused).
     """
 
     kind: str
-    """one of ``constant``, ``exponential``, ``log``"""
+    """one of ``constant``, ``exponential``, ``log`` (or ``sample_average``)"""
     start: float
     """the value at the first episode (the cap of the log schedule)"""
     end: float
@@ -135,12 +145,19 @@ class Schedule:
     @property
     def code(self) -> int:
         """The kind as the integer the compiled agent functions take."""
-        return SCHEDULE_KINDS.index(self.kind)
+        return STEP_SIZE_KINDS.index(self.kind)
 
-    def to_yaml(self) -> float | dict[str, Any]:
-        """Return the YAML form: a number for a constant, else a mapping."""
+    @property
+    def averages(self) -> bool:
+        """Whether this is ``sample_average``, a step size per update (``agent.alpha``)."""
+        return self.kind == SAMPLE_AVERAGE_KIND
+
+    def to_yaml(self) -> float | str | dict[str, Any]:
+        """Return the YAML form: a number, ``sample_average``, or a schedule's mapping."""
         if self.kind == "constant":
             return self.start
+        if self.averages:
+            return SAMPLE_AVERAGE_KIND
         form = SCHEDULE_FORMS[self.kind]
         return {"type": self.kind, **{key.name: getattr(self, key.field) for key in form}}
 
@@ -286,10 +303,13 @@ class AgentConfig:
     alpha: Schedule = field(
         metadata=spec(
             "schedule",
-            "learning rate in {interval}: a number, or a schedule",
+            "learning rate in {interval}: a number, a schedule, or `sample_average` (every "
+            "update of a table entry moves it by `1 / N`, `N` the entry's update count: the "
+            'average of its targets; docs/algorithms.md, "Sample averages")',
             low=0.0,
             high=1.0,
             low_open=True,
+            sample_average=True,
         )
     )
     epsilon: Schedule = field(

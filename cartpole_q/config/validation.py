@@ -26,6 +26,7 @@ from cartpole_q.config.schema import (
     EXACT_INTEGER,
     MAX_SEED,
     MAX_SEEDS,
+    SAMPLE_AVERAGE_KIND,
     SCHEDULE_FORMS,
     AgentConfig,
     Config,
@@ -83,6 +84,8 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     )
     if tilings > 1:
         _check_on_tiles(reader, agent.algorithm)
+    if agent.alpha.averages:
+        _check_sample_average(reader, agent.algorithm, tilings)
     train = TrainConfig(**reader.fields(TrainConfig, "train."))
     _check_epsilon_floor(reader, agent, train.episodes)
     env = _env(reader)
@@ -138,6 +141,26 @@ def _check_on_tiles(reader: _Reader, algorithm: str) -> None:
             "discretization.tilings",
             f"tile coding (tilings > 1) does not run agent.algorithm {algorithm}: {reason}. "
             "Use tilings: 1, or a one-step, n-step or trace algorithm.",
+        )
+
+
+def _check_sample_average(reader: _Reader, algorithm: str, tilings: int) -> None:
+    """Sample averages count updates of table entries: an algorithm that makes them, no tiles."""
+    reason = get_algorithm(algorithm).no_sample_average
+    if reason:
+        raise reader.error(
+            "agent.alpha",
+            f"sample_average does not apply to agent.algorithm {algorithm}: {reason}. Give "
+            "alpha a number or a schedule, or use an algorithm whose updates move one entry "
+            "toward a target (q_learning, sarsa, expected_sarsa, td, the n-step methods, Dyna, "
+            "Monte Carlo).",
+        )
+    if tilings > 1:
+        raise reader.error(
+            "agent.alpha",
+            "sample_average counts the updates of each table entry, and on tiles "
+            "(discretization.tilings > 1) a state is not one entry but its tiles, shared with "
+            "other states. Give alpha a number or a schedule, or use tilings: 1.",
         )
 
 
@@ -485,7 +508,24 @@ class _Reader:
         return tuple(result)
 
     def schedule(self, field: str, value: Any, bounds: Spec) -> Schedule:
-        """A number (a constant) or a mapping with a ``type`` and that type's keys."""
+        """A number (a constant) or a mapping with a ``type`` and that type's keys.
+
+        A step size (a :class:`Key` with ``sample_average``) may also be ``sample_average``,
+        written alone or as ``{type: sample_average}``.
+        """
+        if value == SAMPLE_AVERAGE_KIND or (
+            isinstance(value, dict) and value.get("type") == SAMPLE_AVERAGE_KIND
+        ):
+            if not (isinstance(bounds, Key) and bounds.sample_average):
+                raise self.error(
+                    field,
+                    "cannot be sample_average: only agent.alpha, a step size, can (a step of "
+                    "1 / N per update); give a number or a schedule.",
+                )
+            for key in value if isinstance(value, dict) else ():
+                if key != "type":
+                    raise self.unknown(field, key, ["type"])
+            return Schedule(SAMPLE_AVERAGE_KIND, 0.0, 0.0)
         if not isinstance(value, dict):
             constant = self.number(field, value, bounds)
             return Schedule("constant", constant, constant)

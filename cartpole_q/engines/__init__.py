@@ -141,16 +141,17 @@ def loop_names(
     algorithm = get_algorithm(config.agent.algorithm)
     grid = config.discretization
     tiled = grid is not None and grid.tilings > 1
+    averaged = config.agent.alpha.averages
     if engine == "numba":
         settings = _twin(config, env_info, twin)
         randomized = bool(config.env.randomize)
         played = loops_played(epsilon_record(config), 0, config.train.episodes)
         return tuple(
-            kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy)
+            kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy, averaged)
             for greedy in played
         )
     kind = "tiles" if tiled else "values"  # (every other observation as float64 values)
-    return (step_function_name("next_step", algorithm.key, kind),)
+    return (step_function_name("next_step", algorithm.key, kind, averaged),)
 
 
 def compile_notice(

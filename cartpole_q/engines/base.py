@@ -24,7 +24,7 @@ from cartpole_q.families import profile_for
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
-from cartpole_q.rl.schedules import SCHEDULE_KINDS, schedule_value
+from cartpole_q.rl.schedules import SAMPLE_AVERAGE, SCHEDULE_KINDS, schedule_value
 from cartpole_q.rl.value_iteration import (
     evaluate_policy,
     on_policy_distribution,
@@ -32,26 +32,48 @@ from cartpole_q.rl.value_iteration import (
 )
 
 
+def pair_name(algorithm_key: str, twin_key: str, tiled: bool, averaged: bool = False) -> str:
+    """An (algorithm, twin) pair as the names of its compiled loops say it.
+
+    >>> pair_name("sarsa", "cartpole_0123", tiled=False, averaged=True)
+    'sarsa__cartpole_0123__averaged'
+    """
+    return (
+        f"{algorithm_key}__{twin_key}"
+        + ("__tiles" if tiled else "")
+        + ("__averaged" if averaged else "")
+    )
+
+
 def kernel_name(
-    algorithm_key: str, twin_key: str, randomized: bool, tiled: bool, greedy: bool
+    algorithm_key: str,
+    twin_key: str,
+    randomized: bool,
+    tiled: bool,
+    greedy: bool,
+    averaged: bool = False,
 ) -> str:
     """One of the numba engine's two training loops of a pair, as numba's cache names it.
+
+    ``averaged``: compiled for ``agent.alpha: sample_average``.
 
     >>> kernel_name("sarsa", "cartpole_0123", randomized=True, tiled=False, greedy=False)
     'train_exploring__sarsa__cartpole_0123__randomized'
     """
-    pair = f"{algorithm_key}__{twin_key}" + ("__tiles" if tiled else "")
+    pair = pair_name(algorithm_key, twin_key, tiled, averaged)
     kind = "greedy" if greedy else "exploring"
     return f"train_{kind}__{pair}" + ("__randomized" if randomized else "")
 
 
-def step_function_name(step: str, algorithm_key: str, kind: str) -> str:
+def step_function_name(step: str, algorithm_key: str, kind: str, averaged: bool = False) -> str:
     """One of the gymnasium engine's compiled step functions, as numba's cache names it.
+
+    ``averaged``: compiled for ``agent.alpha: sample_average``.
 
     >>> step_function_name("next_step", "sarsa_0123", "tiles")
     'next_step__sarsa_0123__tiles'
     """
-    return f"{step}__{algorithm_key}__{kind}"
+    return f"{step}__{algorithm_key}__{kind}" + ("__averaged" if averaged else "")
 
 
 class ScheduleRecord(NamedTuple):
@@ -190,7 +212,9 @@ class Tables(NamedTuple):
     visits: np.ndarray
     """int64: how often training took each (state, action)"""
     memory: tuple[np.ndarray, ...]
-    """the algorithm's own arrays (Double Q-learning's ``B``, traces, buffers, a model)"""
+    """the algorithm's own arrays (Double Q-learning's ``B``, traces, buffers, a model),
+    then, under ``agent.alpha: sample_average``, the table of update counts (float64, ``q``'s
+    shape)"""
 
 
 class EpisodeMetrics(NamedTuple):
@@ -240,6 +264,11 @@ class AgentParams:
     def tiled(self) -> bool:
         """Whether observations are tile-coded (the hooks get ``(weights, features)``)."""
         return self.tilings > 1
+
+    @property
+    def averaged(self) -> bool:
+        """Whether ``agent.alpha`` is ``sample_average`` (the hooks' ``alpha`` is the counts)."""
+        return self.agent.alpha.kind == SAMPLE_AVERAGE
 
     def hook_table(self, q: np.ndarray) -> Any:
         """The table as the hooks take it: ``q``, or on tiles ``(q, features)``.
@@ -549,11 +578,14 @@ class TrainingState:
             policy=named_policy(config, env_info) if algorithm.predicts else None,
         )
         columns = algorithm.table_columns(env_info.n_actions)  # V: one column
+        memory = tuple(algorithm.memory(context))
+        if config.agent.alpha.averages:  # the update counts come last
+            memory += (np.zeros((n_states, columns), dtype=np.float64),)
         return cls(
             tables=Tables(
                 q=np.full((n_states, columns), q_init, dtype=np.float64),
                 visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
-                memory=tuple(algorithm.memory(context)),
+                memory=memory,
             ),
             agent_rng=agent_rng,
             metrics=EpisodeMetrics.empty(config.train.episodes),

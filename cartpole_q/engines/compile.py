@@ -15,7 +15,10 @@ name (with the algorithm's and twin's source digests in it) keeps the variants a
 On tile-coded tables (``tiled=True``) every compilable helper that has a tiles variant
 (:func:`~cartpole_q.rl.tabular.tiles_variant`: ``value``, ``shift``, the trace functions) is
 replaced by it, recursively, so the same hooks run on tiles; a variant that calls its own
-original gets the original (it applies it to the weights).
+original gets the original (it applies it to the weights). Under sample averages
+(``averaged=True``, ``agent.alpha: sample_average``) every helper that has an averaged
+variant (:func:`~cartpole_q.rl.tabular.averaged_variant`: ``update``) is replaced by it the
+same way. Validation never lets the two meet (sample averages are refused on tiles).
 """
 
 from __future__ import annotations
@@ -32,7 +35,7 @@ from cartpole_q.numba_cache import configure as configure_numba_cache
 
 configure_numba_cache()  # before any cache=True function is defined
 
-_COMPILED: dict[tuple[Callable[..., Any], bool], Dispatcher] = {}
+_COMPILED: dict[tuple[Callable[..., Any], bool, bool], Dispatcher] = {}
 
 
 def is_compilable(value: Any) -> bool:
@@ -40,19 +43,20 @@ def is_compilable(value: Any) -> bool:
     return isinstance(value, types.FunctionType) and bool(getattr(value, "__compilable__", False))
 
 
-def jit(function: Callable[..., Any], tiled: bool = False) -> Dispatcher:
+def jit(function: Callable[..., Any], tiled: bool = False, averaged: bool = False) -> Dispatcher:
     """``function`` compiled (inlined where compiled code calls it), its helpers compiled too.
 
-    Compiled once per process (and per ``tiled``: for tile-coded tables, see the module
-    docstring); numba compiles it for each argument types on first use.
+    Compiled once per process (and per ``tiled`` and ``averaged``: for tile-coded tables
+    and for sample averages, see the module docstring); numba compiles it for each argument
+    types on first use.
     """
     if isinstance(function, Dispatcher):
         return function
-    found = _COMPILED.get((function, tiled))
+    found = _COMPILED.get((function, tiled, averaged))
     if found is not None:
         return found
     assert isinstance(function, types.FunctionType), function
-    namespace = _compiled_globals(function, tiled)
+    namespace = _compiled_globals(function, tiled, averaged)
     rebuilt = types.FunctionType(
         function.__code__, namespace, function.__name__, function.__defaults__,
         function.__closure__,
@@ -61,25 +65,31 @@ def jit(function: Callable[..., Any], tiled: bool = False) -> Dispatcher:
     rebuilt.__module__ = function.__module__
     rebuilt.__doc__ = function.__doc__
     dispatcher = njit(nogil=True, inline="always")(rebuilt)
-    _COMPILED[(function, tiled)] = dispatcher
+    _COMPILED[(function, tiled, averaged)] = dispatcher
     return dispatcher
 
 
-def _compiled_globals(function: types.FunctionType, tiled: bool = False) -> dict[str, Any]:
+def _compiled_globals(
+    function: types.FunctionType, tiled: bool = False, averaged: bool = False
+) -> dict[str, Any]:
     """The function's globals, the compilable functions it names replaced by compiled ones.
 
-    With ``tiled``, by their tiles variants where they have one (but a variant's own
-    original stays the original, compiled for plain tables).
+    With ``tiled`` (``averaged``), by their tiles (averaged) variants where they have one
+    (but a variant's own original stays the original, compiled for plain tables).
     """
     namespace = dict(function.__globals__)
     for name in _global_names(function.__code__):
         value = namespace.get(name)
         if isinstance(value, types.FunctionType) and is_compilable(value):
-            variant = getattr(value, "__tiled__", None) if tiled else None
+            variant = None
+            if tiled:
+                variant = getattr(value, "__tiled__", None)
+            elif averaged:
+                variant = getattr(value, "__averaged__", None)
             if variant is function:
-                namespace[name] = jit(value, tiled=False)
+                namespace[name] = jit(value)
             else:
-                namespace[name] = jit(variant or value, tiled)
+                namespace[name] = jit(variant or value, tiled, averaged)
     return namespace
 
 
@@ -99,6 +109,7 @@ def specialise(
     *,
     inline: bool = False,
     tiled: bool = False,
+    averaged: bool = False,
 ) -> Dispatcher:
     """A compiled copy of ``template`` whose placeholder globals are ``bindings``.
 
@@ -112,11 +123,14 @@ def specialise(
         inline: inline the copy where compiled code calls it (then it is not cached by
             itself: its callers' cache entries hold it).
         tiled: compile for tile-coded tables (see the module docstring); ``name`` must say so.
+        averaged: compile for sample averages (see the module docstring); ``name`` must say so.
     """
     assert isinstance(template, types.FunctionType)
-    namespace = _compiled_globals(template, tiled)
-    namespace.update({key: jit(value, tiled) if isinstance(value, types.FunctionType) else value
-                      for key, value in bindings.items()})  # fmt: skip
+    namespace = _compiled_globals(template, tiled, averaged)
+    namespace.update({
+        key: jit(value, tiled, averaged) if isinstance(value, types.FunctionType) else value
+        for key, value in bindings.items()
+    })  # fmt: skip
     function = types.FunctionType(
         template.__code__, namespace, name, template.__defaults__, template.__closure__
     )

@@ -17,7 +17,13 @@ from cartpole_q.config import Config
 from cartpole_q.engines.base import AgentParams, TrainingState, step_function_name
 from cartpole_q.engines.compile import jit, specialise
 from cartpole_q.engines.context import StepContext, step_context
-from cartpole_q.engines.kernel import episode_rates, reaches_threshold, record_episode
+from cartpole_q.engines.kernel import (
+    episode_rates,
+    reaches_threshold,
+    record_episode,
+    scheduled_step_size,
+    update_counts,
+)
 from cartpole_q.engines.play import play_greedy
 from cartpole_q.engines.rows import STATE_RULES
 from cartpole_q.envs.gym import info_value, make_env, set_physics
@@ -34,6 +40,7 @@ ALGORITHM_START: Any = None
 ALGORITHM_STEP: Any = None
 ALGORITHM_END: Any = None
 OBSERVATION_STATE: Any = None
+STEP_SIZE: Any = None
 
 
 def first_step(context: Any, observation: Any, epsilon: float) -> tuple[int, int]:
@@ -52,20 +59,21 @@ def next_step(
     visit(context.visits, context.q, state, action)
     chosen = ALGORITHM_STEP(
         context.q, context.memory, context.params, state, action, reward, row, terminated,
-        truncated, alpha, context.gamma, epsilon, context.rng,
+        truncated, STEP_SIZE(alpha, context.memory), context.gamma, epsilon, context.rng,
     )  # fmt: skip
     return row, chosen
 
 
 def end_episode(context: Any, alpha: float, epsilon: float) -> None:
     """Finish an episode (the algorithm's ``end``)."""
+    step_size = STEP_SIZE(alpha, context.memory)
     ALGORITHM_END(
-        context.q, context.memory, context.params, alpha, context.gamma, epsilon, context.rng
+        context.q, context.memory, context.params, step_size, context.gamma, epsilon, context.rng
     )
 
 
 @functools.cache
-def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
+def step_functions(algorithm: Algorithm, kind: str, averaged: bool = False) -> tuple[Any, Any, Any]:
     """The compiled first step, next step and episode end of one algorithm, for a Python loop.
 
     Args:
@@ -73,6 +81,8 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
         kind: how observations come (``values``: any observation's values as a float64
             array; ``tiles``: a Box observation on tiles; see
             :data:`~cartpole_q.engines.rows.STATE_RULES`).
+        averaged: compiled for ``agent.alpha: sample_average`` (the hooks get the update
+            counts, the context's last memory array, as ``alpha``).
 
     They take the run's step context (see :mod:`~cartpole_q.engines.context`) and call the
     algorithm's hooks as the numba engine's loop does; cached on disk under the algorithm's
@@ -83,12 +93,13 @@ def step_functions(algorithm: Algorithm, kind: str) -> tuple[Any, Any, Any]:
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
         "OBSERVATION_STATE": STATE_RULES[kind],
+        "STEP_SIZE": update_counts if averaged else scheduled_step_size,
     }
     tiled = kind == "tiles"
 
     def compiled(template: Any) -> Any:
-        name = step_function_name(template.__name__, algorithm.key, kind)
-        return specialise(template, name, bindings, tiled=tiled)
+        name = step_function_name(template.__name__, algorithm.key, kind, averaged)
+        return specialise(template, name, bindings, tiled=tiled, averaged=averaged)
 
     return compiled(first_step), compiled(next_step), compiled(end_episode)
 
@@ -124,7 +135,7 @@ class GymnasiumEngine:
             self._env.unwrapped.np_random = generator
             self._first_reset_seed = None
         kind = "tiles" if params.tiled else "values"
-        self._first, self._next, self._end = step_functions(params.algorithm, kind)
+        self._first, self._next, self._end = step_functions(params.algorithm, kind, params.averaged)
         self._has_end = params.algorithm.end is not no_episode_end
         # Every observation but tiles' is copied into this array (float64 values), which the
         # step functions read at once: the same compiled code for every world.

@@ -31,7 +31,14 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.engines.base import AgentRecord, EpisodeMetrics, Grid, Truth, kernel_name
+from cartpole_q.engines.base import (
+    AgentRecord,
+    EpisodeMetrics,
+    Grid,
+    Truth,
+    kernel_name,
+    pair_name,
+)
 from cartpole_q.engines.compile import specialise
 from cartpole_q.engines.rows import ARRAY_STATE_RULES
 from cartpole_q.envs.registry import Twin
@@ -51,6 +58,8 @@ TWIN_RANDOMIZE: Any = None
 TWIN_STATE_DTYPE: Any = None
 TWIN_OBSERVATION_DTYPE: Any = None
 OBSERVATION_STATE: Any = None
+STEP_SIZE: Any = None
+"""bound to :func:`scheduled_step_size`, or :func:`update_counts` under sample averages"""
 EPISODE: Any = None
 GREEDY: bool = False
 """bound to True in the copies of :func:`twin_episode` and :func:`train_episodes` compiled
@@ -65,6 +74,24 @@ def episode_rates(agent: AgentRecord, episode: int) -> tuple[float, float]:
     e, a = agent.epsilon, agent.alpha
     epsilon = schedule_value(e.kind, e.start, e.end, e.rate, episode)
     return epsilon, schedule_value(a.kind, a.start, a.end, a.rate, episode)
+
+
+@compilable
+def scheduled_step_size(alpha: float, memory: Any) -> float:
+    """What the hooks get as ``alpha``: the episode's value of ``agent.alpha``'s schedule."""
+    return alpha
+
+
+@compilable
+def update_counts(alpha: float, memory: Any) -> np.ndarray:
+    """What the hooks get as ``alpha`` under ``agent.alpha: sample_average``: the counts.
+
+    The table of update counts is the last memory array (after the algorithm's own); the
+    hooks' :func:`~cartpole_q.rl.tabular.update` is then compiled as
+    :func:`~cartpole_q.rl.tabular.averaged_update`, which reads and counts it.
+    """
+    counts: np.ndarray = memory[-1]
+    return counts
 
 
 @compilable
@@ -112,6 +139,7 @@ def twin_episode(
     TWIN_RESET(env_state, observation, env_rng, env_params)
     state = OBSERVATION_STATE(q, observation, low, high, bins, starts, -1)
     action = ALGORITHM_START(q, memory, params, state, epsilon, rng)
+    step_size = STEP_SIZE(alpha, memory)
     episode_return, length = 0.0, 0
     while action != ENDED:
         reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, env_params)
@@ -121,10 +149,10 @@ def twin_episode(
         visit(visits, q, state, action)
         action = ALGORITHM_STEP(
             q, memory, params, state, action, reward, next_state, terminated,
-            length >= max_steps, alpha, gamma, epsilon, rng,
+            length >= max_steps, step_size, gamma, epsilon, rng,
         )  # fmt: skip
         state = next_state
-    ALGORITHM_END(q, memory, params, alpha, gamma, epsilon, rng)
+    ALGORITHM_END(q, memory, params, step_size, gamma, epsilon, rng)
     return episode_return, length
 
 
@@ -242,7 +270,11 @@ class TrainingKernel:
 
 
 def training_kernel(
-    algorithm: Algorithm, twin: Twin, randomized: bool = False, tiled: bool = False
+    algorithm: Algorithm,
+    twin: Twin,
+    randomized: bool = False,
+    tiled: bool = False,
+    averaged: bool = False,
 ) -> TrainingKernel:
     """The compiled training loop of one algorithm on one twin.
 
@@ -251,9 +283,11 @@ def training_kernel(
     digests of their sources), so a run compiles (or loads) only the machine code it runs.
     ``randomized`` compiles the draws of ``env.randomize`` in (a run without them does not
     compile them at all); ``tiled`` compiles for tile-coded tables (``q`` is then the pair
-    ``(weights, features)``, see :mod:`cartpole_q.rl.tiles`).
+    ``(weights, features)``, see :mod:`cartpole_q.rl.tiles`); ``averaged`` for
+    ``agent.alpha: sample_average`` (the hooks get the update counts as ``alpha``, and
+    their ``update`` is :func:`~cartpole_q.rl.tabular.averaged_update`).
     """
-    return _training_kernel(algorithm.key, twin.key, randomized, tiled, algorithm, twin)
+    return _training_kernel(algorithm.key, twin.key, randomized, tiled, averaged, algorithm, twin)
 
 
 @functools.cache
@@ -262,14 +296,16 @@ def _training_kernel(
     twin_key: str,
     randomized: bool,
     tiled: bool,
+    averaged: bool,
     algorithm: Algorithm,
     twin: Twin,
 ) -> TrainingKernel:
-    pair = f"{algorithm_key}__{twin_key}" + ("__tiles" if tiled else "")
+    pair = pair_name(algorithm_key, twin_key, tiled, averaged)
     hooks = {
         "ALGORITHM_START": algorithm.start,
         "ALGORITHM_STEP": algorithm.step,
         "ALGORITHM_END": algorithm.end,
+        "STEP_SIZE": update_counts if averaged else scheduled_step_size,
         **twin_bindings(twin, tiled),
     }
     loops: list[Any] = []  # name, loop, name, loop
@@ -281,8 +317,9 @@ def _training_kernel(
             f"{'greedy' if greedy else 'exploring'}_episode__{pair}",
             {**hooks, "GREEDY": greedy},
             tiled=tiled,
+            averaged=averaged,
         )
-        name = kernel_name(algorithm_key, twin_key, randomized, tiled, greedy)
+        name = kernel_name(algorithm_key, twin_key, randomized, tiled, greedy, averaged)
         bindings = {
             "EPISODE": episode,
             "GREEDY": greedy,
@@ -291,7 +328,10 @@ def _training_kernel(
             "TWIN_STATE_DTYPE": twin.state_dtype,
             "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
         }
-        loops += [name, specialise(train_episodes, name, bindings, tiled=tiled)]
+        loops += [
+            name,
+            specialise(train_episodes, name, bindings, tiled=tiled, averaged=averaged),
+        ]
     return TrainingKernel(*loops)
 
 

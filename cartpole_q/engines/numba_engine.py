@@ -50,7 +50,7 @@ class NumbaEngine:
         randomize: Mapping[str, tuple[float, float]] | None = None,
     ) -> None:
         self._kernel = training_kernel(
-            params.algorithm, settings.twin, bool(randomize), params.tiled
+            params.algorithm, settings.twin, bool(randomize), params.tiled, params.averaged
         )
         self._greedy_returns = greedy_kernel(settings.twin, params.tiled)
         limit = settings.max_episode_steps

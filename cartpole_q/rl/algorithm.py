@@ -14,7 +14,9 @@ learned model), and its hooks, plain functions the engines compile with numba:
   nothing).
 
 ``q`` is the learned table as 2-D ``(n_states, n_actions)``; ``memory`` the tuple of arrays
-:attr:`Algorithm.memory` allocated; ``params`` the algorithm's parameters as a tuple of
+:attr:`Algorithm.memory` allocated (under ``agent.alpha: sample_average`` followed by the
+table of update counts, which is also what ``alpha`` then is: see
+:func:`~cartpole_q.rl.tabular.averaged_update`); ``params`` the algorithm's parameters as a tuple of
 floats in :attr:`Algorithm.params` order. The training loop counts ``visits[s, a] += 1``
 before every step, for every algorithm. :attr:`Algorithm.policy` says which table
 ``q_table.npy`` holds (``Q`` itself by default). Checkpoints store ``q`` and every memory
@@ -138,6 +140,13 @@ def param_index(params: Sequence[Param], param: Param) -> int:
     return keys.index(param.key)
 
 
+UNDECLARED_SAMPLE_AVERAGE = (
+    "its module does not declare that its step size reaches nothing but update (an algorithm "
+    'that does says so with Algorithm(..., no_sample_average=""))'
+)
+"""the refusal of ``agent.alpha: sample_average`` for an algorithm that does not declare it"""
+
+
 @dataclass(frozen=True)
 class Algorithm:
     """An algorithm: its name, its config keys, its memory and its compiled hooks."""
@@ -170,6 +179,14 @@ class Algorithm:
     """why it does not run on tile coding (empty: it does). On tiles a hook's state is a
     handle of one episode's observations (:mod:`cartpole_q.rl.tiles`), so memory that keys
     states across episodes (a model, per-state counts) has no meaning there"""
+    no_sample_average: str = UNDECLARED_SAMPLE_AVERAGE
+    """why ``agent.alpha: sample_average`` does not apply to it; empty: it does. Under a
+    sample average the hooks' ``alpha`` is the table of update counts and
+    :func:`~cartpole_q.rl.tabular.update` moves an entry by ``1 / N``, so an algorithm
+    declares ``no_sample_average=""`` when its step size reaches nothing but ``update``; one
+    whose step size reaches anything else (traces, two tables, a batch iterated to
+    convergence) has no entry update to count, and says why. The default refuses it for an
+    algorithm that says neither"""
     epsilon_floor: float = 0.0
     """the smallest positive epsilon it is defined for (0.0: any): off-policy Monte Carlo
     divides by the probability ``epsilon / n`` of an exploratory action, which a smaller

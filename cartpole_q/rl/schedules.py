@@ -5,7 +5,11 @@ For episode ``e`` (0 for the first), each value is computed afresh as a float64 
 
 - ``CONSTANT``: ``start``;
 - ``EXPONENTIAL``: ``max(end, start * rate ** float(e))`` with ``rate`` the decay;
-- ``LOG``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the ``k``.
+- ``LOG``: ``max(end, min(start, 1 - log10((e + 1) / rate)))`` with ``rate`` the ``k``;
+- ``SAMPLE_AVERAGE`` (a step size only, ``agent.alpha: sample_average``): NaN. There is no
+  value per episode: every update of a table entry moves it by ``1 / N``, ``N`` the entry's
+  update count (:func:`~cartpole_q.rl.tabular.averaged_update`), and the episode's record
+  says so with NaN.
 
 Plain Python, compiled by the engines (see :mod:`cartpole_q.rl.tabular`).
 
@@ -23,7 +27,9 @@ from cartpole_q.rl.tabular import compilable
 
 SCHEDULE_KINDS = ("constant", "exponential", "log")
 """schedule ``type`` values, in the order of the codes :func:`schedule_value` takes"""
-CONSTANT, EXPONENTIAL, LOG = range(len(SCHEDULE_KINDS))
+STEP_SIZE_KINDS = (*SCHEDULE_KINDS, "sample_average")
+"""``agent.alpha``'s kinds: a schedule, or the sample average (no value per episode)"""
+CONSTANT, EXPONENTIAL, LOG, SAMPLE_AVERAGE = range(len(STEP_SIZE_KINDS))
 
 
 @compilable
@@ -31,7 +37,7 @@ def schedule_value(kind: int, start: float, end: float, rate: float, episode: in
     """Return a schedule's value at a 0-based episode index.
 
     Args:
-        kind: ``CONSTANT``, ``EXPONENTIAL`` or ``LOG``.
+        kind: ``CONSTANT``, ``EXPONENTIAL``, ``LOG`` or ``SAMPLE_AVERAGE`` (NaN).
         start: the constant, the initial value, or the log schedule's cap.
         end: the floor.
         rate: the per-episode decay factor, or the log schedule's ``k``.
@@ -41,6 +47,8 @@ def schedule_value(kind: int, start: float, end: float, rate: float, episode: in
         return start
     if kind == EXPONENTIAL:
         return float(max(end, start * rate ** float(episode)))
+    if kind == SAMPLE_AVERAGE:
+        return math.nan
     return float(max(end, min(start, 1.0 - math.log10((episode + 1.0) / rate))))
 
 

@@ -64,6 +64,23 @@ def compilable(function: Function) -> Function:
     return function
 
 
+def averaged_variant(original: Callable[..., Any]) -> Callable[[Function], Function]:
+    """Mark the function below as ``original``'s version under sample averages.
+
+    With ``agent.alpha: sample_average`` the engines compile every hook with each
+    compilable helper replaced by its averaged variant where it has one, and pass the
+    table of update counts where a hook's ``alpha`` goes: :func:`update` is the one such
+    helper, so an algorithm whose every step size reaches :func:`update` averages
+    unchanged.
+    """
+
+    def register(function: Function) -> Function:
+        original.__averaged__ = function  # type: ignore[attr-defined]
+        return compilable(function)
+
+    return register
+
+
 def tiles_variant(original: Callable[..., Any]) -> Callable[[Function], Function]:
     """Mark the function below as ``original``'s version for tile-coded tables.
 
@@ -216,6 +233,25 @@ def behaviour_action(q: Table, params: Params, state: int, epsilon: float, rng: 
 def update(q: Table, state: int, action: int, target: float, alpha: float) -> None:
     """``Q(s, a) = Q(s, a) + alpha * (target - Q(s, a))`` (tiles: each tile by a T-th)."""
     shift(q, state, action, alpha * (target - value(q, state, action)))
+
+
+@averaged_variant(update)
+def averaged_update(q: Table, state: int, action: int, target: float, counts: np.ndarray) -> None:
+    """:func:`update` under ``agent.alpha: sample_average``: a step of ``1 / N(s, a)``.
+
+    ``counts`` is the table of update counts (float64, ``q``'s shape), which the engines
+    pass where a hook's ``alpha`` goes: ``N(s, a) = N(s, a) + 1.0``, then ``Q(s, a) =
+    Q(s, a) + (target - Q(s, a)) / N(s, a)``, the division last (Monte Carlo's
+    ``agent.update: sample_average`` exactly). So the entry is the average of every target
+    it was updated toward (``q_init`` weighs nothing).
+
+    >>> q, counts = np.array([[5.0]]), np.zeros((1, 1))
+    >>> averaged_update(q, 0, 0, 1.0, counts); averaged_update(q, 0, 0, 2.0, counts)
+    >>> float(q[0, 0]), float(counts[0, 0])
+    (1.5, 2.0)
+    """
+    counts[state, action] = counts[state, action] + 1.0
+    shift(q, state, action, (target - value(q, state, action)) / counts[state, action])
 
 
 @compilable

@@ -37,6 +37,11 @@ TRACE = Param(
     kind="choice", choices=TRACE_KINDS,
 )  # fmt: skip
 """``agent.trace`` of SARSA(lambda) and Watkins's Q(lambda)"""
+TRACES_NOT_AVERAGED = (
+    "every step moves every traced entry by its share of one error, not one entry toward a "
+    "target, so there is no update of an entry to count"
+)
+"""why the trace methods take no ``agent.alpha: sample_average`` (their ``no_sample_average``)"""
 
 
 @compilable

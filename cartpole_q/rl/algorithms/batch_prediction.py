@@ -129,6 +129,7 @@ MAX_PASSES_AT = param_index(PARAMS, MAX_PASSES)
 
 ALGORITHM = Algorithm(
     name="batch_prediction",
+    no_sample_average="its alpha is the step of an iteration over the whole batch run to convergence, not a weight of one target",
     description="batch updating: TD(0) or constant-alpha MC on all episodes seen, to convergence",
     book="6.3",
     task="prediction",

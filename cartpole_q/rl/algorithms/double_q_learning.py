@@ -120,6 +120,7 @@ def policy(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
 
 ALGORITHM = Algorithm(
     name="double_q_learning",
+    no_sample_average="it learns two tables, each from every other update, and a count per entry would average neither table's own targets",
     description="Double Q-learning: two tables, a coin picks which to update; acts on A + B",
     book="6.7",
     step=step,

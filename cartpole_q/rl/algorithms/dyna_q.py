@@ -68,6 +68,7 @@ PLANNING_STEPS_AT = param_index(PARAMS, PLANNING_STEPS)
 
 ALGORITHM = Algorithm(
     name="dyna_q",
+    no_sample_average="",  # every step size reaches update
     description="Dyna-Q: Q-learning plus planning on a learned model (agent.planning_steps)",
     book="8.2",
     not_on_tiles=MODEL_NOT_ON_TILES,

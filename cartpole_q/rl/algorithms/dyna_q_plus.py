@@ -106,6 +106,7 @@ KAPPA_AT = param_index(PARAMS, KAPPA)
 
 ALGORITHM = Algorithm(
     name="dyna_q_plus",
+    no_sample_average="",  # every step size reaches update
     description="Dyna-Q+: Dyna-Q with a bonus for pairs not tried for long (agent.kappa)",
     book="8.3",
     not_on_tiles=MODEL_NOT_ON_TILES,

@@ -42,6 +42,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
 
 ALGORITHM = Algorithm(
     name="expected_sarsa",
+    no_sample_average="",  # every step size reaches update
     description="Expected SARSA: target r + gamma * the epsilon-greedy expectation of Q(s', .)",
     book="6.6",
     step=step,

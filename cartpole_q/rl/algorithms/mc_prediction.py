@@ -101,6 +101,7 @@ VISIT_AT = param_index(PARAMS, VISIT)
 
 ALGORITHM = Algorithm(
     name="mc_prediction",
+    no_sample_average="",  # every step size reaches update
     description="Monte Carlo prediction: the state values of agent.policy from episodes' returns",
     book="5.1, 6.1",
     task="prediction",

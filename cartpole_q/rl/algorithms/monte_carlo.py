@@ -103,6 +103,7 @@ UPDATE_AT = param_index(PARAMS, UPDATE)
 
 ALGORITHM = Algorithm(
     name="monte_carlo",
+    no_sample_average="",  # every step size reaches update
     description="Monte Carlo control: on-policy, first-visit, epsilon-soft (agent.update)",
     book="5.4",
     not_on_tiles=(

@@ -34,6 +34,7 @@ def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, 
 
 ALGORITHM = Algorithm(
     name="monte_carlo_es",
+    no_sample_average="",  # every step size reaches update
     description="Monte Carlo ES: a uniformly random first action, then epsilon-greedy "
     "(agent.epsilon: 0 for the book's greedy policy); first-visit returns (agent.update)",
     book="5.3",

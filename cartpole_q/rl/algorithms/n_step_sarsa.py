@@ -58,6 +58,7 @@ def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
 
 ALGORITHM = Algorithm(
     name="n_step_sarsa",
+    no_sample_average="",  # every step size reaches update
     description="n-step SARSA: on-policy TD control with n-step returns (agent.n)",
     book="7.2",
     step=step,

@@ -62,6 +62,7 @@ def n_step_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
 
 ALGORITHM = Algorithm(
     name="n_step_td",
+    no_sample_average="",  # every step size reaches update
     description="n-step TD prediction: the state values of agent.policy from n-step returns (agent.n)",
     book="7.1",
     task="prediction",

@@ -93,6 +93,7 @@ def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
 
 ALGORITHM = Algorithm(
     name="n_step_tree_backup",
+    no_sample_average="",  # every step size reaches update
     description="n-step tree backup: off-policy n-step returns without importance sampling (agent.n)",
     book="7.5",
     step=step,

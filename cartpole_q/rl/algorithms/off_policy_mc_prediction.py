@@ -107,6 +107,7 @@ VISIT_AT = param_index(PARAMS, VISIT)
 
 ALGORITHM = Algorithm(
     name="off_policy_mc_prediction",
+    no_sample_average="it averages returns by their importance-sampling weights (agent.sampling) and takes no alpha",
     description="off-policy Monte Carlo prediction: V of agent.policy from a uniform policy's play",
     book="5.5, 5.6",
     task="prediction",

@@ -110,6 +110,7 @@ UPDATE_AT = param_index(PARAMS, UPDATE)
 
 ALGORITHM = Algorithm(
     name="off_policy_monte_carlo",
+    no_sample_average="it averages returns by their importance-sampling weights already (agent.update: sample_average), and alpha is only its constant_alpha's recency",
     description="Off-policy Monte Carlo control: weighted importance sampling, greedy target",
     book="5.7",
     not_on_tiles=(

@@ -79,6 +79,7 @@ LAMBDA_AT = param_index(PARAMS, LAMBDA)
 
 ALGORITHM = Algorithm(
     name="offline_lambda_return",
+    no_sample_average="",  # every step size reaches update
     description="the offline lambda-return algorithm: V toward each step's lambda-return after the episode",
     book="12.1",
     task="prediction",

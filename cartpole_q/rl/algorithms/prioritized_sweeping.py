@@ -145,6 +145,7 @@ THETA_AT = param_index(PARAMS, THETA)
 
 ALGORITHM = Algorithm(
     name="prioritized_sweeping",
+    no_sample_average="",  # every step size reaches update
     description="Prioritized sweeping: planning updates in order of priority (agent.theta)",
     book="8.4",
     not_on_tiles=MODEL_NOT_ON_TILES,

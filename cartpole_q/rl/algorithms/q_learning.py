@@ -42,6 +42,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
 
 ALGORITHM = Algorithm(
     name="q_learning",
+    no_sample_average="",  # every step size reaches update
     description="Q-learning: one-step off-policy TD control, target r + gamma * max_b Q(s', b)",
     book="6.5",
     step=step,

@@ -44,6 +44,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
 
 ALGORITHM = Algorithm(
     name="sarsa",
+    no_sample_average="",  # every step size reaches update
     description="SARSA: one-step on-policy TD control, target r + gamma * Q(s', a')",
     book="6.4",
     step=step,

@@ -35,6 +35,7 @@ from cartpole_q.rl.tabular import (
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
+    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -78,6 +79,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="sarsa_lambda",
+    no_sample_average=TRACES_NOT_AVERAGED,
     description="SARSA(lambda): SARSA with eligibility traces (agent.lambda, agent.trace)",
     book="12.7",
     step=step,

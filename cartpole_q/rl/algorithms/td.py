@@ -53,6 +53,7 @@ def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
 
 ALGORITHM = Algorithm(
     name="td",
+    no_sample_average="",  # every step size reaches update
     description="TD(0) prediction: the state values of agent.policy, learnt one step at a time",
     book="6.1",
     task="prediction",

@@ -35,6 +35,7 @@ from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, value
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
+    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -76,6 +77,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="td_lambda",
+    no_sample_average=TRACES_NOT_AVERAGED,
     description="TD(lambda) prediction: the state values of agent.policy with eligibility traces",
     book="12.2",
     task="prediction",

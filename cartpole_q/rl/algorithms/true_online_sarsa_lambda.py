@@ -35,6 +35,7 @@ from cartpole_q.rl.tabular import (
 )
 from cartpole_q.rl.traces import (
     LAMBDA,
+    TRACES_NOT_AVERAGED,
     apply_traces,
     clear_traces,
     decay_traces,
@@ -86,6 +87,7 @@ LAMBDA_AT = param_index(PARAMS, LAMBDA)
 
 ALGORITHM = Algorithm(
     name="true_online_sarsa_lambda",
+    no_sample_average=TRACES_NOT_AVERAGED,
     description="True online SARSA(lambda): dutch traces with the exact online lambda-return",
     book="12.8",
     step=step,

@@ -31,6 +31,7 @@ from cartpole_q.rl.prediction import (
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, feature_alpha, shift, value
 from cartpole_q.rl.traces import (
     LAMBDA,
+    TRACES_NOT_AVERAGED,
     apply_traces,
     clear_traces,
     decay_traces,
@@ -84,6 +85,7 @@ LAMBDA_AT = param_index(PARAMS, LAMBDA)
 
 ALGORITHM = Algorithm(
     name="true_online_td_lambda",
+    no_sample_average=TRACES_NOT_AVERAGED,
     description="True online TD(lambda): dutch traces with the exact online lambda-return",
     book="12.5",
     task="prediction",

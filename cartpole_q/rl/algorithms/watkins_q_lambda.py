@@ -36,6 +36,7 @@ from cartpole_q.rl.tabular import (
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
+    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -81,6 +82,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="watkins_q_lambda",
+    no_sample_average=TRACES_NOT_AVERAGED,
     description="Watkins's Q(lambda): Q-learning with traces, cut after an exploratory action",
     book="12.10",
     step=step,
