@@ -464,6 +464,7 @@ class DoubleQLearning(Agent):
     def __init__(self, n_states: int, n: int, q_init: float, *args: Any) -> None:
         super().__init__(n_states, n, q_init, *args)
         self.q_b = [[q_init] * n for _ in range(n_states)]
+        self.counts_b: list[list[float]] | None = None
 
     def policy_row(self, x: Any) -> list[float]:
         return [self.value(x, b) + self.value(x, b, self.q_b) for b in range(self.n)]
@@ -475,7 +476,14 @@ class DoubleQLearning(Agent):
         first, second = (self.q, self.q_b) if u < 0.5 else (self.q_b, self.q)
         best = argmax([self.value(s2, b, first) for b in range(self.n)])
         y = r if terminated else r + self.gamma * self.value(s2, best, second)
-        self.add(s, a, self.alpha * (y - self.value(s, a, first)), first)
+        if self.counts is not None:  # "Sample averages": each table by its own counts
+            if self.counts_b is None:
+                self.counts_b = [[0.0] * self.n for _ in self.q]
+            counts = self.counts if u < 0.5 else self.counts_b
+            counts[s][a] = counts[s][a] + 1.0
+            self.add(s, a, (y - self.value(s, a, first)) / counts[s][a], first)
+        else:
+            self.add(s, a, self.alpha * (y - self.value(s, a, first)), first)
         if terminated or truncated:
             return None
         return self.draw(s2)
@@ -588,6 +596,10 @@ class TraceAgent(Agent):
                 flat = row * self.n + a
                 self.traces[flat] = self.traces.get(flat, 0.0) + amount
             return
+        alpha = self.alpha
+        if self.counts is not None:  # "Sample averages": the visit counts, 1 / N for dutch
+            self.counts[s][a] = self.counts[s][a] + 1.0
+            alpha = 1.0 / self.counts[s][a]
         for row in s if isinstance(s, tuple) else (s,):
             flat = row * self.n + a
             if flat not in self.traces:
@@ -598,7 +610,7 @@ class TraceAgent(Agent):
             elif kind == "replacing":
                 z = 1.0
             elif kind == "dutch":
-                z = (1.0 - self.alpha) * z + 1.0
+                z = (1.0 - alpha) * z + 1.0
             else:
                 raise ValueError(f"unknown trace {kind!r}")
             self.traces[flat] = z
@@ -615,8 +627,14 @@ class TraceAgent(Agent):
     def apply(self, delta: float) -> None:
         """``Q[x] = Q[x] + alpha * delta * z`` for every trace, in list order.
 
-        On tiles a traced tile ``w = w + ((alpha * delta) / T) * z``.
+        On tiles a traced tile ``w = w + ((alpha * delta) / T) * z``. Under sample
+        averages each entry ``Q[x] = Q[x] + (delta / N[x]) * z``.
         """
+        if self.counts is not None:
+            for flat, z in self.traces.items():
+                x, b = divmod(flat, self.n)
+                self.q[x][b] = self.q[x][b] + (delta / self.counts[x][b]) * z
+            return
         self.apply_scaled(self.alpha * delta)
 
     def apply_scaled(self, scale: float) -> None:

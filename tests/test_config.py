@@ -132,13 +132,18 @@ def test_alpha_may_be_the_sample_average_and_round_trips(tmp_path: Path, value: 
             r"agent\.alpha.*start",
         ),
         (
-            {"agent.algorithm": "sarsa_lambda"},
-            r"agent\.alpha: sample_average does not apply to agent\.algorithm sarsa_lambda: every "
-            r"step moves every traced entry",
+            {"agent.algorithm": "true_online_sarsa_lambda"},
+            r"agent\.alpha: sample_average does not apply to agent\.algorithm "
+            r"true_online_sarsa_lambda: its dutch traces and its correction are derived for one "
+            r"step size",
         ),
         (
-            {"agent.algorithm": "double_q_learning"},
-            r"agent\.alpha: sample_average does not apply .* two tables",
+            {"agent.algorithm": "batch_prediction"},
+            r"agent\.alpha: sample_average does not apply .* iteration over the whole batch",
+        ),
+        (
+            {"agent.algorithm": "off_policy_monte_carlo"},
+            r"agent\.alpha: sample_average does not apply .* importance-sampling weights already",
         ),
         (
             {"discretization.tilings": 4},

@@ -174,8 +174,15 @@ SAMPLE_AVERAGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         "q_learning": ("q_learning", {}),
         "sarsa": ("sarsa", {}),
         "expected_sarsa": ("expected_sarsa", {}),
+        "double_q_learning": ("double_q_learning", {}),
         "n_step_sarsa": ("n_step_sarsa", {"n": 3}),
         "n_step_tree_backup": ("n_step_tree_backup", {"n": 3}),
+        "sarsa_lambda-replacing": ("sarsa_lambda", {"lambda": 0.8, "trace": "replacing"}),
+        "sarsa_lambda-dutch": ("sarsa_lambda", {"lambda": 0.8, "trace": "dutch"}),
+        "watkins_q_lambda-accumulating": (
+            "watkins_q_lambda",
+            {"lambda": 0.8, "trace": "accumulating"},
+        ),
         "dyna_q": ("dyna_q", {"planning_steps": 5}),
         "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
         "prioritized_sweeping": ("prioritized_sweeping", {"planning_steps": 5, "theta": 0.001}),
@@ -185,6 +192,7 @@ SAMPLE_AVERAGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
         "n_step_td": ("n_step_td", {"n": 3}),
         "mc_prediction": ("mc_prediction", {"update": "constant_alpha"}),
         "offline_lambda_return": ("offline_lambda_return", {"lambda": 0.8}),
+        "td_lambda-dutch": ("td_lambda", {"lambda": 0.6, "trace": "dutch"}),
     }.items()
 }
 ES_VARIANTS = [
@@ -690,7 +698,7 @@ def test_exploring_starts(world: str, variant: str, engine: str) -> None:
 AVERAGED_CONTROL = [
     variant
     for variant, (name, _) in SAMPLE_AVERAGE_VARIANTS.items()
-    if name not in {"td", "n_step_td", "mc_prediction", "offline_lambda_return"}
+    if name not in {"td", "n_step_td", "mc_prediction", "offline_lambda_return", "td_lambda"}
 ]
 
 
@@ -699,8 +707,11 @@ AVERAGED_CONTROL = [
 # compilation per algorithm).
 AVERAGED_GYMNASIUM = {
     f"{name}-averaged"
-    for name in ("q_learning", "n_step_tree_backup", "prioritized_sweeping", "monte_carlo", "td")
-}
+    for name in (
+        "q_learning", "n_step_tree_backup", "sarsa_lambda-dutch", "prioritized_sweeping",
+        "monte_carlo", "td",
+    )
+}  # fmt: skip
 
 
 @pytest.mark.parametrize(
@@ -723,6 +734,27 @@ def test_sample_averages_cover_every_algorithm_that_takes_them() -> None:
     """Every algorithm without a ``no_sample_average`` reason is re-derived with it."""
     takes = {module.ALGORITHM.name for module in PACKAGE if not module.ALGORITHM.no_sample_average}
     assert {name for name, _ in SAMPLE_AVERAGE_VARIANTS.values()} == takes
+
+
+@pytest.mark.parametrize(
+    ("traced", "one_step", "world"),
+    [
+        ({"algorithm": "sarsa_lambda", "trace": "dutch"}, "sarsa", "lake"),
+        ({"algorithm": "watkins_q_lambda", "trace": "accumulating"}, "q_learning", "lake"),
+        ({"algorithm": "td_lambda", "trace": "replacing"}, "td", "walk19"),
+    ],
+)
+def test_a_trace_method_at_lambda_0_averages_as_its_one_step_method(
+    traced: dict[str, str], one_step: str, world: str
+) -> None:
+    """With ``lambda: 0`` and sample averages the trace methods are their one-step methods,
+    byte for byte: a visit's count is then its update's count."""
+    name, trace = traced["algorithm"], traced["trace"]
+    by_traces = _config(CASES[world], name, {"lambda": 0.0, "trace": trace, **AVERAGED}, "numba")
+    one = _config(CASES[world], one_step, AVERAGED, "numba")
+    first, second = train(by_traces, final_eval=False), train(one, final_eval=False)
+    assert first.q_table.tobytes() == second.q_table.tobytes()
+    assert first.returns.tolist() == second.returns.tolist()
 
 
 @pytest.mark.parametrize("algorithm", ["monte_carlo", "mc_prediction"])

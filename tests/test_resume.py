@@ -101,14 +101,19 @@ def test_interrupted_run_is_complete_and_resumes_byte_identically(
     _assert_same_results(run, reference)
 
 
-@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
-def test_a_sample_average_run_resumes_byte_identically(tmp_path: Path, engine: str) -> None:
+@pytest.mark.parametrize(
+    ("engine", "algorithm"),
+    [("numba", "q_learning"), ("gymnasium", "q_learning"), ("numba", "double_q_learning")],
+)
+def test_a_sample_average_run_resumes_byte_identically(
+    tmp_path: Path, engine: str, algorithm: str
+) -> None:
     """``agent.alpha: sample_average``: the update counts are checkpointed with the memory."""
     overrides = {
         "engine": engine, "seed": 3, "env.id": "FrozenLake-v1", "discretization": None,
-        "agent.alpha": "sample_average", "agent.epsilon": 0.2, "agent.q_init": 0.0,
-        "agent.gamma": 0.95, "train.episodes": 300, "train.stop_when_solved": False,
-        "train.checkpoint_every": 25, "train.eval_every": 0,
+        "agent.algorithm": algorithm, "agent.alpha": "sample_average", "agent.epsilon": 0.2,
+        "agent.q_init": 0.0, "agent.gamma": 0.95, "train.episodes": 300,
+        "train.stop_when_solved": False, "train.checkpoint_every": 25, "train.eval_every": 0,
     }  # fmt: skip
     reference = _reference(tmp_path, overrides)
     prepared = prepare(load_config(overrides=overrides), "test")
@@ -117,10 +122,16 @@ def test_a_sample_average_run_resumes_byte_identically(tmp_path: Path, engine: s
     outcome = execute_run(run, prepared, should_stop=lambda: next(polls) >= 2)
     assert outcome.result.interrupted
     checkpoint = np.load(run / rundir.CHECKPOINT_FILE)
-    counts = checkpoint["memory_0"]  # q_learning keeps no memory of its own: the counts
+    visits = checkpoint["visits"].reshape(16, 4).astype(np.float64)
+    # each step updates its pair once: in Q-learning's one table (its counts, the only
+    # memory), in one of Double Q's two (B's counts memory_1, A's the last, memory_2)
+    if algorithm == "q_learning":
+        counts = checkpoint["memory_0"]
+    else:
+        counts = checkpoint["memory_1"] + checkpoint["memory_2"]
+        assert checkpoint["memory_1"].sum() > 0 and checkpoint["memory_2"].sum() > 0
     assert counts.shape == (16, 4) and counts.sum() > 0
-    # Q-learning updates the pair of each step once: its update counts are its visits
-    assert counts.tolist() == checkpoint["visits"].reshape(16, 4).astype(np.float64).tolist()
+    assert counts.tolist() == visits.tolist()
 
     result = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
     assert result.exit_code == 0, result.output

@@ -151,9 +151,9 @@ def _check_sample_average(reader: _Reader, algorithm: str, tilings: int) -> None
         raise reader.error(
             "agent.alpha",
             f"sample_average does not apply to agent.algorithm {algorithm}: {reason}. Give "
-            "alpha a number or a schedule, or use an algorithm whose updates move one entry "
-            "toward a target (q_learning, sarsa, expected_sarsa, td, the n-step methods, Dyna, "
-            "Monte Carlo).",
+            "alpha a number or a schedule, or use an algorithm that averages (docs/algorithms.md, "
+            '"Sample averages": one-step and n-step TD, Dyna, on-policy Monte Carlo, '
+            "SARSA(lambda), Watkins's Q(lambda), TD(lambda)).",
         )
     if tilings > 1:
         raise reader.error(

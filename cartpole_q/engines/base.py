@@ -576,6 +576,7 @@ class TrainingState:
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
             episodes=config.train.episodes,
             policy=named_policy(config, env_info) if algorithm.predicts else None,
+            averaged=config.agent.alpha.averages,
         )
         columns = algorithm.table_columns(env_info.n_actions)  # V: one column
         memory = tuple(algorithm.memory(context))

@@ -111,6 +111,9 @@ class MemoryContext:
     policy: Sequence[int] | None = None
     """a prediction run's named policy (``agent.policy`` other than ``random``): the action
     of each state, from the world's profile"""
+    averaged: bool = False
+    """``agent.alpha: sample_average``: the engine keeps the update counts of ``q`` (its last
+    memory array); an algorithm with a second table keeps that table's counts itself"""
 
 
 def no_memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
@@ -141,8 +144,8 @@ def param_index(params: Sequence[Param], param: Param) -> int:
 
 
 UNDECLARED_SAMPLE_AVERAGE = (
-    "its module does not declare that its step size reaches nothing but update (an algorithm "
-    'that does says so with Algorithm(..., no_sample_average=""))'
+    "its module does not declare that its step size reaches nothing but update and the trace "
+    'functions (an algorithm that does says so with Algorithm(..., no_sample_average=""))'
 )
 """the refusal of ``agent.alpha: sample_average`` for an algorithm that does not declare it"""
 
@@ -182,11 +185,11 @@ class Algorithm:
     no_sample_average: str = UNDECLARED_SAMPLE_AVERAGE
     """why ``agent.alpha: sample_average`` does not apply to it; empty: it does. Under a
     sample average the hooks' ``alpha`` is the table of update counts and
-    :func:`~cartpole_q.rl.tabular.update` moves an entry by ``1 / N``, so an algorithm
-    declares ``no_sample_average=""`` when its step size reaches nothing but ``update``; one
-    whose step size reaches anything else (traces, two tables, a batch iterated to
-    convergence) has no entry update to count, and says why. The default refuses it for an
-    algorithm that says neither"""
+    :func:`~cartpole_q.rl.tabular.update` (and the trace functions) move an entry by its own
+    ``1 / N``, so an algorithm declares ``no_sample_average=""`` when its step size reaches
+    nothing but those; one whose step size reaches anything else (true online traces, a
+    batch iterated to convergence) says why not. The default refuses it for an algorithm
+    that says neither"""
     epsilon_floor: float = 0.0
     """the smallest positive epsilon it is defined for (0.0: any): off-policy Monte Carlo
     divides by the probability ``epsilon / n`` of an exploratory action, which a smaller

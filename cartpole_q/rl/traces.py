@@ -14,9 +14,18 @@ times what a traced pair moves by. The contract: docs/algorithms.md, "Eligibilit
 >>> values, states, actions, slots, count = trace_memory(2, 2)
 >>> give_trace(q, values, states, actions, slots, count, 1, 0, 0, 0.5, 2)
 >>> give_trace(q, values, states, actions, slots, count, 1, 0, 0, 0.5, 2)  # accumulating
->>> apply_and_decay(q, values, states, actions, slots, count, 0.5, 0.25)
+>>> apply_and_decay(q, values, states, actions, slots, count, 0.5, 1.0, 0.25)  # alpha, delta
 >>> float(q[1, 0]), float(values[0])
 (1.0, 0.5)
+
+Under ``agent.alpha: sample_average`` the engines pass the counts where ``alpha`` goes, and
+compile the averaged variants: a visit counts, a traced entry moves by ``delta / N``.
+
+>>> counts = np.zeros((2, 2))
+>>> counted_visit_step(counts, 1, 0), counted_visit_step(counts, 1, 0)
+(1.0, 0.5)
+>>> averaged_trace_step(counts, 3.0, 1, 0)
+1.5
 """
 
 from __future__ import annotations
@@ -24,7 +33,13 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.tabular import Table, compilable, feature_alpha, tiles_variant
+from cartpole_q.rl.tabular import (
+    Table,
+    averaged_variant,
+    compilable,
+    feature_alpha,
+    tiles_variant,
+)
 
 TRACE_KINDS = ("accumulating", "replacing", "dutch")
 """``agent.trace`` values, in the order of their codes"""
@@ -37,11 +52,36 @@ TRACE = Param(
     kind="choice", choices=TRACE_KINDS,
 )  # fmt: skip
 """``agent.trace`` of SARSA(lambda) and Watkins's Q(lambda)"""
-TRACES_NOT_AVERAGED = (
-    "every step moves every traced entry by its share of one error, not one entry toward a "
-    "target, so there is no update of an entry to count"
+TRUE_ONLINE_NOT_AVERAGED = (
+    "its dutch traces and its correction are derived for one step size shared by every "
+    "entry (alpha enters the traces themselves), which a count per entry is not"
 )
-"""why the trace methods take no ``agent.alpha: sample_average`` (their ``no_sample_average``)"""
+"""why the true online methods take no ``agent.alpha: sample_average``"""
+
+
+@compilable
+def trace_step(alpha: float, delta: float, state: int, action: int) -> float:
+    """How far a traced entry moves per unit of its trace: ``alpha * delta``."""
+    return alpha * delta
+
+
+@averaged_variant(trace_step)
+def averaged_trace_step(counts: np.ndarray, delta: float, state: int, action: int) -> float:
+    """Under ``agent.alpha: sample_average``: ``delta / N(state, action)``, ``N`` its visits."""
+    return float(delta / counts[state, action])
+
+
+@compilable
+def visit_step(alpha: float, state: int, action: int) -> float:
+    """The step size a visit's dutch trace uses, ``(1 - alpha) z + 1``: ``alpha``."""
+    return alpha
+
+
+@averaged_variant(visit_step)
+def counted_visit_step(counts: np.ndarray, state: int, action: int) -> float:
+    """Under sample averages: count the visit, ``N(s, a) = N(s, a) + 1.0``; ``1.0 / N(s, a)``."""
+    counts[state, action] = counts[state, action] + 1.0
+    return float(1.0 / counts[state, action])
 
 
 @compilable
@@ -78,9 +118,13 @@ def give_trace(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
     count: np.ndarray, state: int, action: int, kind: int, alpha: float, n_actions: int,
 ) -> None:  # fmt: skip
-    """Give ``(state, action)`` its trace: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
+    """Give ``(state, action)`` its trace: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``.
+
+    Under sample averages ``alpha`` is the table of counts: the visit is counted, and
+    dutch's ``alpha`` is ``1 / N(state, action)`` (:func:`counted_visit_step`).
+    """
     where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
-    set_trace(values, where, kind, alpha)
+    set_trace(values, where, kind, visit_step(alpha, state, action))
 
 
 @tiles_variant(give_trace)
@@ -160,17 +204,18 @@ def trace_value(slots: np.ndarray, values: np.ndarray, flat: int) -> float:
 @compilable
 def apply_and_decay(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
-    count: np.ndarray, scale: float, decay: float,
+    count: np.ndarray, alpha: float, delta: float, decay: float,
 ) -> None:  # fmt: skip
-    """``Q[x] = Q[x] + scale * z``, then ``z = decay * z``, for every trace, in one pass.
+    """``Q[x] = Q[x] + (alpha * delta) * z``, then ``z = decay * z``, for every trace, in one pass.
 
-    ``scale`` is ``alpha * delta``; a trace that decays to exactly 0.0 is dropped.
+    A trace that decays to exactly 0.0 is dropped. Under sample averages each entry moves by
+    ``(delta / N[x]) * z`` (:func:`trace_step`).
     """
     n_actions = q.shape[1]
     kept = 0
     for read in range(count[0]):
         state, action, z = states[read], actions[read], values[read]
-        q[state, action] = q[state, action] + scale * z
+        q[state, action] = q[state, action] + trace_step(alpha, delta, state, action) * z
         z = decay * z
         if z == 0.0:
             slots[state * n_actions + action] = -1
@@ -186,10 +231,14 @@ def apply_and_decay(
 @tiles_variant(apply_and_decay)
 def apply_tile_traces_and_decay(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, slots: np.ndarray,
-    count: np.ndarray, scale: float, decay: float,
+    count: np.ndarray, alpha: float, delta: float, decay: float,
 ) -> None:  # fmt: skip
-    """:func:`apply_and_decay` on the weights, each traced tile by ``(scale / T) * z``."""
-    apply_and_decay(q[0], values, states, actions, slots, count, scale / q[1].shape[1], decay)
+    """:func:`apply_and_decay` on the weights, each traced tile by ``((alpha * delta) / T) * z``.
+
+    (The tile's step goes in as ``alpha`` with a ``delta`` of 1.0: ``x * 1.0`` is ``x``.)
+    """
+    tile_step = (alpha * delta) / q[1].shape[1]
+    apply_and_decay(q[0], values, states, actions, slots, count, tile_step, 1.0, decay)
 
 
 @compilable
@@ -216,12 +265,15 @@ def decay_traces(
 @compilable
 def apply_traces(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, count: np.ndarray,
-    scale: float,
+    alpha: float, delta: float,
 ) -> None:  # fmt: skip
-    """``Q[x] = Q[x] + scale * z`` for every trace, in list order."""
+    """``Q[x] = Q[x] + (alpha * delta) * z`` for every trace, in list order.
+
+    Under sample averages each entry moves by ``(delta / N[x]) * z`` (:func:`trace_step`).
+    """
     for read in range(count[0]):
         state, action = states[read], actions[read]
-        q[state, action] = q[state, action] + scale * values[read]
+        q[state, action] = q[state, action] + trace_step(alpha, delta, state, action) * values[read]
 
 
 @compilable
@@ -238,10 +290,10 @@ def clear_traces(
 @tiles_variant(apply_traces)
 def apply_tile_traces(
     q: Table, values: np.ndarray, states: np.ndarray, actions: np.ndarray, count: np.ndarray,
-    scale: float,
+    alpha: float, delta: float,
 ) -> None:  # fmt: skip
-    """:func:`apply_traces` on the weights, each traced tile by ``(scale / T) * z``."""
-    apply_traces(q[0], values, states, actions, count, scale / q[1].shape[1])
+    """:func:`apply_traces` on the weights, each traced tile by ``((alpha * delta) / T) * z``."""
+    apply_traces(q[0], values, states, actions, count, (alpha * delta) / q[1].shape[1], 1.0)
 
 
 def trace_memory(n_states: int, n_actions: int) -> tuple[np.ndarray, ...]:

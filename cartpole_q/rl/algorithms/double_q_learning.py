@@ -1,6 +1,7 @@
 """Double Q-learning (van Hasselt 2010; Sutton & Barto 6.7): two tables, no maximisation bias.
 
-Memory: the second table ``B`` (``Q`` is ``A``), both starting at ``q_init``. Per step a coin
+Memory: the second table ``B`` (``Q`` is ``A``), both starting at ``q_init``, and under
+``agent.alpha: sample_average`` ``B``'s update counts (``A``'s are the run's). Per step a coin
 ``u = rng.random()`` is drawn first; if ``u < 0.5`` table ``A`` is updated with
 ``g = argmax_b A(s', b)``, ``y = r + gamma * B(s', g)``; else ``B`` with
 ``g = argmax_b B(s', b)``, ``y = r + gamma * A(s', g)`` (``y = r`` when terminated). Every
@@ -27,6 +28,7 @@ from cartpole_q.rl.tabular import (
     Rng,
     Table,
     action_count,
+    averaged_variant,
     best_action,
     compilable,
     random_ties,
@@ -80,6 +82,19 @@ def epsilon_greedy_on_sum(
     return best_action_of_sum(q_a, q_b, state)
 
 
+@compilable
+def step_size_of_b(alpha: float, memory: Memory) -> float:
+    """The step size of an update of ``B``: the episode's ``alpha``, as ``A``'s."""
+    return alpha
+
+
+@averaged_variant(step_size_of_b)
+def update_counts_of_b(counts_of_a: np.ndarray, memory: Memory) -> np.ndarray:
+    """Under sample averages, ``B``'s own update counts (``memory_1``; ``A``'s are the run's)."""
+    counts: np.ndarray = memory[1]
+    return counts
+
+
 def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, rng: Rng) -> int:
     """The first action: epsilon-greedy on ``A + B``."""
     return epsilon_greedy_on_sum(q, with_weights(q, memory[0]), params, state, epsilon, rng)
@@ -101,15 +116,19 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         target = reward
         if not terminated:
             target = reward + gamma * value(q, next_state, best_action(q_b, next_state))
-        update(q_b, state, action, target, alpha)
+        update(q_b, state, action, target, step_size_of_b(alpha, memory))
     if terminated or truncated:
         return ENDED
     return epsilon_greedy_on_sum(q, q_b, params, next_state, epsilon, rng)
 
 
 def memory(context: MemoryContext) -> tuple[np.ndarray, ...]:
-    """Table ``B``, at ``q_init`` like ``A``."""
-    return (np.full((context.n_states, context.n_actions), context.q_init, dtype=np.float64),)
+    """Table ``B``, at ``q_init`` like ``A`` (and under sample averages its counts, zeros)."""
+    shape = (context.n_states, context.n_actions)
+    b = np.full(shape, context.q_init, dtype=np.float64)
+    if context.averaged:
+        return (b, np.zeros(shape, dtype=np.float64))
+    return (b,)
 
 
 def policy(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
@@ -120,12 +139,12 @@ def policy(q: np.ndarray, memory: tuple[np.ndarray, ...]) -> np.ndarray:
 
 ALGORITHM = Algorithm(
     name="double_q_learning",
-    no_sample_average="it learns two tables, each from every other update, and a count per entry would average neither table's own targets",
+    no_sample_average="",  # every step size reaches update (B's through step_size_of_b)
     description="Double Q-learning: two tables, a coin picks which to update; acts on A + B",
     book="6.7",
     step=step,
     start=start,
     memory=memory,
-    memory_names=("q_b",),
+    memory_names=("q_b", "q_b_update_counts"),
     policy=policy,
 )

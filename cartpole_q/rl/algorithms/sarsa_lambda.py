@@ -35,7 +35,6 @@ from cartpole_q.rl.tabular import (
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
-    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -59,10 +58,10 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     delta = target - value(q, state, action)
     give_trace(q, values, states, actions, slots, count, state, action, kind, alpha, n_actions)
     if terminated or truncated:
-        apply_traces(q, values, states, actions, count, alpha * delta)
+        apply_traces(q, values, states, actions, count, alpha, delta)
         clear_traces(states, actions, slots, count, n_actions)
         return ENDED
-    apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
+    apply_and_decay(q, values, states, actions, slots, count, alpha, delta, decay)
     return next_action
 
 
@@ -79,7 +78,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="sarsa_lambda",
-    no_sample_average=TRACES_NOT_AVERAGED,
+    no_sample_average="",  # every step size reaches update and the trace functions
     description="SARSA(lambda): SARSA with eligibility traces (agent.lambda, agent.trace)",
     book="12.7",
     step=step,

@@ -35,7 +35,6 @@ from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, value
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
-    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -57,10 +56,10 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     delta = target - value(q, state, 0)
     give_trace(q, values, states, actions, slots, count, state, 0, kind, alpha, 1)
     if terminated or truncated:
-        apply_traces(q, values, states, actions, count, alpha * delta)
+        apply_traces(q, values, states, actions, count, alpha, delta)
         clear_traces(states, actions, slots, count, 1)
         return ENDED
-    apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
+    apply_and_decay(q, values, states, actions, slots, count, alpha, delta, decay)
     return policy_action(policy, next_state, params, rng)
 
 
@@ -77,7 +76,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="td_lambda",
-    no_sample_average=TRACES_NOT_AVERAGED,
+    no_sample_average="",  # every step size reaches update and the trace functions
     description="TD(lambda) prediction: the state values of agent.policy with eligibility traces",
     book="12.2",
     task="prediction",

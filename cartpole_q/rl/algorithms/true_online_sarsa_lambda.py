@@ -35,7 +35,7 @@ from cartpole_q.rl.tabular import (
 )
 from cartpole_q.rl.traces import (
     LAMBDA,
-    TRACES_NOT_AVERAGED,
+    TRUE_ONLINE_NOT_AVERAGED,
     apply_traces,
     clear_traces,
     decay_traces,
@@ -65,7 +65,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     decay_traces(values, states, actions, slots, count, gamma * lam, n_actions)
     grow = 1.0 - feature_alpha(q, alpha) * gamma * lam * z_sa
     grow_trace(q, values, states, actions, slots, count, state, action, grow, n_actions)
-    apply_traces(q, values, states, actions, count, alpha * (delta + q_sa - q_old))
+    apply_traces(q, values, states, actions, count, alpha, delta + q_sa - q_old)
     shift(q, state, action, -(alpha * (q_sa - q_old)))
     q_old_cell[0] = q_next
     if terminated or truncated:
@@ -87,7 +87,7 @@ LAMBDA_AT = param_index(PARAMS, LAMBDA)
 
 ALGORITHM = Algorithm(
     name="true_online_sarsa_lambda",
-    no_sample_average=TRACES_NOT_AVERAGED,
+    no_sample_average=TRUE_ONLINE_NOT_AVERAGED,
     description="True online SARSA(lambda): dutch traces with the exact online lambda-return",
     book="12.8",
     step=step,

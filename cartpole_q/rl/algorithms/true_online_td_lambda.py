@@ -31,7 +31,7 @@ from cartpole_q.rl.prediction import (
 from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, feature_alpha, shift, value
 from cartpole_q.rl.traces import (
     LAMBDA,
-    TRACES_NOT_AVERAGED,
+    TRUE_ONLINE_NOT_AVERAGED,
     apply_traces,
     clear_traces,
     decay_traces,
@@ -59,7 +59,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     decay_traces(values, states, actions, slots, count, gamma * lam, 1)
     grow = 1.0 - feature_alpha(q, alpha) * gamma * lam * z_s
     grow_trace(q, values, states, actions, slots, count, state, 0, grow, 1)
-    apply_traces(q, values, states, actions, count, alpha * (delta + v_s - v_old))
+    apply_traces(q, values, states, actions, count, alpha, delta + v_s - v_old)
     shift(q, state, 0, -(alpha * (v_s - v_old)))
     v_old_cell[0] = v_next
     if terminated or truncated:
@@ -85,7 +85,7 @@ LAMBDA_AT = param_index(PARAMS, LAMBDA)
 
 ALGORITHM = Algorithm(
     name="true_online_td_lambda",
-    no_sample_average=TRACES_NOT_AVERAGED,
+    no_sample_average=TRUE_ONLINE_NOT_AVERAGED,
     description="True online TD(lambda): dutch traces with the exact online lambda-return",
     book="12.5",
     task="prediction",

@@ -36,7 +36,6 @@ from cartpole_q.rl.tabular import (
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
-    TRACES_NOT_AVERAGED,
     apply_and_decay,
     apply_traces,
     clear_traces,
@@ -58,11 +57,11 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     delta = target - value(q, state, action)
     give_trace(q, values, states, actions, slots, count, state, action, kind, alpha, n_actions)
     if terminated or truncated:
-        apply_traces(q, values, states, actions, count, alpha * delta)
+        apply_traces(q, values, states, actions, count, alpha, delta)
         clear_traces(states, actions, slots, count, n_actions)
         return ENDED
     # Decayed in the same pass; cleared below instead when the next action explores.
-    apply_and_decay(q, values, states, actions, slots, count, alpha * delta, decay)
+    apply_and_decay(q, values, states, actions, slots, count, alpha, delta, decay)
     next_action = behaviour_action(q, params, next_state, epsilon, rng)
     if value(q, next_state, next_action) != best_value(q, next_state):
         clear_traces(states, actions, slots, count, n_actions)
@@ -82,7 +81,7 @@ TRACE_AT = param_index(PARAMS, TRACE)
 
 ALGORITHM = Algorithm(
     name="watkins_q_lambda",
-    no_sample_average=TRACES_NOT_AVERAGED,
+    no_sample_average="",  # every step size reaches update and the trace functions
     description="Watkins's Q(lambda): Q-learning with traces, cut after an exploratory action",
     book="12.10",
     step=step,
