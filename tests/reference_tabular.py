@@ -250,8 +250,8 @@ class Agent:
         rng: The agent's generator (every draw of every algorithm).
         epsilon: The current episode's epsilon.
         alpha: The current episode's alpha.
-        counts: ``agent.alpha: sample_average``'s update counts, ``counts[x][b]`` (None
-            under a schedule).
+        step_counts: ``agent.alpha: sample_average``'s update counts, ``step_counts[x][b]``
+            (None under a schedule).
         params: The algorithm's extra keys (``n``, ``lambda``, ``trace``, ...).
     """
 
@@ -270,7 +270,7 @@ class Agent:
         self.rng = rng
         self.epsilon = 0.0
         self.alpha = 0.0
-        self.counts: list[list[float]] | None = None
+        self.step_counts: list[list[float]] | None = None
         self.params = params
 
     # -- reading the table
@@ -375,9 +375,9 @@ class Agent:
         docs/algorithms.md, "Sample averages": under ``agent.alpha: sample_average``,
         ``N(x, b) = N(x, b) + 1.0`` then ``Q(x, b) = Q(x, b) + (y - Q(x, b)) / N(x, b)``.
         """
-        if self.counts is not None:
-            self.counts[x][b] = self.counts[x][b] + 1.0
-            self.add(x, b, (y - self.value(x, b)) / self.counts[x][b])
+        if self.step_counts is not None:
+            self.step_counts[x][b] = self.step_counts[x][b] + 1.0
+            self.add(x, b, (y - self.value(x, b)) / self.step_counts[x][b])
             return
         self.add(x, b, self.alpha * (y - self.value(x, b)))
 
@@ -476,10 +476,10 @@ class DoubleQLearning(Agent):
         first, second = (self.q, self.q_b) if u < 0.5 else (self.q_b, self.q)
         best = argmax([self.value(s2, b, first) for b in range(self.n)])
         y = r if terminated else r + self.gamma * self.value(s2, best, second)
-        if self.counts is not None:  # "Sample averages": each table by its own counts
+        if self.step_counts is not None:  # "Sample averages": each table by its own counts
             if self.counts_b is None:
                 self.counts_b = [[0.0] * self.n for _ in self.q]
-            counts = self.counts if u < 0.5 else self.counts_b
+            counts = self.step_counts if u < 0.5 else self.counts_b
             counts[s][a] = counts[s][a] + 1.0
             self.add(s, a, (y - self.value(s, a, first)) / counts[s][a], first)
         else:
@@ -597,9 +597,9 @@ class TraceAgent(Agent):
                 self.traces[flat] = self.traces.get(flat, 0.0) + amount
             return
         alpha = self.alpha
-        if self.counts is not None:  # "Sample averages": the visit counts, 1 / N for dutch
-            self.counts[s][a] = self.counts[s][a] + 1.0
-            alpha = 1.0 / self.counts[s][a]
+        if self.step_counts is not None:  # "Sample averages": the visit counts, 1 / N for dutch
+            self.step_counts[s][a] = self.step_counts[s][a] + 1.0
+            alpha = 1.0 / self.step_counts[s][a]
         for row in s if isinstance(s, tuple) else (s,):
             flat = row * self.n + a
             if flat not in self.traces:
@@ -630,10 +630,10 @@ class TraceAgent(Agent):
         On tiles a traced tile ``w = w + ((alpha * delta) / T) * z``. Under sample
         averages each entry ``Q[x] = Q[x] + (delta / N[x]) * z``.
         """
-        if self.counts is not None:
+        if self.step_counts is not None:
             for flat, z in self.traces.items():
                 x, b = divmod(flat, self.n)
-                self.q[x][b] = self.q[x][b] + (delta / self.counts[x][b]) * z
+                self.q[x][b] = self.q[x][b] + (delta / self.step_counts[x][b]) * z
             return
         self.apply_scaled(self.alpha * delta)
 
@@ -1445,7 +1445,7 @@ def reference_train(
         {**defaults, **(params or {}), "tilings": tilings},
     )  # fmt: skip
     if averaged:  # docs/algorithms.md, "Sample averages": one count per table entry
-        agent.counts = [[0.0] * len(row) for row in agent.q]
+        agent.step_counts = [[0.0] * len(row) for row in agent.q]
     measured: list[Any] = []
     truth: list[float] = []
     errors: list[float] | None = None

@@ -152,8 +152,9 @@ def _check_sample_average(reader: _Reader, algorithm: str, tilings: int) -> None
             "agent.alpha",
             f"sample_average does not apply to agent.algorithm {algorithm}: {reason}. Give "
             "alpha a number or a schedule, or use an algorithm that averages (docs/algorithms.md, "
-            '"Sample averages": one-step and n-step TD, Dyna, on-policy Monte Carlo, '
-            "SARSA(lambda), Watkins's Q(lambda), TD(lambda)).",
+            '"Sample averages": one-step and n-step TD, Dyna, prioritized sweeping, on-policy '
+            "Monte Carlo, the offline lambda-return, SARSA(lambda), Watkins's Q(lambda), "
+            "TD(lambda)).",
         )
     if tilings > 1:
         raise reader.error(
@@ -530,17 +531,17 @@ class _Reader:
             constant = self.number(field, value, bounds)
             return Schedule("constant", constant, constant)
         kind = value.get("type")
+        kinds = ", ".join(SCHEDULE_KINDS)
+        if isinstance(bounds, Key) and bounds.sample_average:
+            kinds += f" (or {SAMPLE_AVERAGE_KIND})"
         if kind is None:
             raise self.error(
                 field,
-                f"a schedule mapping needs 'type' ({', '.join(SCHEDULE_KINDS)}), got "
-                f"{shown(value)}; a number is a constant.",
+                f"a schedule mapping needs 'type' ({kinds}), got {shown(value)}; a number is a "
+                "constant.",
             )
         if kind not in SCHEDULE_KINDS:
-            raise self.error(
-                f"{field}.type",
-                f"must be one of {', '.join(SCHEDULE_KINDS)}; got {shown(kind)}.",
-            )
+            raise self.error(f"{field}.type", f"must be one of {kinds}; got {shown(kind)}.")
         form = SCHEDULE_FORMS[kind]
         names = ["type", *(schedule_key.name for schedule_key in form)]
         for key in value:

@@ -187,6 +187,7 @@ def _loop_signature(config: Config) -> tuple[Any, ...]:
         config.train.info_metric,
         repr(config.agent.epsilon),  # which of the numba engine's two loops it plays
         config.train.episodes,
+        config.agent.alpha.averages,  # sample averages compile their own loops
     )
 
 

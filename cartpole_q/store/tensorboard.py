@@ -13,7 +13,7 @@ them. The writer is the optional ``tensorboardX`` package
 | ``charts/episodic_return`` | the episode's return (``metrics.csv``'s ``return``) | every episode |
 | ``charts/episodic_length`` | its length in env steps (``length``) | every episode |
 | ``charts/epsilon`` | its exploration rate (``epsilon``) | every episode |
-| ``charts/learning_rate`` | its step size (``alpha``) | every episode |
+| ``charts/learning_rate`` | its step size (``alpha``; none under ``sample_average``) | every episode |
 | ``rollout/ep_rew_mean`` | mean return of the last (up to) 100 episodes | every episode |
 | ``rollout/ep_len_mean`` | mean length of the last (up to) 100 episodes | every episode |
 | ``eval/mean_reward`` | a periodic greedy evaluation's mean (``evaluations.csv``) | every ``train.eval_every`` episodes |
@@ -230,7 +230,13 @@ def _write_events(scratch: Path, session: Session) -> None:
         ("rollout/ep_rew_mean", moving_means(session.returns)),
         ("rollout/ep_len_mean", moving_means(session.lengths)),
     ]
-    columns = [(tag, values) for tag, values in per_episode if values is not None]
+    # Under agent.alpha: sample_average every episode's alpha is NaN: no chart rather than one of
+    # nothing.
+    columns = [
+        (tag, values)
+        for tag, values in per_episode
+        if values is not None and not (len(values) and np.isnan(values).all())
+    ]
     # max_queue: everything is written at once; one flush at close is enough.
     with SummaryWriter(str(scratch), max_queue=1000, flush_secs=3600) as writer:
         _, session_start, session_end = hparams(hparams_of(session.config), {})
