@@ -702,14 +702,15 @@ AVERAGED_CONTROL = [
 ]
 
 
-# The numba engine runs every variant; the gymnasium engine, which compiles the same hooks
-# with the same averaged update around gymnasium.make, one per family (each is one more
-# compilation per algorithm).
-AVERAGED_GYMNASIUM = {
+# The gymnasium engine runs every variant (its step functions compile once per algorithm,
+# for every world); the numba engine, which compiles the same hooks with the same averaged
+# helpers into each (algorithm, twin) loop, one of each kind of update: one-step, two
+# tables, an n-step flush, traces, planning, an episode's returns, prediction.
+AVERAGED_NUMBA = {
     f"{name}-averaged"
     for name in (
-        "q_learning", "n_step_tree_backup", "sarsa_lambda-dutch", "prioritized_sweeping",
-        "monte_carlo", "td",
+        "q_learning", "double_q_learning", "n_step_tree_backup", "sarsa_lambda-dutch",
+        "prioritized_sweeping", "monte_carlo", "td",
     )
 }  # fmt: skip
 
@@ -722,7 +723,7 @@ AVERAGED_GYMNASIUM = {
             *_params(["lake"], AVERAGED_CONTROL),
             *_params(["walk19"], [v for v in SAMPLE_AVERAGE_VARIANTS if v not in AVERAGED_CONTROL]),
         )
-        if param.values[2] == "numba" or param.values[1] in AVERAGED_GYMNASIUM
+        if param.values[2] == "gymnasium" or param.values[1] in AVERAGED_NUMBA
     ],
 )
 def test_sample_averages(world: str, variant: str, engine: str) -> None:
@@ -750,23 +751,27 @@ def test_a_trace_method_at_lambda_0_averages_as_its_one_step_method(
     """With ``lambda: 0`` and sample averages the trace methods are their one-step methods,
     byte for byte: a visit's count is then its update's count."""
     name, trace = traced["algorithm"], traced["trace"]
-    by_traces = _config(CASES[world], name, {"lambda": 0.0, "trace": trace, **AVERAGED}, "numba")
-    one = _config(CASES[world], one_step, AVERAGED, "numba")
+    # (on the gymnasium engine, whose step functions of these the tests above compile)
+    params = {"lambda": 0.0, "trace": trace, **AVERAGED}
+    by_traces = _config(CASES[world], name, params, "gymnasium")
+    one = _config(CASES[world], one_step, AVERAGED, "gymnasium")
     first, second = train(by_traces, final_eval=False), train(one, final_eval=False)
     assert first.q_table.tobytes() == second.q_table.tobytes()
     assert first.returns.tolist() == second.returns.tolist()
 
 
-@pytest.mark.parametrize("algorithm", ["monte_carlo", "mc_prediction"])
+@pytest.mark.parametrize(
+    ("algorithm", "world", "engine"),
+    [("monte_carlo", "lake", "numba"), ("mc_prediction", "walk19", "gymnasium")],
+)
 def test_monte_carlos_constant_alpha_at_sample_averages_is_its_sample_average(
-    algorithm: str,
+    algorithm: str, world: str, engine: str
 ) -> None:
     """``agent.update: constant_alpha`` with ``alpha: sample_average`` is, byte for byte,
     ``agent.update: sample_average`` (docs/algorithms.md states both as one rule)."""
-    world = "lake" if algorithm == "monte_carlo" else "walk19"
-    averaged = _config(CASES[world], algorithm, {"update": "constant_alpha", **AVERAGED}, "numba")
-    averaging = _config(CASES[world], algorithm, {"update": "sample_average"}, "numba")
-    first, second = train(averaged), train(averaging)
+    averaged = _config(CASES[world], algorithm, {"update": "constant_alpha", **AVERAGED}, engine)
+    averaging = _config(CASES[world], algorithm, {"update": "sample_average"}, engine)
+    first, second = train(averaged, final_eval=False), train(averaging, final_eval=False)
     assert first.q_table.tobytes() == second.q_table.tobytes()
     assert first.returns.tolist() == second.returns.tolist()
     assert np.isnan(first.metrics.alphas).all()
