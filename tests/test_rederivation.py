@@ -171,30 +171,21 @@ AVERAGED = {"alpha": "sample_average"}
 SAMPLE_AVERAGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     f"{variant}-averaged": (name, {**params, **AVERAGED})
     for variant, (name, params) in {
-        "q_learning": ("q_learning", {}),
-        "sarsa": ("sarsa", {}),
-        "expected_sarsa": ("expected_sarsa", {}),
-        "double_q_learning": ("double_q_learning", {}),
-        "n_step_sarsa": ("n_step_sarsa", {"n": 3}),
-        "n_step_tree_backup": ("n_step_tree_backup", {"n": 3}),
-        "sarsa_lambda-replacing": ("sarsa_lambda", {"lambda": 0.8, "trace": "replacing"}),
-        "sarsa_lambda-dutch": ("sarsa_lambda", {"lambda": 0.8, "trace": "dutch"}),
-        "watkins_q_lambda-accumulating": (
-            "watkins_q_lambda",
-            {"lambda": 0.8, "trace": "accumulating"},
-        ),
-        "dyna_q": ("dyna_q", {"planning_steps": 5}),
-        "dyna_q_plus": ("dyna_q_plus", {"planning_steps": 5, "kappa": 0.01}),
-        "prioritized_sweeping": ("prioritized_sweeping", {"planning_steps": 5, "theta": 0.001}),
-        "monte_carlo": ("monte_carlo", {"update": "constant_alpha"}),
-        "monte_carlo_es": ("monte_carlo_es", {"update": "constant_alpha"}),
-        "td": ("td", {}),
-        "n_step_td": ("n_step_td", {"n": 3}),
-        "mc_prediction": ("mc_prediction", {"update": "constant_alpha"}),
-        "offline_lambda_return": ("offline_lambda_return", {"lambda": 0.8}),
-        "td_lambda-dutch": ("td_lambda", {"lambda": 0.6, "trace": "dutch"}),
+        **{
+            variant: VARIANTS[variant]
+            for variant in (
+                "q_learning", "sarsa", "expected_sarsa", "double_q_learning", "n_step_sarsa",
+                "n_step_tree_backup", "sarsa_lambda-replacing", "sarsa_lambda-dutch",
+                "watkins_q_lambda-accumulating", "dyna_q", "dyna_q_plus", "prioritized_sweeping",
+                "monte_carlo-constant_alpha", "monte_carlo_es-constant_alpha",
+            )
+        },
+        **{
+            variant: PREDICTION_VARIANTS[variant]
+            for variant in ("td", "n_step_td", "mc_prediction", "offline_lambda_return", "td_lambda-dutch")
+        },
     }.items()
-}
+}  # fmt: skip
 ES_VARIANTS = [
     "monte_carlo_es-sample_average",
     "monte_carlo_es-constant_alpha",
@@ -710,7 +701,7 @@ AVERAGED_NUMBA = {
     f"{name}-averaged"
     for name in (
         "q_learning", "double_q_learning", "n_step_tree_backup", "sarsa_lambda-dutch",
-        "prioritized_sweeping", "monte_carlo", "td",
+        "prioritized_sweeping", "monte_carlo-constant_alpha", "td",
     )
 }  # fmt: skip
 
