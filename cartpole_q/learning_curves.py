@@ -15,7 +15,6 @@ Pure functions of arrays; drawing is :mod:`cartpole_q.figures`' job.
 from __future__ import annotations
 
 import re
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -290,10 +289,37 @@ def aggregate_band(
             [statistic(curves[pick]) for pick in picks[start : start + 50]]
             for start in range(0, resamples, 50)
         ])  # fmt: skip
-    with warnings.catch_warnings():  # a point no seed reaches has no band: NaN, said once
-        warnings.simplefilter("ignore", RuntimeWarning)
-        low, high = np.nanpercentile(resampled, [2.5, 97.5], axis=0)
-    return centre, np.asarray(low), np.asarray(high)
+    low, high = nan_percentiles(resampled, [2.5, 97.5])
+    return centre, low, high
+
+
+def nan_percentiles(values: np.ndarray, percents: Sequence[float]) -> np.ndarray:
+    """``np.nanpercentile(values, percents, axis=0)``, the same numbers, without its slow path.
+
+    Once any value is NaN, numpy computes each column on its own, a Python call per column
+    (seven seconds for a 100,000-episode curve). Here the columns with the same number
+    ``n`` of values are computed together, as ``np.percentile`` of their ``n`` smallest
+    values (NaN sorts last), each column a contiguous row: numpy's own arithmetic, so
+    every number is the same. A column of NaN alone is NaN.
+
+    >>> values = np.array([[1.0, np.nan, np.nan], [3.0, 2.0, np.nan], [2.0, 4.0, np.nan]])
+    >>> nan_percentiles(values, [50.0]).tolist()
+    [[2.0, 3.0, nan]]
+    """
+    present = np.sum(~np.isnan(values), axis=0)
+    result = np.full((len(percents), values.shape[1]), np.nan)
+    full = present == values.shape[0]
+    if full.any():  # (most curves: no NaN, no sorting)
+        rows = np.ascontiguousarray(values[:, full].T)
+        result[:, full] = np.percentile(rows, percents, axis=1, overwrite_input=True)
+    partial = np.flatnonzero(~full & (present > 0))
+    if partial.size:
+        ordered = np.sort(values[:, partial].T, axis=1)
+        for count in np.unique(present[partial]):
+            chosen = present[partial] == count
+            rows = np.ascontiguousarray(ordered[chosen, :count])
+            result[:, partial[chosen]] = np.percentile(rows, percents, axis=1, overwrite_input=True)
+    return result
 
 
 def _statistic(aggregate: str) -> Callable[[np.ndarray], np.ndarray]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ from matplotlib.image import imread
 from cartpole_q.learning_curves import (
     aggregate_band,
     interquartile_mean,
+    nan_percentiles,
     per_episode,
     seed_curves,
     smooth,
@@ -81,6 +83,30 @@ def test_the_interquartile_mean_is_the_mean_of_the_middle_half(values: list[floa
     # NaN (a seed without a value there) is left out, as if the seed were absent
     with_nan = np.array([*values, np.nan])[:, None]
     assert interquartile_mean(with_nan)[0] == pytest.approx(expected, rel=1e-12, abs=1e-9)
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    st.integers(1, 30).flatmap(
+        lambda rows: st.lists(
+            st.lists(
+                st.one_of(st.floats(-1e9, 1e9), st.just(np.nan)), min_size=rows, max_size=rows
+            ),
+            min_size=1,
+            max_size=12,
+        )
+    ),
+    st.lists(st.floats(0.0, 100.0), min_size=1, max_size=3),
+)
+def test_nan_percentiles_are_numpys_nanpercentile(
+    columns: list[list[float]], percents: list[float]
+) -> None:
+    values = np.array(columns).T  # (rows, columns), NaN anywhere, whole columns of it too
+    with warnings.catch_warnings():  # (numpy warns of a column of NaN alone)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        expected = np.nanpercentile(values, percents, axis=0)
+    got = nan_percentiles(values, percents)
+    assert np.array_equal(got, expected, equal_nan=True)  # the same numbers
 
 
 @pytest.mark.parametrize("aggregate", ["mean", "iqm"])
