@@ -150,6 +150,10 @@ def test_the_sweep_keeps_the_curve_and_the_plot_reads_it(in_tmp: Path) -> None:
     assert [run.info.tolist() for run in runs] == [  # type: ignore[union-attr]
         kept[f"seed-00{s}.info_left_from_a"].tolist() for s in range(3)
     ]
+    # and with the metrics `train` writes: epsilon and alpha from the point's schedules
+    one = rundir.load_run(Path("one")).metrics
+    for column, values in runs[2].metrics._asdict().items():
+        assert values.tolist() == getattr(one, column).tolist(), column
     curves = seed_curves(
         [r.metrics.returns for r in runs], [r.metrics.lengths for r in runs],
         "info:left_from_a", "episode", records=[r.info for r in runs],

@@ -252,10 +252,12 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
 
 def _metrics(config: Config, returns: np.ndarray, lengths: np.ndarray) -> EpisodeMetrics:
     """Per-episode metrics from a kept curve; epsilon and alpha from the config's schedules."""
-    from cartpole_q.rl.schedules import schedule_value
+    from cartpole_q.rl.schedules import CONSTANT, schedule_value
 
     def rates(schedule: Schedule) -> np.ndarray:
         code, start, end, rate = schedule.code, schedule.start, schedule.end, schedule.rate
+        if code == CONSTANT:  # (most sweeps: millions of episodes, one value)
+            return np.full(len(returns), start, dtype=np.float64)
         return np.array(
             [schedule_value(code, start, end, rate, e) for e in range(len(returns))],
             dtype=np.float64,
