@@ -311,6 +311,23 @@ def test_the_cli_reference_documents_every_command_and_option() -> None:
     assert hook.on_page_markdown("no marker", page=None) == "no marker"
 
 
+def test_the_commands_page_has_a_section_for_every_command_naming_its_options() -> None:
+    from cartpole_q.cli.app import app
+
+    text = (REPO / "docs" / "commands.md").read_text(encoding="utf-8")
+    sections = {
+        match["name"]: match["body"]
+        for match in re.finditer(r"^## `cartpole-q (?P<name>\w+)`\n(?P<body>.*?)(?=^## |\Z)", text, re.M | re.S)
+    }  # fmt: skip
+    for name, command in typer.main.get_command(app).commands.items():  # type: ignore[attr-defined]
+        assert name in sections, f"docs/commands.md has no section for `cartpole-q {name}`"
+        for option in (opt for param in command.params for opt in param.opts):
+            if option.startswith("--") and option != "--help":
+                assert re.search(rf"(?<![\w-]){option}(?![\w-])", sections[name]), (
+                    f"docs/commands.md, `cartpole-q {name}`: {option} is not named"
+                )
+
+
 def test_sphinx_roles_become_code_on_the_api_pages() -> None:
     pytest.importorskip("griffe")  # the docs extra
     plain = _hook("sphinx_roles").plain

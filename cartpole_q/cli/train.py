@@ -276,7 +276,8 @@ def compile_command(
             "--all",
             help="Compile every algorithm on every environment with a compiled twin, and on "
             "the gymnasium engine (one compilation per algorithm serves every environment "
-            "but tile-coded ones).",
+            "but tile-coded ones), with the shipped configs' settings: tile coding, sample "
+            "averages and env.randomize compile their own loops when first run.",
         ),
     ] = False,
     workers: Workers = None,
