@@ -254,6 +254,11 @@ def interquartile_mean(values: np.ndarray, axis: int = 0) -> np.ndarray:
         return np.asarray(np.where(count > 0, total / np.maximum(count, 1), np.nan))
 
 
+BAND_BLOCK_VALUES = 2**22
+"""resampled values a band computes at once (32 MiB of float64): a longer curve's band is
+computed block of points by block, so that memory stays bounded however long the runs"""
+
+
 def aggregate_band(
     curves: np.ndarray,
     aggregate: str,
@@ -261,6 +266,10 @@ def aggregate_band(
     resamples: int = 1000,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The seeds' aggregate per point and its 95% percentile-bootstrap band.
+
+    The resamples are drawn once, for every point. A curve of more than
+    ``BAND_BLOCK_VALUES / resamples`` points is resampled in blocks of at least that many
+    points (a 100,000-episode curve would need 800 MB at once).
 
     Args:
         curves: ``(seeds, points)``; NaN where a seed has no value.
@@ -272,25 +281,32 @@ def aggregate_band(
         ``(centre, low, high)``, each of length ``points``.
     """
     statistic = _statistic(aggregate)
-    n_seeds = curves.shape[0]
+    n_seeds, points = curves.shape
     centre = statistic(curves)
     picks = rng.integers(0, n_seeds, size=(resamples, n_seeds))
     if aggregate == "mean_square":  # the mean of the squares, resampled as a mean
         return aggregate_band(curves * curves, "mean", rng, resamples)
-    if aggregate == "mean":
-        # A resample's mean is (how often each seed was picked) @ (the seeds' values).
-        counts = np.zeros((resamples, n_seeds))
-        np.add.at(counts, (np.arange(resamples)[:, None], picks), 1.0)
-        present = ~np.isnan(curves)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            resampled = (counts @ np.where(present, curves, 0.0)) / (counts @ present)
-    else:
-        resampled = np.vstack([
-            [statistic(curves[pick]) for pick in picks[start : start + 50]]
-            for start in range(0, resamples, 50)
-        ])  # fmt: skip
-    low, high = nan_percentiles(resampled, [2.5, 97.5])
-    return centre, low, high
+    counts = np.zeros((resamples, n_seeds))  # how often each resample picked each seed
+    np.add.at(counts, (np.arange(resamples)[:, None], picks), 1.0)
+    bands = np.full((2, points), np.nan)
+    blocks = max(1, points * resamples // BAND_BLOCK_VALUES)
+    start = 0
+    for block in range(blocks):
+        stop = start + points // blocks + (block < points % blocks)
+        part = curves[:, start:stop]
+        if aggregate == "mean":
+            # A resample's mean is (how often each seed was picked) @ (the seeds' values).
+            present = ~np.isnan(part)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                resampled = (counts @ np.where(present, part, 0.0)) / (counts @ present)
+        else:
+            resampled = np.vstack([
+                [statistic(part[pick]) for pick in picks[first : first + 50]]
+                for first in range(0, resamples, 50)
+            ])  # fmt: skip
+        bands[:, start:stop] = nan_percentiles(resampled, [2.5, 97.5])
+        start = stop
+    return centre, bands[0], bands[1]
 
 
 def nan_percentiles(values: np.ndarray, percents: Sequence[float]) -> np.ndarray:

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from matplotlib.image import imread
 
+from cartpole_q import learning_curves
 from cartpole_q.learning_curves import (
     aggregate_band,
     interquartile_mean,
@@ -107,6 +108,25 @@ def test_nan_percentiles_are_numpys_nanpercentile(
         expected = np.nanpercentile(values, percents, axis=0)
     got = nan_percentiles(values, percents)
     assert np.array_equal(got, expected, equal_nan=True)  # the same numbers
+
+
+@pytest.mark.parametrize("aggregate", ["mean", "iqm", "mean_square"])
+def test_a_long_curves_band_is_computed_in_blocks_as_at_once(
+    aggregate: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rng = np.random.default_rng(5)
+    curves = rng.normal(size=(7, 1003))
+    curves[2, 600:] = np.nan  # runs of different lengths
+    curves[:, 990:] = np.nan  # points no seed reaches
+    at_once = aggregate_band(curves, aggregate, np.random.default_rng(1), 200)
+    monkeypatch.setattr(learning_curves, "BAND_BLOCK_VALUES", 200 * 64)  # blocks of >= 64 points
+    in_blocks = aggregate_band(curves, aggregate, np.random.default_rng(1), 200)
+    for whole, blocked in zip(at_once, in_blocks, strict=True):
+        if aggregate == "iqm":  # sorted per point: the same numbers
+            assert np.array_equal(whole, blocked, equal_nan=True)
+        else:  # a matrix product in blocks may round the last bit otherwise
+            np.testing.assert_allclose(blocked, whole, rtol=1e-12, atol=0.0)
+            assert np.array_equal(np.isnan(whole), np.isnan(blocked))
 
 
 @pytest.mark.parametrize("aggregate", ["mean", "iqm"])
