@@ -171,7 +171,9 @@ class Algorithm:
     policy: Callable[[np.ndarray, tuple[np.ndarray, ...]], np.ndarray] = same_table
     """the table whose greedy actions are its policy (``q_table.npy``), from ``Q`` and memory"""
     memory_names: tuple[str, ...] = ()
-    """a name for each memory array (checkpoints and messages)"""
+    """a name for each memory array, in order, for readers (checkpoints store them as
+    ``memory_0``, ``memory_1``, ...); one that only a variant allocates comes last (Double
+    Q-learning's ``q_b_update_counts``, under sample averages)"""
     book: str = ""
     """where Sutton & Barto (2nd ed.) state it"""
     task: str = "control"
