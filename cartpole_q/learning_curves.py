@@ -268,7 +268,7 @@ def aggregate_band(
     """The seeds' aggregate per point and its 95% percentile-bootstrap band.
 
     The resamples are drawn once, for every point. A curve of more than
-    ``BAND_BLOCK_VALUES / resamples`` points is resampled in blocks of at least that many
+    ``BAND_BLOCK_VALUES / resamples`` points is resampled in blocks of at most that many
     points (a 100,000-episode curve would need 800 MB at once).
 
     Args:
@@ -289,7 +289,7 @@ def aggregate_band(
     counts = np.zeros((resamples, n_seeds))  # how often each resample picked each seed
     np.add.at(counts, (np.arange(resamples)[:, None], picks), 1.0)
     bands = np.full((2, points), np.nan)
-    blocks = max(1, points * resamples // BAND_BLOCK_VALUES)
+    blocks = max(1, -(-points * resamples // BAND_BLOCK_VALUES))  # (rounded up)
     start = 0
     for block in range(blocks):
         stop = start + points // blocks + (block < points % blocks)
@@ -316,7 +316,8 @@ def nan_percentiles(values: np.ndarray, percents: Sequence[float]) -> np.ndarray
     (seven seconds for a 100,000-episode curve). Here the columns with the same number
     ``n`` of values are computed together, as ``np.percentile`` of their ``n`` smallest
     values (NaN sorts last), each column a contiguous row: numpy's own arithmetic, so
-    every number is the same. A column of NaN alone is NaN.
+    every number is the same. A column of NaN alone is NaN. ``values`` is 2-D (rows,
+    columns) with at least one row, ``percents`` a sequence; the result is float64.
 
     >>> values = np.array([[1.0, np.nan, np.nan], [3.0, 2.0, np.nan], [2.0, 4.0, np.nan]])
     >>> nan_percentiles(values, [50.0]).tolist()
@@ -327,14 +328,17 @@ def nan_percentiles(values: np.ndarray, percents: Sequence[float]) -> np.ndarray
     full = present == values.shape[0]
     if full.any():  # (most curves: no NaN, no sorting)
         rows = np.ascontiguousarray(values[:, full].T)
-        result[:, full] = np.percentile(rows, percents, axis=1, overwrite_input=True)
+        with np.errstate(invalid="ignore"):  # (inf - inf between two infinite values)
+            result[:, full] = np.percentile(rows, percents, axis=1, overwrite_input=True)
     partial = np.flatnonzero(~full & (present > 0))
     if partial.size:
         ordered = np.sort(values[:, partial].T, axis=1)
         for count in np.unique(present[partial]):
             chosen = present[partial] == count
             rows = np.ascontiguousarray(ordered[chosen, :count])
-            result[:, partial[chosen]] = np.percentile(rows, percents, axis=1, overwrite_input=True)
+            with np.errstate(invalid="ignore"):
+                chosen_percentiles = np.percentile(rows, percents, axis=1, overwrite_input=True)
+            result[:, partial[chosen]] = chosen_percentiles
     return result
 
 

@@ -91,7 +91,9 @@ def test_the_interquartile_mean_is_the_mean_of_the_middle_half(values: list[floa
     st.integers(1, 30).flatmap(
         lambda rows: st.lists(
             st.lists(
-                st.one_of(st.floats(-1e9, 1e9), st.just(np.nan)), min_size=rows, max_size=rows
+                st.one_of(st.floats(-1e9, 1e9), st.sampled_from([np.nan, np.inf, -np.inf])),
+                min_size=rows,
+                max_size=rows,
             ),
             min_size=1,
             max_size=12,

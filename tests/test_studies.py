@@ -426,7 +426,7 @@ def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
     result = invoke("compile", "--workers", 1)
     assert result.exit_code == 0, result.output
     assert "compiled q_learning on CartPole-v1 (numba engine)" in result.stdout
-    assert "2 training loops compiled or loaded" in result.stdout
+    assert "2 compiled or loaded, 0 skipped, in " in result.stdout
     twin = twin_for(load_config().env.id)
     assert twin is not None
     # the default's epsilon reaches 0 at episode 90: both loops
@@ -434,3 +434,18 @@ def test_compile_fills_the_cache_for_a_config(in_tmp: Path) -> None:
         assert is_cached(f"train_{kind}__{get('q_learning').key}__{twin.key}")
     assert is_cached(f"next_step__{get('q_learning').key}__values")
     assert_refused(invoke("compile", "-c", "default", "--all"), "not both")
+
+
+def test_compile_names_what_it_skipped_and_counts_it_apart(in_tmp: Path) -> None:
+    # the twins report no step info: the numba engine cannot record train.info_metric
+    config = write_yaml(in_tmp / "lake.yaml", {
+        "env": {"id": "FrozenLake-v1"}, "train": {"info_metric": "prob"},
+    })  # fmt: skip
+    result = invoke("compile", "-c", config, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert "compiled q_learning on FrozenLake-v1 (gymnasium engine)" in lines
+    skipped = [line for line in lines if line.startswith("skipped ")]
+    assert len(skipped) == 1 and "q_learning on FrozenLake-v1 (numba engine): " in skipped[0]
+    assert "train.info_metric" in skipped[0]
+    assert lines[-1].startswith("1 compiled or loaded, 1 skipped, in ")

@@ -293,11 +293,13 @@ def compile_command(
             raise UserError("give either --config (one config) or --all (everything), not both.")
         chosen = load_config(config) if config is not None else None
         with stoppable("run it again to compile the rest") as stop:
-            count, seconds = compile_all(
+            compiled, skipped, seconds = compile_all(
                 chosen, every, workers=workers, should_stop=stop.is_set,
-                on_done=None if quiet else lambda line: typer.echo(f"compiled {line}"),
+                on_done=None if quiet else typer.echo,
             )  # fmt: skip
-        typer.echo(f"{count} training loops compiled or loaded in {seconds:.1f} s ({cache_dir()})")
+        typer.echo(
+            f"{compiled} compiled or loaded, {skipped} skipped, in {seconds:.1f} s ({cache_dir()})"
+        )
         exit_if_stopped(stop.is_set(), "run it again to compile the rest")
 
 

@@ -36,6 +36,10 @@ engine (whose step functions take every observation but tiles' as float64 values
 world covers them all)"""
 
 
+SKIPPED = "skipped"
+"""how the line of a job that could not run its config starts"""
+
+
 @dataclass(frozen=True)
 class CompileJob:
     """One config on one engine."""
@@ -69,7 +73,12 @@ def jobs_for(config: Config | None, every: bool) -> list[CompileJob]:
 
 
 def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None) -> str:
-    """Job: compile one config's loops (a config mapping, or a shipped config's name)."""
+    """Job: compile one config's loops (a config mapping, or a shipped config's name).
+
+    Returns:
+        What it did, a line to print: ``compiled q_learning on CartPole-v1 (numba
+        engine)``, ``skipped ...: why``, or ``""`` when stopped before it started.
+    """
     from cartpole_q.config import ConfigError
     from cartpole_q.engines import precompile
 
@@ -80,8 +89,8 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
     try:
         precompile(config, job.engine)
     except ConfigError as error:  # e.g. an algorithm's parameters a config cannot give
-        return f"skipped {job.describe()}: {error}"
-    return job.describe()
+        return f"{SKIPPED} {job.describe()}: {error}"
+    return f"compiled {job.describe()}"
 
 
 def compile_all(
@@ -91,16 +100,24 @@ def compile_all(
     workers: int | None = None,
     should_stop: Callable[[], bool] | None = None,
     on_done: Callable[[str], None] | None = None,
-) -> tuple[int, float]:
-    """Compile the loops; return how many jobs ran and the seconds it took."""
+) -> tuple[int, int, float]:
+    """Compile the loops of each job (a config on an engine), telling ``on_done`` each line.
+
+    Returns:
+        How many jobs compiled (or loaded) their loops, how many were skipped (an algorithm
+        a config cannot give its parameters), and the seconds it took.
+    """
     jobs = jobs_for(config, every)
     mapping = None if config is None or every else config.to_dict()
     started = time.perf_counter()
-    done = 0
+    compiled = skipped = 0
 
     def on_item(index: int, line: str) -> None:
-        nonlocal done
-        done += 1
+        nonlocal compiled, skipped
+        if line.startswith(SKIPPED):
+            skipped += 1
+        elif line:
+            compiled += 1
         if on_done is not None and line:
             on_done(line)
 
@@ -110,7 +127,7 @@ def compile_all(
         _compile, [(job, mapping) for job in jobs], on_item,
         workers=workers or default_workers(len(jobs)), should_stop=should_stop, abandon=True,
     )  # fmt: skip
-    return done, time.perf_counter() - started
+    return compiled, skipped, time.perf_counter() - started
 
 
 def compile_ahead(
