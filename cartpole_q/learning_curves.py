@@ -326,19 +326,19 @@ def nan_percentiles(values: np.ndarray, percents: Sequence[float]) -> np.ndarray
     present = np.sum(~np.isnan(values), axis=0)
     result = np.full((len(percents), values.shape[1]), np.nan)
     full = present == values.shape[0]
-    if full.any():  # (most curves: no NaN, no sorting)
-        rows = np.ascontiguousarray(values[:, full].T)
-        with np.errstate(invalid="ignore"):  # (inf - inf between two infinite values)
-            result[:, full] = np.percentile(rows, percents, axis=1, overwrite_input=True)
     partial = np.flatnonzero(~full & (present > 0))
-    if partial.size:
-        ordered = np.sort(values[:, partial].T, axis=1)
-        for count in np.unique(present[partial]):
-            chosen = present[partial] == count
-            rows = np.ascontiguousarray(ordered[chosen, :count])
-            with np.errstate(invalid="ignore"):
-                chosen_percentiles = np.percentile(rows, percents, axis=1, overwrite_input=True)
-            result[:, partial[chosen]] = chosen_percentiles
+    with np.errstate(invalid="ignore"):  # (inf - inf between two infinite values: NaN)
+        if full.any():  # (most curves: no NaN, no sorting)
+            rows = np.ascontiguousarray(values[:, full].T)
+            result[:, full] = np.percentile(rows, percents, axis=1, overwrite_input=True)
+        if partial.size:
+            ordered = np.sort(values[:, partial].T, axis=1)
+            for count in np.unique(present[partial]):
+                chosen = present[partial] == count
+                rows = np.ascontiguousarray(ordered[chosen, :count])
+                result[:, partial[chosen]] = np.percentile(
+                    rows, percents, axis=1, overwrite_input=True
+                )
     return result
 
 
