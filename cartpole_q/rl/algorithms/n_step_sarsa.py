@@ -40,14 +40,14 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     next_action = ENDED
     if not terminated:
         next_action = behaviour_action(q, params, next_state, epsilon, rng)
-    if terminated or truncated:
-        while counter[1] > 0:
-            settle_oldest(q, states, actions, rewards, counter, next_state, next_action,
-                          not terminated, alpha, gamma)  # fmt: skip
+    ended = terminated or truncated
+    # One call site (every step inlines what it calls): at the end every pending step is
+    # due, else the oldest once the queue is full (bootstrapping: terminated is False there).
+    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+        settle_oldest(q, states, actions, rewards, counter, next_state, next_action,
+                      not terminated, alpha, gamma)  # fmt: skip
+    if ended:
         return ENDED
-    if counter[1] == states.shape[0]:
-        settle_oldest(q, states, actions, rewards, counter, next_state, next_action, True,
-                      alpha, gamma)  # fmt: skip
     return next_action
 
 

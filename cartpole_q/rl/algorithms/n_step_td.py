@@ -45,13 +45,14 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
         memory[4],
     )
     push(states, actions, rewards, counter, state, 0, reward)
-    if terminated or truncated:
-        while counter[1] > 0:
-            settle_oldest(q, states, actions, rewards, counter, next_state, 0, not terminated,
-                          alpha, gamma)  # fmt: skip
+    ended = terminated or truncated
+    # One call site (every step inlines what it calls): at the end every pending step is
+    # due, else the oldest once the queue is full (bootstrapping: terminated is False there).
+    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+        settle_oldest(q, states, actions, rewards, counter, next_state, 0, not terminated,
+                      alpha, gamma)  # fmt: skip
+    if ended:
         return ENDED
-    if counter[1] == states.shape[0]:
-        settle_oldest(q, states, actions, rewards, counter, next_state, 0, True, alpha, gamma)
     return policy_action(policy, next_state, params, rng)
 
 

@@ -75,14 +75,14 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     """Queue the step, settle what is due, then draw the next action."""
     states, actions, rewards, counter = memory[0], memory[1], memory[2], memory[3]
     push(states, actions, rewards, counter, state, action, reward)
-    if terminated or truncated:
-        while counter[1] > 0:
-            settle_oldest(q, states, actions, rewards, counter, next_state, terminated, alpha,
-                          gamma, epsilon)  # fmt: skip
+    ended = terminated or truncated
+    # One call site (every step inlines what it calls): at the end every pending step is
+    # due, else the oldest once the queue is full (terminated is False there).
+    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+        settle_oldest(q, states, actions, rewards, counter, next_state, terminated, alpha,
+                      gamma, epsilon)  # fmt: skip
+    if ended:
         return ENDED
-    if counter[1] == states.shape[0]:
-        settle_oldest(q, states, actions, rewards, counter, next_state, False, alpha, gamma,
-                      epsilon)  # fmt: skip
     return behaviour_action(q, params, next_state, epsilon, rng)
 
 
