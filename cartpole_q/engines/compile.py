@@ -23,6 +23,8 @@ same way. Validation never lets the two meet (sample averages are refused on til
 
 from __future__ import annotations
 
+import copy
+import inspect
 import types
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -36,6 +38,55 @@ from cartpole_q.numba_cache import configure as configure_numba_cache
 configure_numba_cache()  # before any cache=True function is defined
 
 _COMPILED: dict[tuple[Callable[..., Any], bool, bool], Dispatcher] = {}
+
+
+_FRONT_ENDS: dict[tuple[Any, ...], Any] = {}
+"""the untyped IR of each function inlined so far: (function, enable_ssa, flags) -> IR"""
+
+
+def reuse_inlined_front_ends() -> None:
+    """Make numba run an inlined function's front end once per process, not once per call.
+
+    At every call of an ``inline="always"`` function, numba translates the callee's bytecode
+    and runs its untyped passes again, its own inlined callees included, recursively
+    (``InlineWorker.run_untyped_passes``): a quarter of the compile time of the training
+    loops, whose hooks call the same helpers many times. What those passes give depends only
+    on the function and the compile flags, so the first result is kept (in
+    :data:`_FRONT_ENDS`) and each later call gets a copy of its blocks; numba copies a
+    callee's IR again before changing it, so the kept IR stays as it was. The machine code
+    is the same: the golden hashes and the plain re-derivation check it.
+
+    Idempotent. Where numba's method does not take the arguments it took when this was
+    written (numba 0.68: ``self, func, enable_ssa``), nothing is changed and compiling only
+    takes longer.
+    """
+    from numba.core.inline_closurecall import InlineWorker
+
+    original = getattr(InlineWorker, "run_untyped_passes", None)
+    if original is None or getattr(original, "__reuses_front_ends__", False):
+        return
+    if list(inspect.signature(original).parameters) != ["self", "func", "enable_ssa"]:
+        return
+
+    def run_untyped_passes(self: Any, func: Any, enable_ssa: bool = False) -> Any:
+        flags = self.flags.copy()
+        flags.enable_ssa = False  # set from the argument below: not a flag of the caller's
+        key = (func, enable_ssa, flags)
+        found = _FRONT_ENDS.get(key)
+        if found is None:
+            found = _FRONT_ENDS[key] = original(self, func, enable_ssa)
+        else:
+            self.flags.enable_ssa = enable_ssa  # as numba's own leaves the caller's flags
+        reused = found.copy()  # its blocks are the kept ones: copied here, one scope for all
+        memo: dict[int, Any] = {}
+        reused.blocks = {label: copy.deepcopy(block, memo) for label, block in found.blocks.items()}
+        return reused
+
+    run_untyped_passes.__reuses_front_ends__ = True  # type: ignore[attr-defined]
+    InlineWorker.run_untyped_passes = run_untyped_passes  # type: ignore[method-assign]
+
+
+reuse_inlined_front_ends()
 
 
 def is_compilable(value: Any) -> bool:

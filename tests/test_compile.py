@@ -1,0 +1,53 @@
+"""How cartpole_q.engines.compile compiles: an inlined helper's front end is run once.
+
+numba inlines a ``compilable`` helper at every call; ``reuse_inlined_front_ends`` keeps the
+untyped IR of each helper the first time and gives later calls a copy. The machine code it
+leads to is checked elsewhere, byte for byte (the golden hashes, the plain re-derivation);
+here, that the IR is kept once per helper and that every call still computes its own values.
+"""
+
+from __future__ import annotations
+
+from numba.core.inline_closurecall import InlineWorker
+
+from cartpole_q.engines import compile as engine_compile
+from cartpole_q.engines.compile import jit
+from cartpole_q.rl.tabular import compilable
+
+
+@compilable
+def doubled(x: float) -> float:
+    """A helper that callers inline."""
+    return x * 2.0
+
+
+@compilable
+def three_calls(x: float) -> float:
+    """Inlines ``doubled`` three times, at different arguments."""
+    return doubled(x) + doubled(x + 1.0) + doubled(x + 2.0)
+
+
+@compilable
+def two_more_calls(x: float) -> float:
+    """Inlines ``doubled`` twice more, in another compiled function."""
+    return doubled(x) - doubled(1.0)
+
+
+def _kept_for(function: object) -> list[tuple[object, ...]]:
+    return [key for key in engine_compile._FRONT_ENDS if key[0] is function]
+
+
+def test_an_inlined_helper_is_translated_once_however_many_calls_inline_it() -> None:
+    assert getattr(InlineWorker.run_untyped_passes, "__reuses_front_ends__", False)
+    helper = jit(doubled).py_func
+    assert three_calls(1.0) == 12.0 and two_more_calls(3.0) == 4.0  # as plain Python
+    assert jit(three_calls)(1.0) == 12.0  # 2 + 4 + 6: each call its own argument
+    assert len(_kept_for(helper)) == 1
+    assert jit(two_more_calls)(3.0) == 4.0  # a later function reuses the kept IR intact
+    assert len(_kept_for(helper)) == 1
+
+
+def test_reusing_is_set_up_once() -> None:
+    patched = InlineWorker.run_untyped_passes
+    engine_compile.reuse_inlined_front_ends()
+    assert InlineWorker.run_untyped_passes is patched
