@@ -100,6 +100,8 @@ def test_the_twin_draws_what_the_environment_draws(name: str) -> None:
     assert q_star.tobytes() == env.unwrapped.q_star.tobytes()  # type: ignore[attr-defined]
 
 
+# One worker for all: they compile the same bandit loop, once.
+@pytest.mark.xdist_group("bandit-loops")
 @pytest.mark.parametrize("name", LEARNERS)
 def test_both_engines_equal_the_rederivation_byte_for_byte(name: str) -> None:
     learner = LEARNERS[name]

@@ -46,6 +46,8 @@ def test_sample_averages_are_refused_until_it_declares_them() -> None:
         load_config(overrides={**SETTINGS, "agent.alpha": "sample_average"})
 
 
+# One worker for both: each trains the numba reference, whose loops it then compiles once.
+@pytest.mark.xdist_group("plugin-numba-loops")
 @pytest.mark.parametrize("engine", ["numba", "gymnasium"])
 def test_it_trains_on_both_engines_to_the_same_bytes_and_resumes(
     engine: str, tmp_path: Path

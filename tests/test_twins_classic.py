@@ -166,6 +166,8 @@ def test_mountaincar_twin_is_exact(env_kwargs: dict, heuristic_share: float, see
         assert run["left_wall_hits"] > 0, "the left wall was never hit"
 
 
+# One worker for all: they compile the same recorder, once.
+@pytest.mark.xdist_group("acrobot-recorder")
 @pytest.mark.parametrize("seed", [0, 7, 123])
 @pytest.mark.parametrize("heuristic_share", [0.0, 0.7])
 def test_acrobot_twin_is_exact(heuristic_share: float, seed: int) -> None:
