@@ -3,11 +3,13 @@
 numba inlines a ``compilable`` helper at every call; ``reuse_inlined_front_ends`` keeps the
 untyped IR of each helper the first time and gives later calls a copy. The machine code it
 leads to is checked elsewhere, byte for byte (the golden hashes, the plain re-derivation);
-here, that the IR is kept once per helper and that every call still computes its own values.
+here, that the IR is kept once per helper (and only for the functions ``compile`` built)
+and that every call still computes its own values.
 """
 
 from __future__ import annotations
 
+from numba import njit
 from numba.core.inline_closurecall import InlineWorker
 
 from cartpole_q.engines import compile as engine_compile
@@ -33,6 +35,17 @@ def two_more_calls(x: float) -> float:
     return doubled(x) - doubled(1.0)
 
 
+@njit(inline="always")
+def tripled(x: float) -> float:
+    """An inlined function this project did not build: numba's front end as before."""
+    return x * 3.0
+
+
+@njit
+def tripled_twice(x: float) -> float:
+    return tripled(x) + tripled(1.0)
+
+
 def _kept_for(function: object) -> list[tuple[object, ...]]:
     return [key for key in engine_compile._FRONT_ENDS if key[0] is function]
 
@@ -45,6 +58,12 @@ def test_an_inlined_helper_is_translated_once_however_many_calls_inline_it() -> 
     assert len(_kept_for(helper)) == 1
     assert jit(two_more_calls)(3.0) == 4.0  # a later function reuses the kept IR intact
     assert len(_kept_for(helper)) == 1
+
+
+def test_only_the_functions_this_module_built_are_kept() -> None:
+    """Another function's IR may depend on what it reads when translated: not kept."""
+    assert tripled_twice(2.0) == 9.0
+    assert _kept_for(tripled.py_func) == []
 
 
 def test_reusing_is_set_up_once() -> None:

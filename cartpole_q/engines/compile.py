@@ -40,6 +40,9 @@ configure_numba_cache()  # before any cache=True function is defined
 _COMPILED: dict[tuple[Callable[..., Any], bool, bool], Dispatcher] = {}
 
 
+_KEEPS_FRONT_END = "__cartpole_q_keeps_front_end__"
+"""the attribute that marks a function this module built (see :func:`reuse_inlined_front_ends`)"""
+
 _FRONT_ENDS: dict[tuple[Any, ...], Any] = {}
 """the untyped IR of each function inlined so far: (function, enable_ssa, flags) -> IR"""
 
@@ -53,8 +56,15 @@ def reuse_inlined_front_ends() -> None:
     loops, whose hooks call the same helpers many times. What those passes give depends only
     on the function and the compile flags, so the first result is kept (in
     :data:`_FRONT_ENDS`) and each later call gets a copy of its blocks; numba copies a
-    callee's IR again before changing it, so the kept IR stays as it was. The machine code
-    is the same: the golden hashes and the plain re-derivation check it.
+    callee's IR again before changing it, so the kept IR stays as it was; each copy gets its
+    own function identity, as numba gives each call, so the inlined variables are named
+    apart. The machine code is the same: the golden hashes and the plain re-derivation check
+    it.
+
+    Only this module's compiled functions are kept (:func:`jit` and :func:`specialise` mark
+    them): their globals are a namespace of their own, fixed when they are built, and none
+    is a closure, so their IR depends on nothing else. Every other inlined function (numba's
+    own, a plug-in's) goes through numba's front end as before.
 
     Idempotent. Where numba's method does not take the arguments it took when this was
     written (numba 0.68: ``self, func, enable_ssa``), nothing is changed and compiling only
@@ -69,6 +79,8 @@ def reuse_inlined_front_ends() -> None:
         return
 
     def run_untyped_passes(self: Any, func: Any, enable_ssa: bool = False) -> Any:
+        if not getattr(func, _KEEPS_FRONT_END, False) or func.__closure__ is not None:
+            return original(self, func, enable_ssa)
         flags = self.flags.copy()
         flags.enable_ssa = False  # set from the argument below: not a flag of the caller's
         key = (func, enable_ssa, flags)
@@ -78,6 +90,7 @@ def reuse_inlined_front_ends() -> None:
         else:
             self.flags.enable_ssa = enable_ssa  # as numba's own leaves the caller's flags
         reused = found.copy()  # its blocks are the kept ones: copied here, one scope for all
+        reused.func_id = found.func_id.derive()  # a new unique name, as each call gets
         memo: dict[int, Any] = {}
         reused.blocks = {label: copy.deepcopy(block, memo) for label, block in found.blocks.items()}
         return reused
@@ -115,6 +128,7 @@ def jit(function: Callable[..., Any], tiled: bool = False, averaged: bool = Fals
     rebuilt.__qualname__ = function.__qualname__
     rebuilt.__module__ = function.__module__
     rebuilt.__doc__ = function.__doc__
+    setattr(rebuilt, _KEEPS_FRONT_END, True)
     dispatcher = njit(nogil=True, inline="always")(rebuilt)
     _COMPILED[(function, tiled, averaged)] = dispatcher
     return dispatcher
@@ -188,6 +202,7 @@ def specialise(
     function.__qualname__ = name
     function.__module__ = template.__module__
     function.__doc__ = template.__doc__
+    setattr(function, _KEEPS_FRONT_END, True)
     if inline:
         return njit(nogil=True, inline="always")(function)
     return njit(nogil=True, cache=True)(function)
