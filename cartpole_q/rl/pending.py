@@ -56,6 +56,17 @@ def drop_oldest(counter: np.ndarray, n: int) -> None:
 
 
 @compilable
+def oldest_is_due(counter: np.ndarray, n: int, ended: bool) -> bool:
+    """Whether the oldest pending step is settled now.
+
+    At the episode's end while any step is pending; else once the queue holds ``n`` steps.
+    The n-step hooks settle in one loop on this, so that their settle is called (and, as
+    compiled code inlines every call, compiled) from one place.
+    """
+    return bool(counter[1] > 0 and (ended or counter[1] == n))
+
+
+@compilable
 def settle_oldest(
     q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
     counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, alpha: float,

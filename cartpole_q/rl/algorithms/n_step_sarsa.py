@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.pending import N, push, queue_memory, settle_oldest
+from cartpole_q.rl.pending import N, oldest_is_due, push, queue_memory, settle_oldest
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -41,9 +41,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     if not terminated:
         next_action = behaviour_action(q, params, next_state, epsilon, rng)
     ended = terminated or truncated
-    # One call site (every step inlines what it calls): at the end every pending step is
-    # due, else the oldest once the queue is full (bootstrapping: terminated is False there).
-    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+    while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
         settle_oldest(q, states, actions, rewards, counter, next_state, next_action,
                       not terminated, alpha, gamma)  # fmt: skip
     if ended:

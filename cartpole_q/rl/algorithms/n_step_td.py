@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.pending import N, push, queue_memory, settle_oldest
+from cartpole_q.rl.pending import N, oldest_is_due, push, queue_memory, settle_oldest
 from cartpole_q.rl.prediction import (
     POLICY,
     POLICY_SOURCE,
@@ -46,9 +46,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     )
     push(states, actions, rewards, counter, state, 0, reward)
     ended = terminated or truncated
-    # One call site (every step inlines what it calls): at the end every pending step is
-    # due, else the oldest once the queue is full (bootstrapping: terminated is False there).
-    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+    while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
         settle_oldest(q, states, actions, rewards, counter, next_state, 0, not terminated,
                       alpha, gamma)  # fmt: skip
     if ended:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
-from cartpole_q.rl.pending import N, drop_oldest, push, queue_memory, slot
+from cartpole_q.rl.pending import N, drop_oldest, oldest_is_due, push, queue_memory, slot
 from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
@@ -76,9 +76,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     states, actions, rewards, counter = memory[0], memory[1], memory[2], memory[3]
     push(states, actions, rewards, counter, state, action, reward)
     ended = terminated or truncated
-    # One call site (every step inlines what it calls): at the end every pending step is
-    # due, else the oldest once the queue is full (terminated is False there).
-    while counter[1] > 0 and (ended or counter[1] == states.shape[0]):
+    while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
         settle_oldest(q, states, actions, rewards, counter, next_state, terminated, alpha,
                       gamma, epsilon)  # fmt: skip
     if ended:
