@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 import cartpole_q.numba_cache
@@ -110,15 +111,68 @@ def test_a_sweep_says_how_many_loops_it_compiles_first(
     assert "compiling" not in result.stderr
 
 
-def test_the_numba_engine_compiles_the_loops_its_epsilon_plays() -> None:
-    """An exploring loop for epsilon > 0, a greedy one for epsilon 0: a run names those it plays."""
+def test_the_numba_engine_compiles_the_loops_its_epsilon_plays(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """An exploring loop for epsilon > 0, a greedy one for epsilon 0: a run names those it plays.
 
-    def names(**overrides: Any) -> list[str]:
+    After exploring episodes, the greedy loop only where it is cached or its episodes may
+    take a million steps (engines/base.py, ``greedy_loop_pays``).
+    """
+    cached: set[str] = set()
+    monkeypatch.setattr(cartpole_q.engines.base, "is_cached", lambda name: name in cached)
+
+    def names(greedy_loop: bool | None = None, **overrides: Any) -> list[str]:
         config = load_config(overrides=overrides)
-        return [name.split("__")[0] for name in loop_names(config, inspect_env(config), "numba")]
+        info = inspect_env(config)
+        return [
+            name.split("__")[0] for name in loop_names(config, info, "numba", None, greedy_loop)
+        ]
 
-    # The default's log schedule reaches 0 at episode 90 of its 1,000.
-    assert names() == ["train_exploring", "train_greedy"]
+    # The default's log schedule reaches 0 at episode 89 (0-based) of its 1,000: at most
+    # 911 x 500 greedy steps, under a million.
+    assert names() == ["train_exploring"]
+    assert names(True) == ["train_exploring", "train_greedy"]
+    assert names(**{"train.episodes": 2089}) == ["train_exploring", "train_greedy"]
+    assert names(**{"train.episodes": 2088}) == ["train_exploring"]
+    assert names(False, **{"train.episodes": 5000}) == ["train_exploring"]
+    config = load_config()
+    cached.update(loop_names(config, inspect_env(config), "numba", None, True))
+    assert names() == ["train_exploring", "train_greedy"]  # cached: it is played
     assert names(**{"train.episodes": 89}) == ["train_exploring"]
     assert names(**{"agent.epsilon": 0.1}) == ["train_exploring"]
-    assert names(**{"agent.epsilon": 0.0}) == ["train_greedy"]
+    assert names(**{"agent.epsilon": 0.0}) == ["train_greedy"]  # the only loop it plays
+    assert names(False, **{"agent.epsilon": 0.0}) == ["train_greedy"]
+
+
+def test_a_run_compiles_the_greedy_loop_where_it_pays_or_is_cached(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The exploring loop plays every episode of the default config, greedy ones included.
+
+    The decision is the engine's, made once per run: a later chunk of greedy episodes stays
+    on the exploring loop (the test re-derivation proves both ways byte-identical).
+    """
+    from cartpole_q.engines import make_engine
+    from cartpole_q.engines.base import TrainingState
+
+    monkeypatch.setattr(cartpole_q.engines.base, "is_cached", lambda name: False)
+
+    def engine_and_state(greedy_loop: bool | None = None, **overrides: Any) -> tuple[Any, Any]:
+        config = load_config(overrides=overrides)
+        info = inspect_env(config)
+        state = TrainingState.fresh(config, info, np.random.default_rng(0))
+        return make_engine("numba", config, info, 0, greedy_loop=greedy_loop), state
+
+    engine, state = engine_and_state()
+    assert engine.loops(state) == (False,)
+    state.episode = 500  # a later chunk: greedy episodes only
+    assert engine.loops(state) == (False,)
+    engine, state = engine_and_state(**{"train.episodes": 3000})
+    assert engine.loops(state) == (False, True)
+    engine, state = engine_and_state(True)
+    assert engine.loops(state) == (False, True)
+    state.episode = 500
+    assert engine.loops(state) == (True,)
+    engine, state = engine_and_state(**{"agent.epsilon": 0.0})
+    assert engine.loops(state) == (True,)  # the only loop it plays

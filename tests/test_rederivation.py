@@ -394,8 +394,8 @@ def _frozenlake_with(epsilon: dict[str, Any]) -> dict[str, Any]:
 
 
 # FrozenLake again, where every algorithm runs on both engines: exploring throughout; and
-# with epsilon 0 from episode 199 on, for the numba engine's greedy loop (engines/kernel.py)
-# of the algorithms CartPole's twin does not run below.
+# with epsilon 0 from episode 199 on, on the numba engine's greedy loop (engines/kernel.py).
+# Everywhere else the exploring loop plays the greedy episodes too (see _assert_same).
 CASES["lake"] = _frozenlake_with({"type": "exponential", "start": 1.0, "decay": 0.99, "end": 0.05})
 CASES["lake_greedy"] = _frozenlake_with({"type": "log", "k": 20, "start": 1.0, "end": 0.0})
 
@@ -413,16 +413,16 @@ NUMBA_WORLDS |= {
     "blackjack",
     "blackjack_es",
 }
-# The numba engine compiles two loops per (algorithm, twin), 5-25 s each on a cold cache, so
-# it runs every variant on one world only: FrozenLake's table twin ("lake"; "lake_greedy"
-# adds the greedy loop of the algorithms CartPole's twin does not run). The algorithms'
-# hooks are the same code on every twin, and the gymnasium engine runs every variant on
-# CartPole and on each kind of observation. CartPole's twin runs the algorithms whose loops
-# the suite compiles anyway (the one-step methods, and those whose shipped CartPole configs
-# tests/test_learning.py trains), its default epsilon reaching 0 (both loops); the other
-# twins a few algorithms, most of them loops the shipped configs and the book's studies
-# compile anyway (each twin is also proven step by step in test_twins_*.py and
-# test_engines.py).
+# The numba engine compiles up to two loops per (algorithm, twin), 3-10 s each on a cold
+# cache, so it runs every variant on one world only: FrozenLake's table twin ("lake";
+# "lake_greedy" adds every algorithm's greedy loop). The algorithms' hooks are the same
+# code on every twin, and the gymnasium engine runs every variant on CartPole and on each
+# kind of observation. CartPole's twin runs the algorithms whose loops the suite compiles
+# anyway (the one-step methods, and those whose shipped CartPole configs
+# tests/test_learning.py trains), its default epsilon reaching 0 (greedy episodes on the
+# exploring loop); the other twins a few algorithms, most of them loops the shipped configs
+# and the book's studies compile anyway (each twin is also proven step by step in
+# test_twins_*.py and test_engines.py).
 CARTPOLE_CONFIGS = (
     "n_step_sarsa", "n_step_tree_backup", "sarsa_lambda", "watkins_q_lambda",
     "true_online_sarsa_lambda", "dyna_q", "dyna_q_plus", "monte_carlo",
@@ -432,9 +432,6 @@ CARTPOLE_NUMBA = {
     *(v for v, (name, _) in VARIANTS.items() if name in (*ONE_STEP, *CARTPOLE_CONFIGS)),
     *(f"{name}-random-ties" for name in ("q_learning", "sarsa", "double_q_learning")),
 }
-LAKE_GREEDY = [v for v in VARIANTS if v not in CARTPOLE_NUMBA]
-"""the variants whose greedy loop CartPole's twin does not run (off-policy and ES Monte
-Carlo, prioritized sweeping)"""
 OTHER_TWIN_VARIANTS = {
     **{world: CARTPOLE_NUMBA for world in ("cartpole", "cartpole_physics", "cartpole_randomize")},
     "mountaincar": {"q_learning", "off_policy_monte_carlo-constant_alpha"},
@@ -517,9 +514,18 @@ def _reference(world: str, variant: str, **overrides: Any) -> ReferenceRun:
 
 
 def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
-    """Train with the package and assert every output equals the re-derivation's."""
+    """Train with the package and assert every output equals the re-derivation's.
+
+    On the numba engine, greedy episodes after exploring ones play on the greedy loop in
+    "lake_greedy" and on the exploring loop everywhere else, whatever numba's cache holds.
+    """
+    from cartpole_q.engines import numba_engine  # (imports numba: not at collection)
+
     algorithm, params = ALL_VARIANTS[variant]
-    result = train(_config(CASES[world], algorithm, params, engine))
+    with pytest.MonkeyPatch.context() as patch:
+        greedy_loop = world == "lake_greedy"
+        patch.setattr(numba_engine, "plays_greedy_loop", lambda *args: greedy_loop)
+        result = train(_config(CASES[world], algorithm, params, engine))
     expected = _reference(world, variant)
     assert result.engine == engine
     assert result.returns.tolist() == expected.returns
@@ -786,14 +792,14 @@ def test_cartpole_default_grid(world: str, variant: str, engine: str) -> None:
     ("world", "variant", "engine"),
     [
         *_params(["lake", "taxi", "blackjack"], list(VARIANTS)),
-        *_params(["lake_greedy"], LAKE_GREEDY),
+        *(p for p in _params(["lake_greedy"], list(VARIANTS)) if p.values[2] == "numba"),
     ],
 )
 def test_discrete_and_tuple_worlds(world: str, variant: str, engine: str) -> None:
     """Discrete observations (FrozenLake, Taxi) and a Tuple of Discrete (Blackjack).
 
-    On FrozenLake every variant runs on both engines; the greedy loops of those CartPole's
-    twin does not run too.
+    On FrozenLake every variant runs on both engines, and on the numba engine's greedy loop
+    (the gymnasium engine has none).
     """
     _assert_same(world, variant, engine)
 

@@ -102,18 +102,23 @@ def make_engine(
     env_seed: int,
     env_rng_state: dict[str, Any] | None = None,
     twin: TwinSettings | None = None,
+    greedy_loop: bool | None = None,
 ) -> Engine:
     """Build the named engine for a config, seeding its environment with ``env_seed``.
 
     ``env_rng_state`` restores a checkpointed environment generator instead; ``twin`` is
-    the twin's settings when the caller has them (a :class:`~cartpole_q.engines.plan.Plan`).
+    the twin's settings when the caller has them (a :class:`~cartpole_q.engines.plan.Plan`);
+    ``greedy_loop`` is the numba engine's (see
+    :class:`~cartpole_q.engines.numba_engine.NumbaEngine`).
     """
     params = AgentParams.from_config(config, env_info)
     if name == "numba":
         from cartpole_q.engines.numba_engine import NumbaEngine
 
         settings = _twin(config, env_info, twin)
-        return NumbaEngine(settings, params, env_seed, env_rng_state, config.env.randomize)
+        return NumbaEngine(
+            settings, params, env_seed, env_rng_state, config.env.randomize, greedy_loop
+        )
     from cartpole_q.engines.gymnasium_engine import GymnasiumEngine
     from cartpole_q.envs.models import GREEDY_STEP_CAP
 
@@ -122,18 +127,26 @@ def make_engine(
 
 
 def loop_names(
-    config: Config, env_info: EnvInfo, engine: str, twin: TwinSettings | None = None
+    config: Config,
+    env_info: EnvInfo,
+    engine: str,
+    twin: TwinSettings | None = None,
+    greedy_loop: bool | None = None,
 ) -> tuple[str, ...]:
     """The compiled loops a run of ``config`` on ``engine`` calls, as numba's cache names them.
 
     On the numba engine, the training loops its epsilon plays over ``train.episodes`` (see
     :func:`~cartpole_q.engines.base.loops_played`) on ``twin`` (the config's twin when
-    ``None``); on the gymnasium engine, its step functions (named by the one that learns).
+    ``None``), the greedy loop after exploring episodes only where ``greedy_loop`` says
+    (``None``: where it is cached or pays, as
+    :meth:`~cartpole_q.engines.numba_engine.NumbaEngine.loops` decides); on the gymnasium
+    engine, its step functions (named by the one that learns).
     """
     from cartpole_q.engines.base import (
         epsilon_record,
         kernel_name,
         loops_played,
+        plays_greedy_loop,
         step_function_name,
     )
     from cartpole_q.rl.algorithms import get as get_algorithm
@@ -145,11 +158,18 @@ def loop_names(
     if engine == "numba":
         settings = _twin(config, env_info, twin)
         randomized = bool(config.env.randomize)
-        played = loops_played(epsilon_record(config), 0, config.train.episodes)
-        return tuple(
-            kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy, averaged)
-            for greedy in played
-        )
+        epsilon, episodes = epsilon_record(config), config.train.episodes
+        names = {
+            greedy: kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy, averaged)
+            for greedy in loops_played(epsilon, 0, episodes)
+        }  # fmt: skip
+        if len(names) == 2 and greedy_loop is not True:
+            greedy_loop = greedy_loop is None and plays_greedy_loop(
+                names[True], epsilon, 0, episodes, settings.max_episode_steps
+            )
+            if not greedy_loop:
+                del names[True]
+        return tuple(names.values())
     kind = "tiles" if tiled else "values"  # (every other observation as float64 values)
     return (step_function_name("next_step", algorithm.key, kind, averaged),)
 
@@ -181,10 +201,12 @@ def compile_notice(
     )
 
 
-def precompile(config: Config, engine: str) -> None:
+def precompile(config: Config, engine: str, greedy_loop: bool | None = None) -> None:
     """Compile (or load from the cache) what training ``config`` on ``engine`` runs.
 
-    Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up does.
+    Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up does;
+    ``greedy_loop`` as :func:`make_engine` takes it (``True``: the greedy loop as well,
+    wherever the run's epsilon reaches 0).
 
     Raises:
         ConfigError: the config does not fit its environment, or ``engine`` is ``numba`` and
@@ -201,7 +223,7 @@ def precompile(config: Config, engine: str) -> None:
     info = inspect_env(config)
     chosen, twin = engine_and_twin(config, info)
     state = TrainingState.fresh(config, info, np.random.default_rng(0))
-    made = make_engine(chosen, config, info, env_seed=0, twin=twin)
+    made = make_engine(chosen, config, info, env_seed=0, twin=twin, greedy_loop=greedy_loop)
     try:
         made.warm_up(state)
     finally:

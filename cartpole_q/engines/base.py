@@ -8,6 +8,7 @@ compiled loops are built per algorithm (see :mod:`cartpole_q.engines.kernel`).
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from cartpole_q.config import Config, ConfigError, Schedule
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.families import profile_for
+from cartpole_q.numba_cache import is_cached
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
@@ -123,6 +125,54 @@ def loops_played(epsilon: ScheduleRecord, start: int, stop: int) -> tuple[bool, 
         for episode in (start, stop - 1)
     )
     return tuple(sorted({first, last}))
+
+
+GREEDY_LOOP_STEPS = 1_000_000
+"""the greedy env steps a run may play from which it compiles the greedy loop as well"""
+
+
+def greedy_loop_pays(
+    epsilon: ScheduleRecord, start: int, stop: int, time_limit: int | None
+) -> bool:
+    """Whether episodes ``start .. stop - 1`` may play enough greedy steps to compile for.
+
+    A run that explores first and then plays greedy episodes needs only the exploring loop:
+    it plays a greedy episode as well, with epsilon 0 (the same draws: none), about a third
+    slower than the greedy loop, whose compilation takes seconds. So the greedy loop is
+    compiled for such a run only when its greedy episodes may take at least
+    :data:`GREEDY_LOOP_STEPS` env steps (their number times the time limit; no limit:
+    always), where being faster may pay; under that bound it would save a few hundredths
+    of a second. (A cached greedy loop is used anyway: see the numba engine.)
+
+    >>> default = ScheduleRecord(2, 1.0, 0.0, 9.0)  # 0 from episode 89 (0-based) on
+    >>> greedy_loop_pays(default, 0, 1000, 500), greedy_loop_pays(default, 0, 3000, 500)
+    (False, True)
+    >>> greedy_loop_pays(default, 0, 1000, None), greedy_loop_pays(default, 0, 89, None)
+    (True, False)
+    """
+    first_greedy = bisect.bisect_left(
+        range(start, stop),
+        True,
+        key=lambda episode: (
+            not schedule_value(epsilon.kind, epsilon.start, epsilon.end, epsilon.rate, episode)
+            > 0.0
+        ),
+    )
+    greedy_episodes = stop - start - first_greedy
+    if greedy_episodes <= 0:
+        return False
+    return time_limit is None or greedy_episodes * time_limit >= GREEDY_LOOP_STEPS
+
+
+def plays_greedy_loop(
+    greedy_name: str, epsilon: ScheduleRecord, start: int, stop: int, time_limit: int | None
+) -> bool:
+    """Whether a run that explores, then plays greedy episodes, plays those on the greedy loop.
+
+    Where the loop (``greedy_name``) is in numba's cache, loading it costs nothing; else
+    where compiling it pays (:func:`greedy_loop_pays`).
+    """
+    return is_cached(greedy_name) or greedy_loop_pays(epsilon, start, stop, time_limit)
 
 
 class Truth(NamedTuple):

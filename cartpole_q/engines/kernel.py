@@ -18,9 +18,13 @@ A pair has two training loops, each calling its own episode loop: the *exploring
 plays the episodes whose epsilon is positive, the *greedy* one, compiled with epsilon the
 constant 0 (without the generator calls greedy steps skip anyway: a third faster), those
 whose epsilon is 0. Each returns at the first episode that is the other's, and the engine goes on with
-the other; epsilon schedules never rise, so a run switches at most once. A run compiles
-only the loops its schedule plays (a constant positive epsilon: the exploring one alone),
-and a cold start compiles the two side by side.
+the other; epsilon schedules never rise, so a run switches at most once. The exploring
+loop can also play the greedy episodes itself (``plays_greedy``), with epsilon 0: the same
+draws (none), so the same results, a little slower; a run that explores first compiles the
+greedy loop only where its greedy episodes are long enough for that to pay
+(:func:`~cartpole_q.engines.base.greedy_loop_pays`), or finds it cached. A run compiles
+only the loops it plays (a constant positive epsilon: the exploring one alone), and a cold
+start compiles its loop and the greedy play side by side.
 """
 
 from __future__ import annotations
@@ -161,12 +165,15 @@ def train_episodes(
     metrics: EpisodeMetrics, agent_rng: np.random.Generator, env_rng: np.random.Generator,
     env: Any, start: int, stop: int, check_solved: bool, physics_rng: np.random.Generator,
     randomize: tuple[np.ndarray, np.ndarray, np.ndarray], truth: Truth, errors: np.ndarray,
+    plays_greedy: bool,
 ) -> tuple[int, int, int]:  # fmt: skip
     """Train episodes ``start .. stop - 1`` on the twin, up to the first that is the other loop's.
 
     The exploring copy (``GREEDY`` False) plays the episodes whose epsilon is positive and
-    returns at the first whose epsilon is not; the greedy copy the reverse (see the module
-    docstring). An episode handed back is untouched: nothing of it is drawn.
+    returns at the first whose epsilon is not, unless ``plays_greedy``: then it plays those
+    too, with epsilon 0. The greedy copy plays the episodes whose epsilon is not positive
+    and returns at the first that is (see the module docstring). An episode handed back is
+    untouched: nothing of it is drawn.
 
     Args:
         q: the learned table as ``(n_states, n_actions)``, updated in place (on tiles the
@@ -189,6 +196,8 @@ def train_episodes(
         truth: a prediction run's true values; when it measures any, each episode's RMS
             error of ``V`` goes to ``errors`` at the episode's index.
         errors: per-episode errors (empty when nothing is measured).
+        plays_greedy: the exploring copy plays the greedy episodes too (the greedy copy
+            ignores it).
 
     Returns:
         ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
@@ -204,14 +213,16 @@ def train_episodes(
     env_steps = 0
     for episode in range(start, stop):
         epsilon, alpha = episode_rates(agent, episode)
-        if (epsilon > 0.0) == GREEDY:  # the other loop's episode (NaN: the greedy one's)
+        explores = epsilon > 0.0  # (NaN: a greedy episode)
+        if explores == GREEDY and (GREEDY or not plays_greedy):  # the other loop's episode
             return episode, env_steps, -1
         env_params = base_params
         if RANDOMIZED:  # compiled in only where env.randomize draws physics
             env_params = TWIN_RANDOMIZE(base_params, physics_rng, keys, lows, highs)
         episode_return, length = EPISODE(
-            q, visits, memory, params, low, high, bins, starts, gamma, alpha, epsilon,
-            agent_rng, env_rng, env_params, max_steps, env_state, observation,
+            q, visits, memory, params, low, high, bins, starts, gamma, alpha,
+            epsilon if explores else 0.0, agent_rng, env_rng, env_params, max_steps,
+            env_state, observation,
         )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
         if truth.rows.shape[0] > 0:

@@ -20,6 +20,7 @@ from cartpole_q.engines.base import (
     TrainingState,
     loops_played,
     played_until_stopped,
+    plays_greedy_loop,
 )
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
@@ -48,7 +49,22 @@ class NumbaEngine:
         env_seed: int,
         env_rng_state: dict[str, Any] | None = None,
         randomize: Mapping[str, tuple[float, float]] | None = None,
+        greedy_loop: bool | None = None,
     ) -> None:
+        """Build the engine of one run.
+
+        Args:
+            settings: the twin and its settings.
+            params: the agent's parameters as the compiled code takes them.
+            env_seed: seeds the twin's generator as ``reset(seed=env_seed)`` would.
+            env_rng_state: a checkpointed state of that generator, restored instead.
+            randomize: ``env.randomize``'s ranges.
+            greedy_loop: whether greedy episodes that follow exploring ones play on the
+                greedy loop; ``None``: where that is cached or pays (see :meth:`loops`).
+        """
+        self._greedy_loop = greedy_loop
+        self._exploring_alone = False  # the exploring loop plays the greedy episodes too
+        self._time_limit = settings.max_episode_steps
         self._kernel = training_kernel(
             params.algorithm, settings.twin, bool(randomize), params.tiled, params.averaged
         )
@@ -82,8 +98,11 @@ class NumbaEngine:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`).
 
         The exploring and the greedy loop take turns (see :mod:`~cartpole_q.engines.kernel`):
-        each plays episodes up to the first that is the other's.
+        each plays episodes up to the first that is the other's. Where the run plays the
+        exploring loop alone, it plays every episode.
         """
+        if self.loops(state) == (False,):
+            return self._run_loop(False, state, stop, check_solved)
         first = loops_played(self._params.agent.epsilon, state.episode, state.episode + 1)
         greedy = first == (True,)  # the loop of the first episode
         handed_back = False  # the last loop returned without playing an episode
@@ -114,7 +133,7 @@ class NumbaEngine:
         finished, env_steps, solved = loop(
             self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
             self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
-            self._randomize, p.truth, errors,
+            self._randomize, p.truth, errors, self._exploring_alone,
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps
@@ -126,6 +145,24 @@ class NumbaEngine:
             self._hook_tables = (q, self._params.hook_table(q))
         return self._hook_tables[1]
 
+    def loops(self, state: TrainingState) -> tuple[bool, ...]:
+        """The loops the run plays from ``state`` on, as ``greedy`` flags (decided once).
+
+        Those its epsilon plays over the episodes left (up to the configured episodes), but
+        for a run that explores and then plays greedy: it plays the greedy loop only where
+        that is cached or pays (:func:`~cartpole_q.engines.base.plays_greedy_loop`), else
+        the exploring loop alone plays every episode.
+        """
+        epsilon, start, stop = self._params.agent.epsilon, state.episode, len(state.metrics.returns)
+        played = loops_played(epsilon, start, stop)
+        if played == (False, True) and not self._exploring_alone:
+            if self._greedy_loop is None:
+                name = self._kernel.greedy_name
+                self._greedy_loop = plays_greedy_loop(name, epsilon, start, stop, self._time_limit)
+            self._exploring_alone = not self._greedy_loop
+        # (once the exploring loop plays greedy episodes, it plays every later one)
+        return (False,) if played and self._exploring_alone else played
+
     def warm_up(self, state: TrainingState) -> None:
         """Compile the loops the run plays (or load them from the cache); nothing runs.
 
@@ -134,7 +171,7 @@ class NumbaEngine:
         are compiled side by side, in this process and a forked one, which leaves its code
         in numba's cache for this one to load (see :meth:`_compile_side_by_side`).
         """
-        needed = loops_played(self._params.agent.epsilon, state.episode, len(state.metrics.returns))
+        needed = self.loops(state)
         if not all(is_cached(self._kernel.loop(greedy)[0]) for greedy in needed):
             self._compile_side_by_side(state, needed)
         for greedy in needed:

@@ -87,7 +87,8 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
     config = load_config(mapping if mapping is not None else (job.config or None))
     config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm})
     try:
-        precompile(config, job.engine)
+        # (the greedy loop too: a run that finds it cached plays its greedy episodes on it)
+        precompile(config, job.engine, greedy_loop=True)
     except ConfigError as error:  # e.g. an algorithm's parameters a config cannot give
         return f"{SKIPPED} {job.describe()}: {error}"
     return f"compiled {job.describe()}"
