@@ -51,7 +51,7 @@ def _kept_for(function: object) -> list[tuple[object, ...]]:
 
 
 def test_an_inlined_helper_is_translated_once_however_many_calls_inline_it() -> None:
-    assert getattr(InlineWorker.run_untyped_passes, "__reuses_front_ends__", False)
+    assert getattr(InlineWorker.inline_function, "__reuses_front_ends__", False)
     helper = jit(doubled).py_func
     assert three_calls(1.0) == 12.0 and two_more_calls(3.0) == 4.0  # as plain Python
     assert jit(three_calls)(1.0) == 12.0  # 2 + 4 + 6: each call its own argument
@@ -67,6 +67,6 @@ def test_only_the_functions_this_module_built_are_kept() -> None:
 
 
 def test_reusing_is_set_up_once() -> None:
-    patched = InlineWorker.run_untyped_passes
+    patched = InlineWorker.inline_function
     engine_compile.reuse_inlined_front_ends()
-    assert InlineWorker.run_untyped_passes is patched
+    assert InlineWorker.inline_function is patched

@@ -23,7 +23,6 @@ same way. Validation never lets the two meet (sample averages are refused on til
 
 from __future__ import annotations
 
-import copy
 import inspect
 import types
 from collections.abc import Callable, Mapping
@@ -52,51 +51,58 @@ def reuse_inlined_front_ends() -> None:
 
     At every call of an ``inline="always"`` function, numba translates the callee's bytecode
     and runs its untyped passes again, its own inlined callees included, recursively
-    (``InlineWorker.run_untyped_passes``): a quarter of the compile time of the training
-    loops, whose hooks call the same helpers many times. What those passes give depends only
-    on the function and the compile flags, so the first result is kept (in
-    :data:`_FRONT_ENDS`) and each later call gets a copy of its blocks; numba copies a
-    callee's IR again before changing it, so the kept IR stays as it was; each copy gets its
-    own function identity, as numba gives each call, so the inlined variables are named
-    apart. The machine code is the same: the golden hashes and the plain re-derivation check
-    it.
+    (``InlineWorker.inline_function`` calls ``run_untyped_passes``): a quarter of the
+    compile time of the training loops, whose hooks call the same helpers many times. What
+    those passes give depends only on the function and the compile flags, so the first
+    result is kept (in :data:`_FRONT_ENDS`) and each later call inlines it through numba's
+    own ``inline_ir``, which copies the callee's blocks before it changes them (the kept
+    IR stays as it was: no copy of ours is needed). Each call gets its own function
+    identity, as numba gives each call, so the inlined variables are named apart. The
+    machine code is the same: the golden hashes and the plain re-derivation check it.
 
     Only this module's compiled functions are kept (:func:`jit` and :func:`specialise` mark
     them): their globals are a namespace of their own, fixed when they are built, and none
     is a closure, so their IR depends on nothing else. Every other inlined function (numba's
     own, a plug-in's) goes through numba's front end as before.
 
-    Idempotent. Where numba's method does not take the arguments it took when this was
-    written (numba 0.68: ``self, func, enable_ssa``), nothing is changed and compiling only
-    takes longer.
+    Idempotent. Where numba's methods do not take the arguments they took when this was
+    written (numba 0.68), nothing is changed and compiling only takes longer.
     """
     from numba.core.inline_closurecall import InlineWorker
 
-    original = getattr(InlineWorker, "run_untyped_passes", None)
+    original = getattr(InlineWorker, "inline_function", None)
     if original is None or getattr(original, "__reuses_front_ends__", False):
         return
-    if list(inspect.signature(original).parameters) != ["self", "func", "enable_ssa"]:
-        return
+    expected = {
+        "inline_function": ["self", "caller_ir", "block", "i", "function", "arg_typs"],
+        "run_untyped_passes": ["self", "func", "enable_ssa"],
+        "inline_ir": ["self", "caller_ir", "block", "i", "callee_ir", "callee_freevars", "arg_typs"],
+    }  # fmt: skip
+    for name, parameters in expected.items():
+        method = getattr(InlineWorker, name, None)
+        if method is None or list(inspect.signature(method).parameters) != parameters:
+            return
 
-    def run_untyped_passes(self: Any, func: Any, enable_ssa: bool = False) -> Any:
-        if not getattr(func, _KEEPS_FRONT_END, False) or func.__closure__ is not None:
-            return original(self, func, enable_ssa)
+    def inline_function(
+        self: Any, caller_ir: Any, block: Any, i: int, function: Any, arg_typs: Any = None
+    ) -> Any:
+        if not getattr(function, _KEEPS_FRONT_END, False) or function.__closure__ is not None:
+            return original(self, caller_ir, block, i, function, arg_typs)
         flags = self.flags.copy()
-        flags.enable_ssa = False  # set from the argument below: not a flag of the caller's
-        key = (func, enable_ssa, flags)
-        found = _FRONT_ENDS.get(key)
-        if found is None:
-            found = _FRONT_ENDS[key] = original(self, func, enable_ssa)
+        flags.enable_ssa = False  # (numba's run_untyped_passes sets it; not a caller's flag)
+        key = (function, False, flags)
+        kept = _FRONT_ENDS.get(key)
+        if kept is None:
+            kept = _FRONT_ENDS[key] = self.run_untyped_passes(function)
         else:
-            self.flags.enable_ssa = enable_ssa  # as numba's own leaves the caller's flags
-        reused = found.copy()  # its blocks are the kept ones: copied here, one scope for all
-        reused.func_id = found.func_id.derive()  # a new unique name, as each call gets
-        memo: dict[int, Any] = {}
-        reused.blocks = {label: copy.deepcopy(block, memo) for label, block in found.blocks.items()}
-        return reused
+            self.flags.enable_ssa = False  # as numba's run_untyped_passes leaves the flags
+        callee = kept.copy()  # the kept blocks: inline_ir copies them before changing them
+        callee.func_id = kept.func_id.derive()  # a new unique name, as each call gets
+        freevars = function.__code__.co_freevars
+        return self.inline_ir(caller_ir, block, i, callee, freevars, arg_typs=arg_typs)
 
-    run_untyped_passes.__reuses_front_ends__ = True  # type: ignore[attr-defined]
-    InlineWorker.run_untyped_passes = run_untyped_passes  # type: ignore[method-assign]
+    inline_function.__reuses_front_ends__ = True  # type: ignore[attr-defined]
+    InlineWorker.inline_function = inline_function  # type: ignore[method-assign]
 
 
 reuse_inlined_front_ends()
