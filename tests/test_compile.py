@@ -1,15 +1,19 @@
 """How cartpole_q.engines.compile compiles: an inlined helper's front end is run once.
 
 numba inlines a ``compilable`` helper at every call; ``reuse_inlined_front_ends`` keeps the
-untyped IR of each helper the first time and gives later calls a copy. The machine code it
-leads to is checked elsewhere, byte for byte (the golden hashes, the plain re-derivation);
-here, that the IR is kept once per helper (and only for the functions ``compile`` built)
-and that every call still computes its own values.
+untyped IR of each helper the first time and hands it to numba's ``inline_ir`` at later
+calls, which copies it (each scope once). The machine code it leads to is checked
+elsewhere, byte for byte (the golden hashes, the plain re-derivation); here, that the IR is
+kept once per helper (and only for the functions ``compile`` built), that every call still
+computes its own values, and that a copy made while inlining copies a scope once.
 """
 
 from __future__ import annotations
 
+import copy
+
 from numba import njit
+from numba.core import ir
 from numba.core.inline_closurecall import InlineWorker
 
 from cartpole_q.engines import compile as engine_compile
@@ -70,3 +74,19 @@ def test_reusing_is_set_up_once() -> None:
     patched = InlineWorker.inline_function
     engine_compile.reuse_inlined_front_ends()
     assert InlineWorker.inline_function is patched
+
+
+def test_while_inlining_a_functions_blocks_share_one_copy_of_their_scope() -> None:
+    """numba copies a callee block by block; each copied its scope, every variable in it."""
+    loc = ir.Loc("f.py", 1)
+    scope = ir.Scope(None, loc)
+    scope.define("x", loc)
+    blocks = [ir.Block(scope, loc) for _ in range(3)]
+    with engine_compile._one_scope_per_copy():
+        copies = [copy.deepcopy(block) for block in blocks]
+    (shared,) = {id(block.scope) for block in copies}
+    assert shared != id(scope)
+    assert copies[0].scope.get_exact("x").name == "x"
+    assert copies[0].scope.get_exact("x").scope is copies[0].scope
+    assert not hasattr(ir.Scope, "__deepcopy__")  # only while inlining
+    assert len({id(copy.deepcopy(block).scope) for block in blocks}) == 3  # numba's own

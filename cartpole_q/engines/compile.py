@@ -23,9 +23,11 @@ same way. Validation never lets the two meet (sample averages are refused on til
 
 from __future__ import annotations
 
+import contextlib
+import copy
 import inspect
 import types
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from typing import Any
 
 from numba import njit
@@ -99,10 +101,40 @@ def reuse_inlined_front_ends() -> None:
         callee = kept.copy()  # the kept blocks: inline_ir copies them before changing them
         callee.func_id = kept.func_id.derive()  # a new unique name, as each call gets
         freevars = function.__code__.co_freevars
-        return self.inline_ir(caller_ir, block, i, callee, freevars, arg_typs=arg_typs)
+        with _one_scope_per_copy():
+            return self.inline_ir(caller_ir, block, i, callee, freevars, arg_typs=arg_typs)
 
     inline_function.__reuses_front_ends__ = True  # type: ignore[attr-defined]
     InlineWorker.inline_function = inline_function  # type: ignore[method-assign]
+
+
+@contextlib.contextmanager
+def _one_scope_per_copy() -> Iterator[None]:
+    """While inlining: a deep copy of a function's blocks copies their scope once, not per block.
+
+    numba's ``inline_ir`` copies the callee's IR block by block, each ``copy.deepcopy``
+    on its own, so every block copies the scope again, all its variables with it: blocks
+    times variables (the n-step tree backup's ``step``: 72 blocks of 1,039 variables).
+    Within one inlining, a scope is copied once and the other blocks share that copy, as
+    the original blocks share the original scope (numba kept one of the equal copies
+    anyway: the callee must have one scope).
+    """
+    from numba.core.ir import Scope
+
+    copies: dict[int, Any] = {}
+
+    def copied_once(scope: Any, memo: dict[int, Any]) -> Any:
+        found = copies.get(id(scope))
+        if found is None:
+            found = copies[id(scope)] = memo[id(scope)] = Scope.__new__(Scope)
+            found.__dict__.update(copy.deepcopy(scope.__dict__, memo))
+        return found
+
+    Scope.__deepcopy__ = copied_once  # type: ignore[attr-defined]
+    try:
+        yield
+    finally:
+        del Scope.__deepcopy__  # type: ignore[attr-defined]
 
 
 reuse_inlined_front_ends()
