@@ -176,3 +176,33 @@ def test_a_run_compiles_the_greedy_loop_where_it_pays_or_is_cached(
     assert engine.loops(state) == (True,)
     engine, state = engine_and_state(**{"agent.epsilon": 0.0})
     assert engine.loops(state) == (True,)  # the only loop it plays
+    # A run resumed among its greedy episodes plays the loops its first part played.
+    engine, state = engine_and_state()
+    state.episode = 500
+    assert engine.loops(state) == (False,)
+    engine, state = engine_and_state(**{"train.episodes": 3000})
+    state.episode = 500
+    assert engine.loops(state) == (True,)
+
+
+@pytest.mark.parametrize(
+    "overrides",
+    [{}, {"train.episodes": 3000}, {"agent.epsilon": 0.1}, {"agent.epsilon": 0.0}, RANDOMIZE],
+)
+@pytest.mark.parametrize("cached", [False, True])
+def test_a_runs_loops_are_the_loops_its_notice_names(
+    monkeypatch: pytest.MonkeyPatch, overrides: dict[str, Any], cached: bool
+) -> None:
+    """``loop_names`` (the compile notice, a sweep's compile-ahead) and the engine agree."""
+    from cartpole_q.engines import make_engine
+    from cartpole_q.engines.base import TrainingState
+
+    monkeypatch.setattr(cartpole_q.engines.base, "is_cached", lambda name: cached)
+    config = load_config(overrides=overrides)
+    info = inspect_env(config)
+    state = TrainingState.fresh(config, info, np.random.default_rng(0))
+    engine = make_engine("numba", config, info, 0)
+    names = {name.split("__")[0] for name in loop_names(config, info, "numba")}
+    assert names == {
+        f"train_{'greedy' if greedy else 'exploring'}" for greedy in engine.loops(state)
+    }

@@ -522,10 +522,22 @@ def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
     from cartpole_q.engines import numba_engine  # (imports numba: not at collection)
 
     algorithm, params = ALL_VARIANTS[variant]
+    played: set[bool] = set()  # the numba engine's loops, as greedy flags
+    run_loop = numba_engine.NumbaEngine._run_loop
+
+    def recorded(self: Any, greedy: bool, *args: Any, **kwargs: Any) -> Any:
+        played.add(greedy)
+        return run_loop(self, greedy, *args, **kwargs)
+
     with pytest.MonkeyPatch.context() as patch:
         greedy_loop = world == "lake_greedy"
         patch.setattr(numba_engine, "plays_greedy_loop", lambda *args: greedy_loop)
+        patch.setattr(numba_engine.NumbaEngine, "_run_loop", recorded)
         result = train(_config(CASES[world], algorithm, params, engine))
+    if world == "lake_greedy" and engine == "numba":
+        assert played == {False, True}
+    elif False in played:  # a run that explores: its greedy episodes on the exploring loop
+        assert played == {False}
     expected = _reference(world, variant)
     assert result.engine == engine
     assert result.returns.tolist() == expected.returns

@@ -137,8 +137,8 @@ def greedy_loop_pays(
     """Whether episodes ``start .. stop - 1`` may play enough greedy steps to compile for.
 
     A run that explores first and then plays greedy episodes needs only the exploring loop:
-    it plays a greedy episode as well, with epsilon 0 (the same draws: none), about a third
-    slower than the greedy loop, whose compilation takes seconds. So the greedy loop is
+    it plays a greedy episode as well, with epsilon 0 (the same draws: none), where the
+    greedy loop takes about a third less time per step but seconds to compile. So the greedy loop is
     compiled for such a run only when its greedy episodes may take at least
     :data:`GREEDY_LOOP_STEPS` env steps (their number times the time limit; no limit:
     always), where being faster may pay; under that bound it would save a few hundredths

@@ -45,7 +45,8 @@ _KEEPS_FRONT_END = "__cartpole_q_keeps_front_end__"
 """the attribute that marks a function this module built (see :func:`reuse_inlined_front_ends`)"""
 
 _FRONT_ENDS: dict[tuple[Any, ...], Any] = {}
-"""the untyped IR of each function inlined so far: (function, enable_ssa, flags) -> IR"""
+"""the untyped IR of each function inlined so far: (function, enable_ssa (False: numba
+inlines without SSA), flags) -> IR"""
 
 
 def reuse_inlined_front_ends() -> None:
@@ -58,7 +59,7 @@ def reuse_inlined_front_ends() -> None:
     those passes give depends only on the function and the compile flags, so the first
     result is kept (in :data:`_FRONT_ENDS`) and each later call inlines it through numba's
     own ``inline_ir``, which copies the callee's blocks before it changes them (the kept
-    IR stays as it was: no copy of ours is needed). Each call gets its own function
+    IR stays as it was: no deep copy of ours is needed). Each call gets its own function
     identity, as numba gives each call, so the inlined variables are named apart. The
     machine code is the same: the golden hashes and the plain re-derivation check it.
 
@@ -84,6 +85,10 @@ def reuse_inlined_front_ends() -> None:
         method = getattr(InlineWorker, name, None)
         if method is None or list(inspect.signature(method).parameters) != parameters:
             return
+    from numba.core.ir import Scope
+
+    if "__deepcopy__" in vars(Scope):  # (numba copies scopes its own way: left to it)
+        return
 
     def inline_function(
         self: Any, caller_ir: Any, block: Any, i: int, function: Any, arg_typs: Any = None
@@ -130,11 +135,15 @@ def _one_scope_per_copy() -> Iterator[None]:
             found.__dict__.update(copy.deepcopy(scope.__dict__, memo))
         return found
 
+    before = vars(Scope).get("__deepcopy__")
     Scope.__deepcopy__ = copied_once  # type: ignore[attr-defined]
     try:
         yield
     finally:
-        del Scope.__deepcopy__  # type: ignore[attr-defined]
+        if before is None:
+            del Scope.__deepcopy__  # type: ignore[attr-defined]
+        else:
+            Scope.__deepcopy__ = before  # type: ignore[attr-defined]
 
 
 reuse_inlined_front_ends()

@@ -20,11 +20,12 @@ constant 0 (without the generator calls greedy steps skip anyway: a third faster
 whose epsilon is 0. Each returns at the first episode that is the other's, and the engine goes on with
 the other; epsilon schedules never rise, so a run switches at most once. The exploring
 loop can also play the greedy episodes itself (``plays_greedy``), with epsilon 0: the same
-draws (none), so the same results, a little slower; a run that explores first compiles the
-greedy loop only where its greedy episodes are long enough for that to pay
-(:func:`~cartpole_q.engines.base.greedy_loop_pays`), or finds it cached. A run compiles
-only the loops it plays (a constant positive epsilon: the exploring one alone), and a cold
-start compiles its loop and the greedy play side by side.
+draws (none), so the same results, without the greedy loop's third less time per step; a
+run that explores first compiles the greedy loop only where its greedy episodes are long
+enough for that to pay (:func:`~cartpole_q.engines.base.greedy_loop_pays`), or finds it
+cached. A run compiles only the loops it plays (a constant positive epsilon: the
+exploring one alone); on a cold cache, the first loop here and the other (if any) and the
+greedy play in a forked process, side by side.
 """
 
 from __future__ import annotations

@@ -64,6 +64,7 @@ class NumbaEngine:
         """
         self._greedy_loop = greedy_loop
         self._exploring_alone = False  # the exploring loop plays the greedy episodes too
+        self._decided = False  # whether loops() has decided the above
         self._time_limit = settings.max_episode_steps
         self._kernel = training_kernel(
             params.algorithm, settings.twin, bool(randomize), params.tiled, params.averaged
@@ -98,10 +99,11 @@ class NumbaEngine:
         """Train episodes up to ``stop`` (see :class:`~cartpole_q.engines.base.Engine`).
 
         The exploring and the greedy loop take turns (see :mod:`~cartpole_q.engines.kernel`):
-        each plays episodes up to the first that is the other's. Where the run plays the
-        exploring loop alone, it plays every episode.
+        each plays episodes up to the first that is the other's. Where the exploring loop
+        plays the greedy episodes too (see :meth:`loops`), it plays every episode.
         """
-        if self.loops(state) == (False,):
+        self.loops(state)  # (decides, once)
+        if self._exploring_alone:
             return self._run_loop(False, state, stop, check_solved)
         first = loops_played(self._params.agent.epsilon, state.episode, state.episode + 1)
         greedy = first == (True,)  # the loop of the first episode
@@ -151,16 +153,19 @@ class NumbaEngine:
         Those its epsilon plays over the episodes left (up to the configured episodes), but
         for a run that explores and then plays greedy: it plays the greedy loop only where
         that is cached or pays (:func:`~cartpole_q.engines.base.plays_greedy_loop`), else
-        the exploring loop alone plays every episode.
+        the exploring loop alone plays every episode. That is decided over the whole run,
+        from episode 0, as :func:`~cartpole_q.engines.loop_names` decides it: a resumed run
+        plays the loops its first part did.
         """
         epsilon, start, stop = self._params.agent.epsilon, state.episode, len(state.metrics.returns)
+        if not self._decided:
+            self._decided = True
+            if loops_played(epsilon, 0, stop) == (False, True):
+                if self._greedy_loop is None:
+                    name = self._kernel.greedy_name
+                    self._greedy_loop = plays_greedy_loop(name, epsilon, 0, stop, self._time_limit)
+                self._exploring_alone = not self._greedy_loop
         played = loops_played(epsilon, start, stop)
-        if played == (False, True) and not self._exploring_alone:
-            if self._greedy_loop is None:
-                name = self._kernel.greedy_name
-                self._greedy_loop = plays_greedy_loop(name, epsilon, start, stop, self._time_limit)
-            self._exploring_alone = not self._greedy_loop
-        # (once the exploring loop plays greedy episodes, it plays every later one)
         return (False,) if played and self._exploring_alone else played
 
     def warm_up(self, state: TrainingState) -> None:
