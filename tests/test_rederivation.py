@@ -519,6 +519,7 @@ def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
     On the numba engine, greedy episodes after exploring ones play on the greedy loop in
     "lake_greedy" and on the exploring loop everywhere else, whatever numba's cache holds.
     """
+    from cartpole_q.engines import base as engine_base
     from cartpole_q.engines import numba_engine  # (imports numba: not at collection)
 
     algorithm, params = ALL_VARIANTS[variant]
@@ -531,7 +532,7 @@ def _assert_same(world: str, variant: str, engine: str) -> ReferenceRun:
 
     with pytest.MonkeyPatch.context() as patch:
         greedy_loop = world == "lake_greedy"
-        patch.setattr(numba_engine, "plays_greedy_loop", lambda *args: greedy_loop)
+        patch.setattr(engine_base, "plays_greedy_loop", lambda *args: greedy_loop)
         patch.setattr(numba_engine.NumbaEngine, "_run_loop", recorded)
         result = train(_config(CASES[world], algorithm, params, engine))
     if world == "lake_greedy" and engine == "numba":

@@ -137,16 +137,15 @@ def loop_names(
 
     On the numba engine, the training loops its epsilon plays over ``train.episodes`` (see
     :func:`~cartpole_q.engines.base.loops_played`) on ``twin`` (the config's twin when
-    ``None``), the greedy loop after exploring episodes only where ``greedy_loop`` says
-    (``None``: where it is cached or pays, as
-    :meth:`~cartpole_q.engines.numba_engine.NumbaEngine.loops` decides); on the gymnasium
-    engine, its step functions (named by the one that learns).
+    ``None``), the greedy loop after exploring episodes only where
+    :func:`~cartpole_q.engines.base.exploring_plays_greedy` says (as the engine decides);
+    on the gymnasium engine, its step functions (named by the one that learns).
     """
     from cartpole_q.engines.base import (
         epsilon_record,
+        exploring_plays_greedy,
         kernel_name,
         loops_played,
-        plays_greedy_loop,
         step_function_name,
     )
     from cartpole_q.rl.algorithms import get as get_algorithm
@@ -161,15 +160,13 @@ def loop_names(
         epsilon, episodes = epsilon_record(config), config.train.episodes
         names = {
             greedy: kernel_name(algorithm.key, settings.twin.key, randomized, tiled, greedy, averaged)
-            for greedy in loops_played(epsilon, 0, episodes)
+            for greedy in (False, True)
         }  # fmt: skip
-        if len(names) == 2 and greedy_loop is not True:
-            greedy_loop = greedy_loop is None and plays_greedy_loop(
-                names[True], epsilon, 0, episodes, settings.max_episode_steps
-            )
-            if not greedy_loop:
-                del names[True]
-        return tuple(names.values())
+        played = loops_played(epsilon, 0, episodes)
+        limit = settings.max_episode_steps
+        if exploring_plays_greedy(greedy_loop, names[True], epsilon, episodes, limit):
+            played = (False,)
+        return tuple(names[greedy] for greedy in played)
     kind = "tiles" if tiled else "values"  # (every other observation as float64 values)
     return (step_function_name("next_step", algorithm.key, kind, averaged),)
 

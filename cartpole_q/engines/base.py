@@ -175,6 +175,27 @@ def plays_greedy_loop(
     return is_cached(greedy_name) or greedy_loop_pays(epsilon, start, stop, time_limit)
 
 
+def exploring_plays_greedy(
+    greedy_loop: bool | None,
+    greedy_name: str,
+    epsilon: ScheduleRecord,
+    episodes: int,
+    time_limit: int | None,
+) -> bool:
+    """Whether a run's exploring loop plays its greedy episodes too, leaving the greedy loop.
+
+    Only a run that explores and then plays greedy episodes (over its ``episodes``, from
+    0: a resumed run decides as its first part did) has the choice: ``greedy_loop`` makes
+    it (``None``: :func:`plays_greedy_loop`). The numba engine and
+    :func:`~cartpole_q.engines.loop_names` both ask here.
+    """
+    if loops_played(epsilon, 0, episodes) != (False, True):
+        return False
+    if greedy_loop is None:
+        greedy_loop = plays_greedy_loop(greedy_name, epsilon, 0, episodes, time_limit)
+    return not greedy_loop
+
+
 class Truth(NamedTuple):
     """The true values a prediction run's ``V`` is measured against after every episode.
 

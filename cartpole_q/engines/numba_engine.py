@@ -18,9 +18,9 @@ from gymnasium.utils import seeding
 from cartpole_q.engines.base import (
     AgentParams,
     TrainingState,
+    exploring_plays_greedy,
     loops_played,
     played_until_stopped,
-    plays_greedy_loop,
 )
 from cartpole_q.engines.kernel import greedy_kernel, training_kernel
 from cartpole_q.envs.models import GREEDY_STEP_CAP
@@ -63,8 +63,7 @@ class NumbaEngine:
                 greedy loop; ``None``: where that is cached or pays (see :meth:`loops`).
         """
         self._greedy_loop = greedy_loop
-        self._exploring_alone = False  # the exploring loop plays the greedy episodes too
-        self._decided = False  # whether loops() has decided the above
+        self._exploring_alone: bool | None = None  # decided by loops(), once
         self._time_limit = settings.max_episode_steps
         self._kernel = training_kernel(
             params.algorithm, settings.twin, bool(randomize), params.tiled, params.averaged
@@ -135,7 +134,7 @@ class NumbaEngine:
         finished, env_steps, solved = loop(
             self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
             self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
-            self._randomize, p.truth, errors, self._exploring_alone,
+            self._randomize, p.truth, errors, bool(self._exploring_alone),
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps
@@ -152,19 +151,15 @@ class NumbaEngine:
 
         Those its epsilon plays over the episodes left (up to the configured episodes), but
         for a run that explores and then plays greedy: it plays the greedy loop only where
-        that is cached or pays (:func:`~cartpole_q.engines.base.plays_greedy_loop`), else
-        the exploring loop alone plays every episode. That is decided over the whole run,
-        from episode 0, as :func:`~cartpole_q.engines.loop_names` decides it: a resumed run
-        plays the loops its first part did.
+        that is cached or pays, else the exploring loop alone plays every episode (see
+        :func:`~cartpole_q.engines.base.exploring_plays_greedy`, which
+        :func:`~cartpole_q.engines.loop_names` asks too).
         """
         epsilon, start, stop = self._params.agent.epsilon, state.episode, len(state.metrics.returns)
-        if not self._decided:
-            self._decided = True
-            if loops_played(epsilon, 0, stop) == (False, True):
-                if self._greedy_loop is None:
-                    name = self._kernel.greedy_name
-                    self._greedy_loop = plays_greedy_loop(name, epsilon, 0, stop, self._time_limit)
-                self._exploring_alone = not self._greedy_loop
+        if self._exploring_alone is None:
+            self._exploring_alone = exploring_plays_greedy(
+                self._greedy_loop, self._kernel.greedy_name, epsilon, stop, self._time_limit
+            )
         played = loops_played(epsilon, start, stop)
         return (False,) if played and self._exploring_alone else played
 
