@@ -45,8 +45,7 @@ _KEEPS_FRONT_END = "__cartpole_q_keeps_front_end__"
 """the attribute that marks a function this module built (see :func:`reuse_inlined_front_ends`)"""
 
 _FRONT_ENDS: dict[tuple[Any, ...], Any] = {}
-"""the untyped IR of each function inlined so far: (function, enable_ssa (False: numba
-inlines without SSA), flags) -> IR"""
+"""the untyped IR of each function inlined so far: (function, flags) -> IR"""
 
 
 def reuse_inlined_front_ends() -> None:
@@ -97,7 +96,7 @@ def reuse_inlined_front_ends() -> None:
             return original(self, caller_ir, block, i, function, arg_typs)
         flags = self.flags.copy()
         flags.enable_ssa = False  # (numba's run_untyped_passes sets it; not a caller's flag)
-        key = (function, False, flags)
+        key = (function, flags)
         kept = _FRONT_ENDS.get(key)
         if kept is None:
             kept = _FRONT_ENDS[key] = self.run_untyped_passes(function)
