@@ -219,6 +219,7 @@ def specialise(
     bindings: Mapping[str, Any],
     *,
     inline: bool = False,
+    callee: bool = False,
     tiled: bool = False,
     averaged: bool = False,
 ) -> Dispatcher:
@@ -233,6 +234,9 @@ def specialise(
             as :func:`jit` does: an algorithm's hooks).
         inline: inline the copy where compiled code calls it (then it is not cached by
             itself: its callers' cache entries hold it).
+        callee: only compiled code calls the copy (an episode loop): it is compiled without
+            the wrapper that lets Python call it, whose unboxing of every argument costs
+            about a tenth of a training pair's compile; called from Python, it fails.
         tiled: compile for tile-coded tables (see the module docstring); ``name`` must say so.
         averaged: compile for sample averages (see the module docstring); ``name`` must say so.
     """
@@ -251,4 +255,5 @@ def specialise(
     setattr(function, _KEEPS_FRONT_END, True)
     if inline:
         return njit(nogil=True, inline="always")(function)
-    return njit(nogil=True, cache=True)(function)
+    # No C-callable wrapper either: nothing takes these functions' addresses.
+    return njit(nogil=True, cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=callee)(function)

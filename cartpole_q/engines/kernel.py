@@ -328,6 +328,7 @@ def _training_kernel(
             twin_episode,
             f"{'greedy' if greedy else 'exploring'}_episode__{pair}",
             {**hooks, "GREEDY": greedy},
+            callee=True,
             tiled=tiled,
             averaged=averaged,
         )
