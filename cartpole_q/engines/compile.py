@@ -255,5 +255,8 @@ def specialise(
     setattr(function, _KEEPS_FRONT_END, True)
     if inline:
         return njit(nogil=True, inline="always")(function)
-    # No C-callable wrapper either: nothing takes these functions' addresses.
-    return njit(nogil=True, cache=True, no_cfunc_wrapper=True, no_cpython_wrapper=callee)(function)
+    # No C-callable wrapper either: nothing takes these functions' addresses. (numba's
+    # stubs do not list these two options of its CPU target.)
+    wrappers: dict[str, Any] = {"no_cfunc_wrapper": True, "no_cpython_wrapper": callee}
+    compiled: Dispatcher = njit(nogil=True, cache=True, **wrappers)(function)
+    return compiled

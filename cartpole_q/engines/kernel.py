@@ -60,8 +60,6 @@ ALGORITHM_END: Any = None
 TWIN_RESET: Any = None
 TWIN_STEP: Any = None
 TWIN_RANDOMIZE: Any = None
-TWIN_STATE_DTYPE: Any = None
-TWIN_OBSERVATION_DTYPE: Any = None
 OBSERVATION_STATE: Any = None
 STEP_SIZE: Any = None
 """bound to :func:`scheduled_step_size`, or :func:`update_counts` under sample averages"""
@@ -187,8 +185,10 @@ def train_episodes(
         metrics: per-episode metrics, written at each episode's index.
         agent_rng: the agent's generator (exploration, and the algorithm's own draws).
         env_rng: the twin's generator (resets, and the steps of a world that draws).
-        env: ``(max_episode_steps, state_size, observation_size, params)`` of the twin
-            (no time limit: the largest int64).
+        env: ``(max_episode_steps, state, observation, params)`` of the twin (no time
+            limit: the largest int64; ``state`` and ``observation`` are the twin's scratch
+            arrays, which every reset overwrites: made by the caller, so that no compiled
+            loop compiles numba's array allocation).
         start: the first episode (0-based) to train.
         stop: train up to this episode, excluded.
         check_solved: stop right after the first solving episode.
@@ -205,11 +205,9 @@ def train_episodes(
         right after the solve episode when ``check_solved``, and before an episode that
         is the other loop's (then ``episodes finished < stop`` and no solve).
     """
-    max_steps, state_size, observation_size, base_params = env
+    max_steps, env_state, observation, base_params = env
     keys, lows, highs = randomize
     low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
-    env_state = np.empty(state_size, dtype=TWIN_STATE_DTYPE)
-    observation = np.empty(observation_size, dtype=TWIN_OBSERVATION_DTYPE)
     gamma = agent.gamma
     env_steps = 0
     for episode in range(start, stop):
@@ -235,19 +233,16 @@ def train_episodes(
 
 
 def greedy_returns(
-    q: Any, grid: Grid, env_rng: np.random.Generator, env: Any, episodes: int
+    q: Any, grid: Grid, env_rng: np.random.Generator, env: Any, returns: np.ndarray
 ) -> np.ndarray:
-    """The greedy policy's return in each of ``episodes`` twin episodes.
+    """The greedy policy's return in each of ``len(returns)`` twin episodes, into ``returns``.
 
-    ``env`` as :func:`train_episodes` takes it, with the greedy step cap as the time limit
-    of an environment that has none.
+    ``returns`` comes in zeroed; ``env`` as :func:`train_episodes` takes it, with the greedy
+    step cap as the time limit of an environment that has none.
     """
-    max_steps, state_size, observation_size, params = env
+    max_steps, env_state, observation, params = env
     low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
-    env_state = np.empty(state_size, dtype=TWIN_STATE_DTYPE)
-    observation = np.empty(observation_size, dtype=TWIN_OBSERVATION_DTYPE)
-    returns = np.zeros(episodes, dtype=np.float64)
-    for episode in range(episodes):
+    for episode in range(returns.shape[0]):
         TWIN_RESET(env_state, observation, env_rng, params)
         for length in range(1, max_steps + 1):
             state = OBSERVATION_STATE(q, observation, low, high, bins, starts, -1)
@@ -338,8 +333,6 @@ def _training_kernel(
             "GREEDY": greedy,
             "TWIN_RANDOMIZE": twin.randomize,
             "RANDOMIZED": randomized,
-            "TWIN_STATE_DTYPE": twin.state_dtype,
-            "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
         }
         loops += [
             name,
@@ -360,7 +353,5 @@ def twin_bindings(twin: Twin, tiled: bool = False) -> dict[str, Any]:
     return {
         "TWIN_RESET": twin.reset,
         "TWIN_STEP": twin.step,
-        "TWIN_STATE_DTYPE": twin.state_dtype,
-        "TWIN_OBSERVATION_DTYPE": twin.observation_dtype,
         "OBSERVATION_STATE": ARRAY_STATE_RULES["tiles" if tiled else twin.observation_kind],
     }

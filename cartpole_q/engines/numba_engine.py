@@ -72,13 +72,17 @@ class NumbaEngine:
         limit = settings.max_episode_steps
         self._env = (
             NO_TIME_LIMIT if limit is None else limit,
-            settings.state_size,
-            settings.observation_size,
+            *_scratch(settings),
             settings.params,
         )
         # Greedy play stops at the step cap where the environment has no time limit, as
-        # the gymnasium engine's evaluations do (a greedy policy may walk in circles).
-        self._greedy_env = (GREEDY_STEP_CAP if limit is None else limit, *self._env[1:])
+        # the gymnasium engine's evaluations do (a greedy policy may walk in circles). Its
+        # own scratch arrays: an evaluation may come between two turns of training.
+        self._greedy_env = (
+            GREEDY_STEP_CAP if limit is None else limit,
+            *_scratch(settings),
+            settings.params,
+        )
         self._params = params
         self._hook_tables: tuple[Any, Any] = (None, None)  # (q, the hooks' view of it)
         ranges = randomize or {}
@@ -240,7 +244,8 @@ class NumbaEngine:
         table, grid, env = self._params.hook_table(q), self._params.grid, self._greedy_env
 
         def play(count: int) -> np.ndarray:
-            returns: np.ndarray = self._greedy_returns(table, grid, env_rng, env, count)
+            returns = np.zeros(count, dtype=np.float64)
+            self._greedy_returns(table, grid, env_rng, env, returns)
             return returns
 
         if should_stop is None:
@@ -253,3 +258,12 @@ class NumbaEngine:
 
     def close(self) -> None:
         """Nothing to release."""
+
+
+def _scratch(settings: TwinSettings) -> tuple[np.ndarray, np.ndarray]:
+    """A twin's state and observation arrays, as its reset and step fill them."""
+    twin = settings.twin
+    return (
+        np.empty(settings.state_size, dtype=twin.state_dtype),
+        np.empty(settings.observation_size, dtype=twin.observation_dtype),
+    )
