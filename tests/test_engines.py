@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -269,3 +275,41 @@ def test_every_package_twin_loads_through_a_function_mypy_checks() -> None:
             ), (profile.name, module.__name__)
             loaded.add(module.__name__)
     assert len(loaded) == 8  # cartpole, mountaincar, acrobot, tables (2), taxi, blackjack (2)
+
+
+COLD_WARM_UP = """
+import json, sys
+import numpy as np
+from cartpole_q.config import load_config
+from cartpole_q.engines import make_engine
+from cartpole_q.engines.base import TrainingState
+from cartpole_q.envs.gym import inspect_env
+
+config = load_config(overrides={"env.id": "FrozenLake-v1", "train.episodes": 3})
+info = inspect_env(config)
+state = TrainingState.fresh(config, info, np.random.default_rng(0))
+engine = make_engine("numba", config, info, env_seed=0)
+engine.warm_up(state)
+stats = engine._kernel.exploring.stats
+print(json.dumps({
+    "hits": sum(stats.cache_hits.values()), "misses": sum(stats.cache_misses.values()),
+    "figure_imported": "matplotlib.figure" in sys.modules,
+}))
+"""
+
+
+@pytest.mark.slow
+def test_a_cold_warm_up_loads_the_childs_loop_and_imports_for_the_outputs_meanwhile(
+    tmp_path: Path,
+) -> None:
+    """On an empty cache a forked child compiles the exploring loop; this process compiles
+    the greedy play, imports matplotlib for the run's figure, and loads the child's loop."""
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "empty-cache")}
+    env.pop("NUMBA_CACHE_DIR", None)
+    done = subprocess.run(
+        [sys.executable, "-c", COLD_WARM_UP], env=env, capture_output=True, text=True,
+        check=False, timeout=300,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    seen = json.loads(done.stdout.strip().splitlines()[-1])
+    assert seen == {"hits": 1, "misses": 0, "figure_imported": True}

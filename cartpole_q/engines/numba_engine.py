@@ -194,17 +194,19 @@ class NumbaEngine:
     def _compile_side_by_side(self, state: TrainingState, needed: tuple[bool, ...]) -> None:
         """Compile the loops ``needed`` and the greedy play, in two processes at once.
 
-        The first loop needed (the exploring one, the larger compilation, when both are)
-        here; the other, if any, and the greedy play in a forked child, which writes numba's
-        cache and exits; this process then loads the child's code from there. Where a
-        process cannot fork (or has threads, where forking is unsafe), everything is
-        compiled here, one after another.
+        The first loop needed (the exploring one, the larger compilation, when both are) in
+        a forked child, which writes numba's cache and exits; the other, if any, and the
+        greedy play here, and then what writing the run will need is imported (see
+        :func:`_import_for_outputs`) while the child finishes: the run loads the child's
+        code from the cache. Where a process cannot fork (or has threads, where forking is
+        unsafe), everything is compiled here, one after another.
 
         The child leaves signals to this process (a Ctrl-C to the terminal reaches both: the
-        command answers it once) and dies with it; if this process stops compiling (a second
-        Ctrl-C), the child is killed, not waited for.
+        command answers it once) and dies with it; if this process stops (a second Ctrl-C,
+        or a failure here), the child is killed, not waited for. Should the child fail, the
+        run compiles that loop itself, where its error is raised.
         """
-        plays = not self._params.algorithm.predicts  # the greedy play, compiled in the child
+        plays = not self._params.algorithm.predicts  # the greedy play, compiled here
         if (
             not hasattr(os, "fork")
             or threading.active_count() > 1
@@ -217,15 +219,16 @@ class NumbaEngine:
             code = 1
             try:
                 leave_signals_to_parent(parent)
-                for greedy in needed[1:]:
-                    self._load(state, greedy)
-                if plays:
-                    self.evaluate(state.tables.q.copy(), 0, 0)
+                self._load(state, needed[0])
                 code = 0
             finally:
                 os._exit(code)
         try:
-            self._load(state, needed[0])
+            for greedy in needed[1:]:
+                self._load(state, greedy)
+            if plays:
+                self.evaluate(state.tables.q.copy(), 0, 0)
+            _import_for_outputs()
         except BaseException:
             os.kill(child, signal.SIGKILL)  # its half-compiled loop is worth nothing
             raise
@@ -267,3 +270,19 @@ def _scratch(settings: TwinSettings) -> tuple[np.ndarray, np.ndarray]:
         np.empty(settings.state_size, dtype=twin.state_dtype),
         np.empty(settings.observation_size, dtype=twin.observation_dtype),
     )
+
+
+def _import_for_outputs() -> None:
+    """Import matplotlib's figure and PNG writing, as a run's outputs will (about 0.4 s).
+
+    Called while a forked child compiles the run's loop, when this process would otherwise
+    wait: the import is then off a cold start's critical path. Nothing else changes; a
+    missing module is left for the outputs to report.
+    """
+    import importlib
+
+    for name in ("matplotlib.figure", "matplotlib.backends.backend_agg", "PIL.PngImagePlugin"):
+        try:
+            importlib.import_module(name)
+        except ImportError:
+            return
