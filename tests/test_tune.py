@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import json
 import os
 import signal
 import subprocess
@@ -188,7 +189,7 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
         deadline = time.monotonic() + 120
-        while sum(t.state.name == "COMPLETE" for t in _read_or_empty(out)) < 2:
+        while _completed_in_journal(out) < 2:
             assert process.poll() is None, process.stderr.read() if process.stderr else ""
             assert time.monotonic() < deadline
             time.sleep(0.05)
@@ -203,13 +204,42 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     assert not [t for t in trials if t.state.name == "RUNNING"]
 
 
-def _read_or_empty(directory: Path) -> list[Any]:
-    if not (directory / tunedir.JOURNAL_FILE).is_file():
+def _journal_entries(directory: Path) -> list[dict[str, Any]]:
+    """The journal's operations, read from its lines as they are written (a line being
+    written is skipped). Loading the study instead, twenty times a second, took a core
+    from the study it watched."""
+    path = directory / tunedir.JOURNAL_FILE
+    if not path.is_file():
         return []
-    try:
-        return _journal_trials(directory)
-    except Exception:  # the study is not created yet
-        return []
+    entries = []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        try:
+            entries.append(json.loads(line))
+        except ValueError:
+            continue
+    return entries
+
+
+def _completed_in_journal(directory: Path) -> int:
+    """How many trials the journal marks complete."""
+    from optuna.storages.journal._storage import JournalOperation
+    from optuna.trial import TrialState
+
+    return sum(
+        entry.get("op_code") == JournalOperation.SET_TRIAL_STATE_VALUES.value
+        and entry.get("state") == TrialState.COMPLETE.value
+        for entry in _journal_entries(directory)
+    )
+
+
+def _created_in_journal(directory: Path) -> int:
+    """How many trials the journal has created."""
+    from optuna.storages.journal._storage import JournalOperation
+
+    return sum(
+        entry.get("op_code") == JournalOperation.CREATE_TRIAL
+        for entry in _journal_entries(directory)
+    )
 
 
 @pytest.mark.slow
@@ -267,7 +297,7 @@ def test_sigterm_ends_a_study_with_130_and_resume_finishes_it(tmp_path: Path) ->
     out = tmp_path / "out"
     process = start_command(tmp_path, "tune", path, "--out", out, "--workers", 2, "-q")
     deadline = time.monotonic() + 120
-    while sum(t.state.name == "COMPLETE" for t in _read_or_empty(out)) < 1:
+    while _completed_in_journal(out) < 1:
         assert process.poll() is None, (tmp_path / "stderr").read_text()
         assert time.monotonic() < deadline
         time.sleep(0.05)
@@ -490,7 +520,7 @@ def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path:
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
         deadline = time.monotonic() + 120
-        while not (out / ".lock").is_file() or not _read_or_empty(out):
+        while not (out / ".lock").is_file() or not _created_in_journal(out):
             assert process.poll() is None
             assert time.monotonic() < deadline
             time.sleep(0.05)
