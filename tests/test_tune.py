@@ -204,11 +204,10 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     assert not [t for t in trials if t.state.name == "RUNNING"]
 
 
-def _journal_entries(directory: Path) -> list[dict[str, Any]]:
-    """The journal's operations, read from its lines as they are written (a line being
+def _journal_entries(path: Path) -> list[dict[str, Any]]:
+    """A journal file's operations, read from its lines as they are written (a line being
     written is skipped). Loading the study instead, twenty times a second, took a core
     from the study it watched."""
-    path = directory / tunedir.JOURNAL_FILE
     if not path.is_file():
         return []
     entries = []
@@ -228,18 +227,16 @@ def _completed_in_journal(directory: Path) -> int:
     return sum(
         entry.get("op_code") == JournalOperation.SET_TRIAL_STATE_VALUES.value
         and entry.get("state") == TrialState.COMPLETE.value
-        for entry in _journal_entries(directory)
+        for entry in _journal_entries(directory / tunedir.JOURNAL_FILE)
     )
 
 
-def _created_in_journal(directory: Path) -> int:
-    """How many trials the journal has created."""
+def _created_in_journal(path: Path) -> int:
+    """How many trials a journal file has created."""
     from optuna.storages.journal._storage import JournalOperation
 
-    return sum(
-        entry.get("op_code") == JournalOperation.CREATE_TRIAL
-        for entry in _journal_entries(directory)
-    )
+    created = JournalOperation.CREATE_TRIAL.value
+    return sum(entry.get("op_code") == created for entry in _journal_entries(path))
 
 
 @pytest.mark.slow
@@ -254,7 +251,7 @@ def test_two_processes_share_one_study_without_duplicating_trials(tmp_path: Path
     journal = tmp_path / "shared.journal"
     first = _start(tmp_path, path, "--out", tmp_path / "one", "--storage", journal, "--workers", 1)
     deadline = time.monotonic() + 120
-    while not _storage_trials(journal, "small"):
+    while not _created_in_journal(journal):
         assert first.poll() is None
         assert time.monotonic() < deadline
         time.sleep(0.05)
@@ -520,7 +517,7 @@ def test_a_second_writer_of_a_tune_directory_is_refused_naming_its_pid(tmp_path:
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
         deadline = time.monotonic() + 120
-        while not (out / ".lock").is_file() or not _created_in_journal(out):
+        while not (out / ".lock").is_file() or not _created_in_journal(out / tunedir.JOURNAL_FILE):
             assert process.poll() is None
             assert time.monotonic() < deadline
             time.sleep(0.05)
