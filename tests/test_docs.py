@@ -26,6 +26,7 @@ import pytest
 import typer.main
 import yaml
 
+from tests.command_server import command_server
 from tests.conftest import REPO
 
 DOCS = REPO / "docs"
@@ -207,20 +208,21 @@ def _run_page(page: Path, workdir: Path) -> None:
         "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}",
         "MPLBACKEND": "Agg",
     }
-    for block in blocks(page):
-        if block.title is not None:
-            (workdir / block.title).write_text(block.body, encoding="utf-8")
-        if not block.runs:
-            continue
-        command = shrink(block.body)
-        done = subprocess.run(
-            ["bash", "-euo", "pipefail", "-c", command],
-            cwd=workdir, env=env, capture_output=True, text=True, check=False,
-        )  # fmt: skip
-        assert done.returncode == 0, (
-            f"{page.name}: this block failed (exit {done.returncode}):\n{command}\n"
-            f"stdout:\n{done.stdout[-3000:]}\nstderr:\n{done.stderr[-3000:]}"
-        )
+    with command_server(env) as served:
+        for block in blocks(page):
+            if block.title is not None:
+                (workdir / block.title).write_text(block.body, encoding="utf-8")
+            if not block.runs:
+                continue
+            command = shrink(block.body)
+            done = subprocess.run(
+                ["bash", "-euo", "pipefail", "-c", command],
+                cwd=workdir, env=served, capture_output=True, text=True, check=False,
+            )  # fmt: skip
+            assert done.returncode == 0, (
+                f"{page.name}: this block failed (exit {done.returncode}):\n{command}\n"
+                f"stdout:\n{done.stdout[-3000:]}\nstderr:\n{done.stderr[-3000:]}"
+            )
 
 
 @pytest.mark.slow
