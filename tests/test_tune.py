@@ -204,6 +204,30 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     assert not [t for t in trials if t.state.name == "RUNNING"]
 
 
+def test_a_killed_writers_journal_lock_is_taken_over_at_once_on_resume(tmp_path: Path) -> None:
+    """A kill -9 in the middle of a journal write leaves Optuna's lock behind: the resume
+    removes it (Optuna would wait 30 s for it); a shared journal's lock is left alone."""
+    from optuna.storages.journal import JournalFileSymlinkLock
+
+    from cartpole_q.experiments.tune import load_tune_dir
+
+    path = write_yaml(tmp_path / "t.yaml", {**TUNE, "trials": 1})
+    shared = tmp_path / "shared.journal"
+    for out, storage in ((tmp_path / "own", None), (tmp_path / "shared", shared)):
+        extra = () if storage is None else ("--storage", storage)
+        assert invoke("tune", path, "--out", out, *extra, "-q").exit_code == 0
+        journal = out / tunedir.JOURNAL_FILE if storage is None else storage
+        JournalFileSymlinkLock(str(journal)).acquire()  # a writer killed while it held it
+        lock = journal.with_name(journal.name + tunedir.JOURNAL_LOCK_SUFFIX)
+        assert lock.is_symlink()  # (the suffix is Optuna's)
+        load_tune_dir(out)
+        assert lock.is_symlink() == (storage is not None)
+        lock.unlink(missing_ok=True)
+    result = invoke("tune", "--resume", tmp_path / "own", "--trials", 2, "-q")
+    assert result.exit_code == 0, result.output
+    assert "taking longer" not in result.output
+
+
 def _journal_entries(path: Path) -> list[dict[str, Any]]:
     """A journal file's operations, read from its lines as they are written (a line being
     written is skipped). Loading the study instead, twenty times a second, took a core

@@ -365,6 +365,8 @@ def load_tune_dir(directory: Path) -> tuple[TuneSpec, str | None]:
     """The tune file and storage URL of a tune directory (``--resume``; hold its lock)."""
     data, storage_url = tunedir.tune_file(directory)
     remove_stale_temporaries(directory)  # the caller holds the lock: none is in use
+    if storage_url is None:  # the directory's own journal: no other process writes it
+        tunedir.remove_stale_journal_lock(directory)
     return load_tune(data, label=str(directory / tunedir.TUNE_FILE)), storage_url
 
 

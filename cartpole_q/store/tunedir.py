@@ -30,6 +30,9 @@ if TYPE_CHECKING:
 
 TUNE_FILE = "tune.yaml"
 JOURNAL_FILE = "study.journal"
+JOURNAL_LOCK_SUFFIX = ".lock"
+"""Optuna's lock of a journal file (``JournalFileSymlinkLock``): a link named the journal's
+path with this suffix, there while a process writes the journal"""
 TRIALS_FILE = "trials.csv"
 BEST_FILE = "best.yaml"
 HISTORY_FILE = "history.png"
@@ -71,6 +74,23 @@ def tune_file(directory: Path) -> tuple[dict[str, Any], str | None]:
     if storage is not None and not isinstance(storage, str):
         raise ConfigError(f"{path}: storage: must be an Optuna storage URL or null.")
     return data, storage
+
+
+def remove_stale_journal_lock(directory: Path) -> bool:
+    """Remove the lock of the tune directory's own journal; say whether there was one.
+
+    Only the process holding the directory's lock writes its own journal, so when that
+    process starts, a journal lock left behind is a killed writer's (a kill -9 in the
+    middle of a write). Optuna would wait 30 seconds before taking it over, with a warning
+    every ten. Call it holding the directory's lock, before any process of this command
+    writes the journal; a journal in a storage given with ``--storage`` is shared, and
+    not touched.
+    """
+    lock = directory / (JOURNAL_FILE + JOURNAL_LOCK_SUFFIX)
+    if not lock.is_symlink() and not lock.exists():
+        return False
+    lock.unlink(missing_ok=True)
+    return True
 
 
 def write_trials(directory: Path, header: Sequence[str], rows: Iterable[Mapping[str, str]]) -> None:
