@@ -189,7 +189,7 @@ def test_a_study_killed_with_sigkill_resumes_to_the_requested_trials(tmp_path: P
     process = _start(tmp_path, path, "--out", out, "--workers", 1)
     try:
         deadline = time.monotonic() + 120
-        while _completed_in_journal(out) < 2:
+        while _completed_in_journal(out / tunedir.JOURNAL_FILE) < 2:
             assert process.poll() is None, process.stderr.read() if process.stderr else ""
             assert time.monotonic() < deadline
             time.sleep(0.05)
@@ -243,15 +243,15 @@ def _journal_entries(path: Path) -> list[dict[str, Any]]:
     return entries
 
 
-def _completed_in_journal(directory: Path) -> int:
-    """How many trials the journal marks complete."""
+def _completed_in_journal(path: Path) -> int:
+    """How many trials a journal file marks complete."""
     from optuna.storages.journal._storage import JournalOperation
     from optuna.trial import TrialState
 
     return sum(
         entry.get("op_code") == JournalOperation.SET_TRIAL_STATE_VALUES.value
         and entry.get("state") == TrialState.COMPLETE.value
-        for entry in _journal_entries(directory / tunedir.JOURNAL_FILE)
+        for entry in _journal_entries(path)
     )
 
 
@@ -318,7 +318,7 @@ def test_sigterm_ends_a_study_with_130_and_resume_finishes_it(tmp_path: Path) ->
     out = tmp_path / "out"
     process = start_command(tmp_path, "tune", path, "--out", out, "--workers", 2, "-q")
     deadline = time.monotonic() + 120
-    while _completed_in_journal(out) < 1:
+    while _completed_in_journal(out / tunedir.JOURNAL_FILE) < 1:
         assert process.poll() is None, (tmp_path / "stderr").read_text()
         assert time.monotonic() < deadline
         time.sleep(0.05)
