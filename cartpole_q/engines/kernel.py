@@ -24,8 +24,8 @@ draws (none), so the same results, without the greedy loop's third less time per
 run that explores first compiles the greedy loop only where its greedy episodes are long
 enough for that to pay (:func:`~cartpole_q.engines.base.greedy_loop_pays`), or finds it
 cached. A run compiles only the loops it plays (a constant positive epsilon: the
-exploring one alone); on a cold cache, the first loop here and the other (if any) and the
-greedy play in a forked process, side by side.
+exploring one alone); on a cold cache, the first loop in a forked process and the other
+(if any) and the greedy play here, side by side.
 """
 
 from __future__ import annotations
