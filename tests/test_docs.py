@@ -5,7 +5,8 @@ directory per page, after the page's files (fences with ``title="NAME"``) are wr
 there. A block that cannot run here is preceded by ``<!-- not run: REASON -->``. The
 commands run as printed, on smaller settings: a seed range ``A-B`` becomes ``A-(A+1)`` (two
 seeds), and the study files under ``examples/`` are copied with two seeds and a few trials
-(the book's, ``examples/book/``, with two values per sweep axis).
+(the book's, ``examples/book/``, with two values per sweep axis and long runs cut to a
+hundredth).
 Each figure a tutorial shows must be written by a command printed on its page (its path
 from the repository's root, e.g. ``docs/reward_curves.png``), and is, when the page runs.
 """
@@ -91,9 +92,10 @@ def shrink_study(path: Path, axes: bool = False) -> None:
     """A sweep or tune file on small settings (comments dropped).
 
     Two seeds, a few trials, and with ``axes`` each sweep axis cut to its first and last
-    values (a zip's axes, and an ``until_optimal`` study's ``scales``, to their first two):
-    the study keeps its shape and its figure, on fewer points (for studies whose points no
-    page names by number: the book's).
+    values (a zip's axes, and an ``until_optimal`` study's ``scales``, to their first two)
+    and runs of over :data:`MOST_EPISODES` episodes to a hundredth (:func:`fewer_episodes`):
+    the study keeps its shape and its figure, on fewer points and shorter runs (for studies
+    whose points no page names by number: the book's).
     """
     data = yaml.safe_load(path.read_text(encoding="utf-8"))
     if not isinstance(data, dict):
@@ -111,7 +113,27 @@ def shrink_study(path: Path, axes: bool = False) -> None:
                 data["zip"][key] = values[:2]
         if isinstance(data.get("scales"), list):  # an until_optimal study's maze sizes
             data["scales"] = data["scales"][:2]
+        train = (data.get("base") or {}).get("train") or {}
+        if isinstance(train.get("episodes"), int):
+            train["episodes"] = fewer_episodes(train["episodes"])
+        for axis in ("grid", "zip"):
+            values = (data.get(axis) or {}).get("train.episodes")
+            if isinstance(values, list):
+                data[axis]["train.episodes"] = [fewer_episodes(value) for value in values]
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+
+
+MOST_EPISODES = 1000
+"""a book study's runs in the tests: longer ones are cut to a hundredth, at least this many"""
+
+
+def fewer_episodes(episodes: int) -> int:
+    """A book study's episodes in the tests: a hundredth of a long run (the figure's shape).
+
+    >>> fewer_episodes(300), fewer_episodes(10_000), fewer_episodes(5_000_000)
+    (300, 1000, 50000)
+    """
+    return episodes if episodes <= MOST_EPISODES else max(MOST_EPISODES, episodes // 100)
 
 
 def figures(page: Path) -> list[str]:
@@ -132,20 +154,26 @@ def test_shrink_cuts_seed_ranges_and_nothing_else() -> None:
     )
 
 
-def test_shrink_study_keeps_two_seeds_a_few_trials_and_two_values_per_axis(tmp_path: Path) -> None:
+def test_shrink_study_keeps_two_seeds_a_few_trials_two_values_per_axis_and_short_runs(
+    tmp_path: Path,
+) -> None:
     study = tmp_path / "s.yaml"
     study.write_text(
-        "# a comment\nseeds: 0-99\ntrials: 40\ngrid:\n  agent.alpha: [0.1, 0.2, 0.5]\n"
-        "  agent.n: [1, 2]\nzip:\n  agent.lambda: [0, 0.5, 0.9]\n  agent.gamma: [1, 0.9, 0.8]\n",
+        "# a comment\nbase:\n  train:\n    episodes: 100000\nseeds: 0-99\ntrials: 40\n"
+        "grid:\n  agent.alpha: [0.1, 0.2, 0.5]\n  agent.n: [1, 2]\n"
+        "  train.episodes: [500, 50000, 5000000]\n"
+        "zip:\n  agent.lambda: [0, 0.5, 0.9]\n  agent.gamma: [1, 0.9, 0.8]\n",
         encoding="utf-8",
     )
     shrink_study(study, axes=True)
     assert yaml.safe_load(study.read_text(encoding="utf-8")) == {
+        "base": {"train": {"episodes": 1000}},
         "seeds": "0-1",
         "trials": STUDY_TRIALS,
-        "grid": {"agent.alpha": [0.1, 0.5], "agent.n": [1, 2]},
+        "grid": {"agent.alpha": [0.1, 0.5], "agent.n": [1, 2], "train.episodes": [500, 50000]},
         "zip": {"agent.lambda": [0, 0.5], "agent.gamma": [1, 0.9]},
     }
+    assert [fewer_episodes(n) for n in (1000, 1001, 99_999, 100_000)] == [1000, 1000, 1000, 1000]
 
 
 def test_blocks_are_found_with_their_titles_and_reasons(tmp_path: Path) -> None:
