@@ -10,9 +10,10 @@ returns, the lengths and the solve episode.
 
 Every algorithm runs on both engines on FrozenLake (its table twin) and on the gymnasium
 engine on CartPole and each kind of observation. CartPole's twin runs the one-step methods
-and the algorithms of the shipped CartPole configs, both of the numba engine's loops (the
-exploring and the greedy one); FrozenLake's the other algorithms' greedy loop; the other
-twins run a few algorithms: a twin's own exactness is proven in ``test_twins_classic.py``,
+and the algorithms of the shipped CartPole configs; FrozenLake's also runs the numba
+engine's greedy loop (the exploring loop compiled with epsilon 0) of one algorithm per
+family and of each algorithm whose own code reads epsilon; the other twins run a few
+algorithms: a twin's own exactness is proven in ``test_twins_classic.py``,
 ``test_twins_tabular.py`` and ``test_engines.py``, and each new (algorithm, twin) pair costs
 compilations of several seconds. Physics options run the one-step methods and one
 algorithm of each other family.
@@ -415,7 +416,7 @@ NUMBA_WORLDS |= {
 }
 # The numba engine compiles up to two loops per (algorithm, twin), 3-10 s each on a cold
 # cache, so it runs every variant on one world only: FrozenLake's table twin ("lake";
-# "lake_greedy" adds every algorithm's greedy loop). The algorithms' hooks are the same
+# "lake_greedy" adds greedy loops, see GREEDY_LOOP_VARIANTS). The algorithms' hooks are the same
 # code on every twin, and the gymnasium engine runs every variant on CartPole and on each
 # kind of observation. CartPole's twin runs the algorithms whose loops the suite compiles
 # anyway (the one-step methods, and those whose shipped CartPole configs
@@ -433,7 +434,10 @@ CARTPOLE_NUMBA = {
     *(f"{name}-random-ties" for name in ("q_learning", "sarsa", "double_q_learning")),
 }
 OTHER_TWIN_VARIANTS = {
-    **{world: CARTPOLE_NUMBA for world in ("cartpole", "cartpole_physics", "cartpole_randomize")},
+    **{world: CARTPOLE_NUMBA for world in ("cartpole", "cartpole_physics")},
+    # env.randomize's draws are the outer loop's, before each episode (each algorithm's
+    # outer loop is compiled again with them): a one-step and a multi-step method.
+    "cartpole_randomize": {"q_learning", "n_step_sarsa"},
     "mountaincar": {"q_learning", "off_policy_monte_carlo-constant_alpha"},
     "acrobot": {"q_learning"},
     "mountaincar_tiles": {"sarsa", "n_step_sarsa", "sarsa_lambda-replacing"},
@@ -801,18 +805,36 @@ def test_cartpole_default_grid(world: str, variant: str, engine: str) -> None:
     assert sum(expected.lengths) > 2000  # not a few short episodes
 
 
+# The greedy loop is the exploring loop compiled with epsilon the constant 0: the same
+# hooks, the same kernel. It runs for one algorithm of each family and for every algorithm
+# whose own code reads epsilon beyond acting epsilon-greedily (an expectation under the
+# policy, a behaviour probability, a uniform first action, its own act), where the
+# constant changes what is compiled.
+GREEDY_LOOP_VARIANTS = [
+    "q_learning",
+    "expected_sarsa",
+    "double_q_learning",
+    "n_step_tree_backup",
+    "watkins_q_lambda-replacing",
+    "dyna_q",
+    "monte_carlo-sample_average",
+    "monte_carlo_es-sample_average",
+    "off_policy_monte_carlo-sample_average",
+]
+
+
 @pytest.mark.parametrize(
     ("world", "variant", "engine"),
     [
         *_params(["lake", "taxi", "blackjack"], list(VARIANTS)),
-        *(p for p in _params(["lake_greedy"], list(VARIANTS)) if p.values[2] == "numba"),
+        *(p for p in _params(["lake_greedy"], GREEDY_LOOP_VARIANTS) if p.values[2] == "numba"),
     ],
 )
 def test_discrete_and_tuple_worlds(world: str, variant: str, engine: str) -> None:
     """Discrete observations (FrozenLake, Taxi) and a Tuple of Discrete (Blackjack).
 
-    On FrozenLake every variant runs on both engines, and on the numba engine's greedy loop
-    (the gymnasium engine has none).
+    On FrozenLake every variant runs on both engines, and some on the numba engine's greedy
+    loop (the gymnasium engine has none; see ``GREEDY_LOOP_VARIANTS``).
     """
     _assert_same(world, variant, engine)
 
