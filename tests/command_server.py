@@ -9,8 +9,8 @@ imports them (and every module of the package) once, loads numba's registries, a
 the command's own arguments, working directory, environment, standard streams and exit
 code, and ``cartpole_q.cli.main`` run as the console script runs it, in a process of its
 own that exits as that one would (its ``atexit`` handlers included). Nothing is compiled
-or run in the server itself, so no command sees another's state. The console script's own start-up is tested where it matters (``tests/test_cli.py``,
-``tests/test_makefile.py``).
+or run in the server itself, so no command sees another's state. The console script's own
+start-up is tested where it matters (``tests/test_cli.py``, ``tests/test_makefile.py``).
 """
 
 from __future__ import annotations

@@ -416,9 +416,9 @@ NUMBA_WORLDS |= {
 }
 # The numba engine compiles up to two loops per (algorithm, twin), 3-10 s each on a cold
 # cache, so it runs every variant on one world only: FrozenLake's table twin ("lake";
-# "lake_greedy" adds greedy loops, see GREEDY_LOOP_VARIANTS). The algorithms' hooks are the same
-# code on every twin, and the gymnasium engine runs every variant on CartPole and on each
-# kind of observation. CartPole's twin runs the algorithms whose loops the suite compiles
+# "lake_greedy" adds greedy loops, see GREEDY_LOOP_VARIANTS). The algorithms' hooks are the
+# same code on every twin, and the gymnasium engine runs every variant on CartPole and on
+# each kind of observation. CartPole's twin runs the algorithms whose loops the suite compiles
 # anyway (the one-step methods, and those whose shipped CartPole configs
 # tests/test_learning.py trains), its default epsilon reaching 0 (greedy episodes on the
 # exploring loop); the other twins a few algorithms, most of them loops the shipped configs
