@@ -190,7 +190,8 @@ def test_tune_refuses_a_storage_file_that_is_not_a_journal(in_tmp: Path) -> None
         "name": "t", "base": SMALL, "seeds": "0", "trials": 1,
         "space": {"agent.alpha": {"low": 0.1, "high": 0.5}},
     })  # fmt: skip
-    for junk in ("junk\n", '{"op_code": 99}\n', "precious, no newline"):
+    # (a line like the beginning of a record, cut short, with no record before it)
+    for junk in ("junk\n", '{"op_code": 99}\n', "precious, no newline", '{"op'):
         journal = in_tmp / "junk.journal"
         journal.write_text(junk)
         _refused_quickly(

@@ -463,6 +463,28 @@ def test_resume_fails_a_trial_its_killed_process_never_named(tmp_path: Path) -> 
     assert states == ["COMPLETE", "FAIL", "COMPLETE"]
 
 
+@pytest.mark.parametrize("cut", [b'{"op_code":5,"worker_id":"w', b'{"op_c', b"{"])
+def test_resume_cuts_a_record_a_full_disk_cut_a_few_bytes_in(tmp_path: Path, cut: bytes) -> None:
+    """A full disk cuts a write where the journal's last block ends, as early in a record
+    as anywhere: the resume drops what was cut and runs the trials left."""
+    import yaml
+
+    path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
+    out = tmp_path / "out"
+    assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
+    journal = out / tunedir.JOURNAL_FILE
+    whole = journal.read_bytes()
+    journal.write_bytes(whole + cut)
+    tune_yaml = out / tunedir.TUNE_FILE
+    data = yaml.safe_load(tune_yaml.read_text())
+    data["trials"] = 2
+    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    result = invoke("tune", "--resume", out, "-q")
+    assert result.exit_code == 0, result.output
+    assert journal.read_bytes().startswith(whole)  # only the cut record was dropped
+    assert [trial.state.name for trial in _journal_trials(out)] == ["COMPLETE", "COMPLETE"]
+
+
 def test_resume_may_raise_the_trials_in_tune_yaml(tmp_path: Path) -> None:
     import yaml
 

@@ -128,10 +128,13 @@ def check_journal(path: Path, *, given: bool) -> None:
     """Refuse a file that is not an Optuna journal before anything reads, cuts or appends to it.
 
     Every line of a journal is one JSON object with an ``op_code``; only the last may be
-    cut short (a kill mid-write, which :func:`repair_journal` then removes). Optuna skips a
-    last line it cannot read and would append its records after it, turning a file that
-    was never a journal into one no reader accepts; and cutting a "half-written record"
-    from a file that is not a journal would destroy its end.
+    cut short (a kill or a full disk mid-write, which :func:`repair_journal` then removes).
+    Such a line begins as every record does, or, after complete records, is a beginning
+    of that beginning: a full disk cuts a write where the file's last block ends, a few
+    bytes into a record as likely as any other place. Optuna skips a last line it cannot
+    read and would append its records after it, turning a file that was never a journal
+    into one no reader accepts; and cutting a "half-written record" from a file that is
+    not a journal would destroy its end.
 
     Args:
         path: the journal file (it may not exist yet).
@@ -149,7 +152,10 @@ def check_journal(path: Path, *, given: bool) -> None:
         lines = iter(lambda: journal.readline(MAX_JOURNAL_RECORD), b"")
         for number, line in enumerate(lines, start=1):
             cut_short = not line.endswith(b"\n") and len(line) < MAX_JOURNAL_RECORD
-            if cut_short and line.startswith(JOURNAL_RECORD_START):
+            if cut_short and (
+                line.startswith(JOURNAL_RECORD_START)
+                or (number > 1 and JOURNAL_RECORD_START.startswith(line))
+            ):
                 return  # a record cut short, the last line: repair_journal removes it
             try:
                 record = json.loads(line)
