@@ -442,10 +442,19 @@ def test_resume_refuses_a_tune_yaml_edited_since_the_start(
     assert _trials(out) == before
 
 
+def _set_trials(directory: Path, trials: int) -> None:
+    """Set ``trials`` in a tune directory's ``tune.yaml`` (a resume then runs up to it)."""
+    import yaml
+
+    tune_yaml = directory / tunedir.TUNE_FILE
+    data = yaml.safe_load(tune_yaml.read_text())
+    data["trials"] = trials
+    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+
+
 def test_resume_fails_a_trial_its_killed_process_never_named(tmp_path: Path) -> None:
     """Killed between asking for a trial and naming itself: resume must not count it."""
     import optuna
-    import yaml
 
     path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
     out = tmp_path / "out"
@@ -454,10 +463,7 @@ def test_resume_fails_a_trial_its_killed_process_never_named(tmp_path: Path) -> 
         optuna.storages.journal.JournalFileBackend(str(out / tunedir.JOURNAL_FILE))
     )
     optuna.load_study(study_name=TUNE["name"], storage=storage).ask()  # RUNNING, no owner
-    tune_yaml = out / tunedir.TUNE_FILE
-    data = yaml.safe_load(tune_yaml.read_text())
-    data["trials"] = 2
-    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    _set_trials(out, 2)
     assert invoke("tune", "--resume", out, "-q").exit_code == 0
     states = [trial.state.name for trial in _journal_trials(out)]
     assert states == ["COMPLETE", "FAIL", "COMPLETE"]
@@ -467,18 +473,13 @@ def test_resume_fails_a_trial_its_killed_process_never_named(tmp_path: Path) -> 
 def test_resume_cuts_a_record_a_full_disk_cut_a_few_bytes_in(tmp_path: Path, cut: bytes) -> None:
     """A full disk cuts a write where the journal's last block ends, as early in a record
     as anywhere: the resume drops what was cut and runs the trials left."""
-    import yaml
-
     path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
     out = tmp_path / "out"
     assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
     journal = out / tunedir.JOURNAL_FILE
     whole = journal.read_bytes()
     journal.write_bytes(whole + cut)
-    tune_yaml = out / tunedir.TUNE_FILE
-    data = yaml.safe_load(tune_yaml.read_text())
-    data["trials"] = 2
-    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    _set_trials(out, 2)
     result = invoke("tune", "--resume", out, "-q")
     assert result.exit_code == 0, result.output
     assert journal.read_bytes().startswith(whole)  # only the cut record was dropped
@@ -486,15 +487,10 @@ def test_resume_cuts_a_record_a_full_disk_cut_a_few_bytes_in(tmp_path: Path, cut
 
 
 def test_resume_may_raise_the_trials_in_tune_yaml(tmp_path: Path) -> None:
-    import yaml
-
     path = write_yaml(tmp_path / "small.yaml", {**TUNE, "trials": 1})
     out = tmp_path / "out"
     assert invoke("tune", path, "--out", out, "--workers", 1, "-q").exit_code == 0
-    tune_yaml = out / tunedir.TUNE_FILE
-    data = yaml.safe_load(tune_yaml.read_text())
-    data["trials"] = 2
-    tune_yaml.write_text(yaml.safe_dump(data, sort_keys=False))
+    _set_trials(out, 2)
     assert invoke("tune", "--resume", out, "-q").exit_code == 0
     assert len(_trials(out)) == 2
 
