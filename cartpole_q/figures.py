@@ -1092,6 +1092,44 @@ def sweep_figure(
     return figure
 
 
+def prediction_sweep_figure(
+    title: str,
+    axes: Sequence[SweepAxis],
+    point_ids: Sequence[str],
+    statistics: Sequence[dict[str, float | int | None]],
+) -> DataFigure:
+    """``sweep.png`` of a prediction sweep: each point's final RMS error against the axes.
+
+    The mean over seeds of the RMS error after the last episode, with its 95% bootstrap
+    interval as error bars; two axes: a heatmap. More: against the point id.
+
+    Args:
+        title: the sweep's name.
+        axes: the axes, in point order (last fastest); the zip group counts as one.
+        point_ids: the points' ids.
+        statistics: each point's ``points.csv`` statistics (``None`` = missing).
+    """
+    figure = DataFigure(figsize=(SWEEP_PANEL_SIZE[0] * 1.5, SWEEP_PANEL_SIZE[1]), dpi=DPI,
+                        layout="constrained")  # fmt: skip
+    panel = figure.subplots(1, 1)
+    label = "RMS error after the last episode"
+    if len(axes) == 2:
+        shape = (len(axes[0].values), len(axes[1].values))
+        values = _column(statistics, "mean_rms_error").reshape(shape)
+        _sweep_heatmap(figure, panel, axes, values, label, None, digits=3)
+    else:
+        labels, name = (
+            (axes[0].values, axes[0].name) if len(axes) == 1 else (list(point_ids), "point")
+        )
+        # points joined by a line only along one numeric axis (not categories, not ids)
+        joined = len(axes) == 1 and _numeric(labels) is not None
+        _sweep_errorbars(panel, figure.data.panel(label), labels, name, statistics,
+                         "mean_rms_error", label, joined)  # fmt: skip
+        panel.set_ylim(bottom=0.0)
+    figure.suptitle(f"Sweep {title}: mean over seeds, 95% bootstrap intervals")
+    return figure
+
+
 def profile_thresholds(
     scores: Sequence[np.ndarray], threshold: float | None = None, count: int = 200
 ) -> np.ndarray:
@@ -1252,8 +1290,14 @@ def _sweep_heatmap(
     values: np.ndarray,
     label: str,
     limits: tuple[float, float] | None,
+    digits: int | None = None,
 ) -> None:
-    """A heatmap of one statistic: first axis down, second across, each cell annotated."""
+    """A heatmap of one statistic: first axis down, second across, each cell annotated.
+
+    Each cell's text has ``digits`` decimals (default: 2 for a statistic with ``limits``,
+    else 0).
+    """
+    digits = digits if digits is not None else 2 if limits else 0
     masked = np.ma.masked_invalid(values)
     cmap = "viridis" if limits is not None else "viridis_r"
     vmin, vmax = limits if limits is not None else (None, None)
@@ -1263,13 +1307,7 @@ def _sweep_heatmap(
     rows, columns = values.shape
     for i in range(rows):
         for j in range(columns):
-            text = (
-                "—"
-                if np.isnan(values[i, j])
-                else f"{values[i, j]:.2f}"
-                if limits
-                else f"{values[i, j]:.0f}"
-            )
+            text = "—" if np.isnan(values[i, j]) else f"{values[i, j]:.{digits}f}"
             axes.text(j, i, text, ha="center", va="center", fontsize="small", color="white",
                       path_effects=_outline())  # fmt: skip
     axes.set_xticks(range(columns), sweep_axes[1].values, rotation=30, ha="right", fontsize="small")

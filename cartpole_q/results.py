@@ -74,6 +74,11 @@ class SeedResult:
     mean_return: float | None = None
     """the mean training return over all the run's episodes (:func:`mean_return`; ``None``:
     not recorded, as in a ``results.csv`` written before the column)"""
+    rms_error: float | None = None
+    """a prediction run's RMS error after its last episode (``None``: a control run, a
+    world without a model to measure it, or a ``results.csv`` written before the column)"""
+    predicts: bool = False
+    """a prediction run (it learnt ``V``; not a ``results.csv`` column)"""
 
     @classmethod
     def of_train(cls, result: TrainResult) -> SeedResult:
@@ -93,7 +98,20 @@ class SeedResult:
             train_seconds=round(result.train_seconds, 6),
             interrupted=result.interrupted,
             mean_return=mean_return(result.returns),
+            rms_error=final_error(result.errors),
+            predicts=result.predicts,
         )
+
+
+def final_error(errors: np.ndarray | None) -> float | None:
+    """A prediction run's RMS error after its last episode (``None``: none measured).
+
+    >>> final_error(np.array([0.3, 0.2])), final_error(None), final_error(np.zeros(0))
+    (0.2, None, None)
+    """
+    if errors is None or not len(errors):
+        return None
+    return float(errors[-1])
 
 
 def mean_return(returns: Sequence[float] | np.ndarray) -> float | None:
@@ -233,8 +251,9 @@ class GreedySuccess:
 
 _RUN_KEYS = (
     "episodes", "env_steps", "wall_seconds", "train_seconds", "steps_per_second",
-    "solved_episode", "env_steps_to_solve", "reward_threshold", "q_table", "eval",
-    "first_greedy_success", "engine", "seed", "interrupted", "versions", "finished_at",
+    "solved_episode", "env_steps_to_solve", "reward_threshold", "q_table", "v_table",
+    "rms_error", "eval", "first_greedy_success", "engine", "seed", "interrupted", "versions",
+    "finished_at",
 )  # fmt: skip
 
 
@@ -244,7 +263,8 @@ class RunSummary:
 
     Files written before a key existed read with its default (``None``, or ``False`` for
     ``interrupted``); keys this version does not know are kept in :attr:`extra` and
-    written back after the known ones.
+    written back after the known ones. A prediction run names its kept table ``v_table``
+    (its file is ``v_table.npy``) and writes ``rms_error``, the error after its last episode.
     """
 
     episodes: int
@@ -266,6 +286,10 @@ class RunSummary:
     first_greedy_success: GreedySuccess | None = None
     interrupted: bool = False
     finished_at: str | None = None
+    predicts: bool = False
+    """a prediction run: its table is ``V`` (``v_table``), its figure ``rms_error``"""
+    rms_error: float | None = None
+    """a prediction run's RMS error after its last episode (``None``: not measured)"""
     extra: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     """keys of the file this version does not know, kept as they were"""
 
@@ -301,6 +325,8 @@ class RunSummary:
             interrupted=result.interrupted,
             versions=MappingProxyType(dict(versions)),
             finished_at=finished_at,
+            predicts=result.predicts,
+            rms_error=final_error(result.errors),
         )
 
     def result(self, seed: int | None = None) -> SeedResult:
@@ -319,10 +345,16 @@ class RunSummary:
             reward_threshold=self.reward_threshold,
             train_seconds=self.train_seconds or 0.0,
             interrupted=self.interrupted,
+            rms_error=self.rms_error,
+            predicts=self.predicts,
         )
 
     def to_json(self) -> JsonObject:
         """The JSON object, keys in the order this version writes them."""
+        kept = {"episode": self.kept_episode, "source": self.kept_from}
+        table: JsonObject = {"q_table": kept}
+        if self.predicts:
+            table = {"v_table": kept, "rms_error": self.rms_error}
         return {
             "episodes": self.episodes,
             "env_steps": self.env_steps,
@@ -332,7 +364,7 @@ class RunSummary:
             "solved_episode": self.solved_episode,
             "env_steps_to_solve": self.env_steps_to_solve,
             "reward_threshold": self.reward_threshold,
-            "q_table": {"episode": self.kept_episode, "source": self.kept_from},
+            **table,
             "eval": None if self.eval is None else self.eval.to_json(),
             "first_greedy_success": None
             if self.first_greedy_success is None
@@ -354,7 +386,8 @@ class RunSummary:
                 the message names the file and the key.
         """
         reader = _Reader(data, where)
-        kept = reader.optional_object("q_table")
+        predicts = reader.get("v_table") is not None
+        kept = reader.optional_object("v_table" if predicts else "q_table")
         return cls(
             episodes=reader.integer("episodes"),
             env_steps=reader.integer("env_steps"),
@@ -375,6 +408,8 @@ class RunSummary:
             ),
             interrupted=reader.flag("interrupted", default=False),
             finished_at=reader.optional_text("finished_at"),
+            predicts=predicts,
+            rms_error=reader.optional_number("rms_error"),
             extra=MappingProxyType(reader.others(_RUN_KEYS)),
         )
 
@@ -655,8 +690,9 @@ class MultiSeedSummary:
 def summarize_seeds(results: Sequence[SeedResult]) -> PointStatistics:
     """The statistics of many seeds of one config: a multi-seed run, a sweep point, a trial.
 
-    Only seeds with a final greedy evaluation count. The success rate is ``None`` when
-    some seed has no success (no reward threshold).
+    ``seeds`` counts every result; the evaluation's statistics are over the seeds with a
+    final greedy evaluation, the RMS error's over the prediction runs that measured one.
+    The success rate is ``None`` when some seed has no success (no reward threshold).
 
     >>> result = SeedResult(0, 10, 900, 5, 400, None, 480.0, True)
     >>> summarize_seeds([result]).success_rate
@@ -668,7 +704,10 @@ def summarize_seeds(results: Sequence[SeedResult]) -> PointStatistics:
         [bool(result.success) for result in evaluated],
         [result.solved_episode for result in evaluated],
         [result.env_steps_to_solve for result in evaluated],
+        rms_errors=[result.rms_error for result in results if result.rms_error is not None],
     )
+    # `seeds` counts every seed with a result (a prediction run has no greedy evaluation).
+    statistics = dataclasses.replace(statistics, seeds=len(results))
     if any(result.success is None for result in evaluated):
         # no reward threshold: there is no success to count
         return dataclasses.replace(

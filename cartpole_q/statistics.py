@@ -464,6 +464,41 @@ def median_interval(
     return median(values), low, high
 
 
+def mean_rows(samples: ArrayLike) -> FloatArray:
+    """The mean of each row (resample): ``samples.mean(axis=1)``."""
+    means: FloatArray = _as_matrix(samples).mean(axis=1)
+    return means
+
+
+def mean_interval(
+    values: ArrayLike,
+    *,
+    resamples: int = DEFAULT_RESAMPLES,
+    rng: np.random.Generator | None = None,
+    level: float = DEFAULT_LEVEL,
+) -> tuple[float, float, float]:
+    """The mean (``np.mean``) with its percentile bootstrap interval over seeds.
+
+    Returns:
+        ``(mean, low, high)``; all ``nan`` for no values; the interval ``nan`` when a value
+        is not finite (a diverged run's error).
+
+    >>> mean_interval([0.1, float("inf")])
+    (inf, nan, nan)
+    >>> mean_interval([])
+    (nan, nan, nan)
+    >>> mean_interval([0.25, 0.25])
+    (0.25, 0.25, 0.25)
+    """
+    array = np.asarray(values, dtype=np.float64)
+    if not array.size:
+        return _NAN, _NAN, _NAN
+    if not np.all(np.isfinite(array)):  # a diverged run: the mean is not finite, no interval
+        return float(np.mean(array)), _NAN, _NAN
+    low, high = bootstrap_interval(array, mean_rows, resamples=resamples, rng=rng, level=level)
+    return float(np.mean(array)), low, high
+
+
 def aggregate_iqm(
     values_by_point: Sequence[ArrayLike],
     *,
@@ -619,6 +654,12 @@ class PointStatistics:
     """95% percentile bootstrap interval over the solved seeds, lower end"""
     median_env_steps_to_solve_high: float | None
     """95% percentile bootstrap interval over the solved seeds, upper end"""
+    mean_rms_error: float | None = None
+    """a prediction point's mean over seeds of the RMS error after the last episode"""
+    mean_rms_error_low: float | None = None
+    """95% percentile bootstrap interval over the seeds, lower end"""
+    mean_rms_error_high: float | None = None
+    """95% percentile bootstrap interval over the seeds, upper end"""
 
     @classmethod
     def columns(cls) -> tuple[str, ...]:
@@ -649,6 +690,7 @@ def summarize_point(
     threshold: float | None = None,
     *,
     resamples: int = DEFAULT_RESAMPLES,
+    rms_errors: Sequence[float] = (),
 ) -> PointStatistics:
     """The ``points.csv`` statistics of one point, from its seeds' ``results.csv`` rows.
 
@@ -664,6 +706,7 @@ def summarize_point(
             ``nan``) = not solved.
         threshold: The eval-mean success threshold, needed only without ``successes``.
         resamples: Bootstrap resamples per interval (the contract's 2000 by default).
+        rms_errors: A prediction point's seeds' final RMS errors (none for control).
 
     Returns:
         The point's statistics; ``None`` where a value is missing.
@@ -704,6 +747,7 @@ def summarize_point(
     steps, steps_low, steps_high = median_interval(
         _solved_only(env_steps_to_solve), resamples=resamples
     )
+    error, error_low, error_high = mean_interval(rms_errors, resamples=resamples)
     return PointStatistics(
         seeds=seeds,
         success_rate=_missing(rate),
@@ -718,6 +762,9 @@ def summarize_point(
         median_env_steps_to_solve=_missing(steps),
         median_env_steps_to_solve_low=_missing(steps_low),
         median_env_steps_to_solve_high=_missing(steps_high),
+        mean_rms_error=_missing(error),
+        mean_rms_error_low=_missing(error_low),
+        mean_rms_error_high=_missing(error_high),
     )
 
 

@@ -197,14 +197,15 @@ def test_a_results_csv_from_before_mean_return_is_read_with_it_empty(tmp_path: P
                                           mean_return=-20.5))]  # fmt: skip
     sweepdir.write_results(tmp_path, ["agent.alpha"], rows)
     text = (tmp_path / sweepdir.RESULTS_FILE).read_text()
-    assert text.splitlines()[0].endswith(",train_seconds,mean_return")
-    assert text.splitlines()[1].endswith(",-20.5")
+    assert text.splitlines()[0].endswith(",train_seconds,mean_return,rms_error")
+    assert text.splitlines()[1].endswith(",-20.5,")
     assert sweepdir.read_results(tmp_path, ["agent.alpha"]) == rows
-    older = "\n".join(line.rsplit(",", 1)[0] for line in text.splitlines()) + "\n"
-    (tmp_path / sweepdir.RESULTS_FILE).write_text(older)
-    (row,) = sweepdir.read_results(tmp_path, ["agent.alpha"])
-    assert row.result.mean_return is None
-    assert row.result == dataclasses.replace(rows[0].result, mean_return=None)
+    # before rms_error (prediction runs' errors), then before mean_return too
+    for cut, dropped in ((1, {"rms_error": None}), (2, {"mean_return": None})):
+        older = "\n".join(line.rsplit(",", cut)[0] for line in text.splitlines()) + "\n"
+        (tmp_path / sweepdir.RESULTS_FILE).write_text(older)
+        (row,) = sweepdir.read_results(tmp_path, ["agent.alpha"])
+        assert row.result == dataclasses.replace(rows[0].result, **dropped)
 
 
 def test_success_is_reaching_the_threshold_exactly() -> None:

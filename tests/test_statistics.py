@@ -486,7 +486,11 @@ DESIGN_COLUMNS = (
 
 
 def test_point_columns_are_the_contract() -> None:
-    assert PointStatistics.columns() == DESIGN_COLUMNS
+    # design.md's columns, then the ones added since (a prediction point's error)
+    assert PointStatistics.columns() == (*DESIGN_COLUMNS, *PREDICTION_COLUMNS)
+
+
+PREDICTION_COLUMNS = ("mean_rms_error", "mean_rms_error_low", "mean_rms_error_high")
 
 
 def test_summarize_point_is_the_functions_each_with_a_fresh_generator() -> None:
@@ -513,8 +517,22 @@ def test_summarize_point_is_the_functions_each_with_a_fresh_generator() -> None:
         "median_env_steps_to_solve": 6.3e4,
         "median_env_steps_to_solve_low": steps_column[1],
         "median_env_steps_to_solve_high": steps_column[2],
+        # a control point has no error
+        "mean_rms_error": None,
+        "mean_rms_error_low": None,
+        "mean_rms_error_high": None,
     }
-    assert list(stats.as_row()) == list(DESIGN_COLUMNS)
+    assert list(stats.as_row()) == [*DESIGN_COLUMNS, *PREDICTION_COLUMNS]
+
+
+def test_a_prediction_points_error_is_the_mean_over_seeds_with_a_bootstrap_interval() -> None:
+    errors = [0.05, 0.07, 0.02, 0.04]
+    stats = summarize_point([], [], [], [], rms_errors=errors)
+    assert stats.mean_rms_error == float(np.mean(errors))
+    low, high = bootstrap_interval(errors, lambda s: np.asarray(s).mean(axis=1))
+    assert (stats.mean_rms_error_low, stats.mean_rms_error_high) == (low, high)
+    diverged = summarize_point([], [], [], [], rms_errors=[0.05, float("inf")])
+    assert diverged.mean_rms_error == float("inf") and diverged.mean_rms_error_low is None
 
 
 def test_summarize_point_uses_given_successes() -> None:

@@ -210,7 +210,7 @@ def test_the_sweep_directory_has_the_contract_files(reference: Path) -> None:
     assert list(rows[0]) == [
         "point", "agent.alpha", "agent.algorithm", "seed", "solved_episode",
         "env_steps_to_solve", "first_greedy_success_env_steps", "eval_mean", "success",
-        "episodes", "env_steps", "train_seconds", "mean_return",
+        "episodes", "env_steps", "train_seconds", "mean_return", "rms_error",
     ]  # fmt: skip
     assert [(row["point"], row["seed"]) for row in rows] == [
         (f"{p:03d}", str(s)) for p in range(4) for s in range(3)
@@ -703,7 +703,7 @@ def test_a_figure_without_mean_return_in_results_is_refused(tmp_path: Path) -> N
     out = tmp_path / "out"
     assert invoke("sweep", write_yaml(tmp_path / "c.yaml", sweep), "--out", out).exit_code == 0
     lines = (out / sweepdir.RESULTS_FILE).read_text().splitlines()
-    older = "\n".join(line.rsplit(",", 1)[0] for line in lines) + "\n"
+    older = "\n".join(line.rsplit(",", 2)[0] for line in lines) + "\n"  # both added columns
     (out / sweepdir.RESULTS_FILE).write_text(older)
     spec = load_sweep(out / sweepdir.SWEEP_FILE)
     points = [out / "points" / spec.point_id(p.index) for p in spec.points]

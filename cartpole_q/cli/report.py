@@ -17,16 +17,21 @@ def _rows_single(run_dir: Path, summary: RunSummary) -> list[tuple[str, str]]:
     solved = summary.solved_episode
     evaluation = summary.eval
     greedy = summary.first_greedy_success
-    rows = [
-        ("run", str(run_dir)),
-        ("engine", summary.engine or "?"),
-        (
+    rows = [("run", str(run_dir)), ("engine", summary.engine or "?")]
+    if summary.predicts:  # V of a fixed policy: nothing to solve, its error is the figure
+        rows.append((
+            "RMS error",
+            f"{summary.rms_error:.6g} after episode {summary.episodes} (V against the policy's exact values)"
+            if summary.rms_error is not None
+            else f"- ({summary.episodes} episodes; the world has no model to know the exact values by)",
+        ))  # fmt: skip
+    else:
+        rows.append((
             "solved",
             f"episode {solved} (100-episode average >= {threshold:g})"
             if solved is not None and threshold is not None
             else f"no ({summary.episodes} episodes)",
-        ),
-    ]
+        ))  # fmt: skip
     if evaluation is not None:
         cut = ", cut short by the stop" if evaluation.interrupted else ""
         rows.append((
@@ -241,6 +246,8 @@ def sweep_table(
     point  agent.alpha  seeds  success rate [95%]  IQM eval return [95%]  median solve episode [95%]
     000    0.1          2      1.00 [0.34, 1.00]   500.0 [500.0, 500.0]   175 [170, 180]
     """
+    if point_rows and all(row.statistics.mean_rms_error is not None for row in point_rows):
+        return _prediction_table(axes, point_rows, limit)
 
     def rank(row: PointRow) -> tuple[float, float]:
         stats = row.statistics
@@ -261,6 +268,35 @@ def sweep_table(
             _interval(s.median_solved_episode, s.median_solved_episode_low,
                       s.median_solved_episode_high, 0),
         ])  # fmt: skip
+    return _aligned(table)
+
+
+def _prediction_table(axes: Sequence[str], point_rows: Sequence[PointRow], limit: int) -> list[str]:
+    """Prediction points, the lowest final RMS error first.
+
+    >>> from cartpole_q.statistics import PointStatistics
+    >>> stats = PointStatistics(100, *[None] * 12, 0.0512, 0.049, 0.0533)
+    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
+    ...     print(line)
+    point  agent.alpha  seeds  RMS error after the last episode, mean [95%]
+    000    0.1          100    0.0512 [0.0490, 0.0533]
+    """
+    ordered = sorted(point_rows, key=lambda row: row.statistics.mean_rms_error or 0.0)[:limit]
+    table = [["point", *axes, "seeds", "RMS error after the last episode, mean [95%]"]]
+    for row in ordered:
+        s = row.statistics
+        table.append([
+            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
+            _interval(s.mean_rms_error, s.mean_rms_error_low, s.mean_rms_error_high, 4)
+            if s.mean_rms_error is None or math.isfinite(s.mean_rms_error)
+            else f"{s.mean_rms_error} (a run diverged)",
+        ])  # fmt: skip
+    return _aligned(table)
+
+
+def _aligned(table: list[list[str]]) -> list[str]:
+    """The rows of a table as lines, each column as wide as its widest cell."""
+    header = table[0]
     widths = [max(len(line[i]) for line in table) for i in range(len(header))]
     return ["  ".join(text.ljust(width) for text, width in zip(line, widths, strict=True)).rstrip()
             for line in table]  # fmt: skip

@@ -17,7 +17,7 @@ import yaml
 
 from cartpole_q.config.messages import shown, type_name, unknown_key
 from cartpole_q.config.schema import Config, key_of, sections
-from cartpole_q.config.yaml_io import YamlLimitError, load_yaml_text
+from cartpole_q.config.yaml_io import NotTextError, YamlLimitError, load_yaml_text
 from cartpole_q.errors import ConfigError
 from cartpole_q.rl.algorithms import algorithms
 
@@ -97,6 +97,8 @@ def parse_assignment(text: str, option: str = "--set") -> tuple[str, Any]:
         parsed = load_yaml_text(value) if value.strip() else None
     except YamlLimitError as error:
         raise ConfigError(f"{option} {shown(text)}: the value {error}.") from None
+    except NotTextError as error:
+        raise ConfigError(f"{option} {shown(text)}: the value is {error.problem}.") from None
     except yaml.YAMLError as error:
         problem = getattr(error, "problem", None) or "invalid syntax"
         raise ConfigError(

@@ -118,7 +118,20 @@ def load_yaml_text(text: str) -> Any:
         yaml.YAMLError: not YAML, a tag that would construct an object, a duplicate key,
             or beyond the bounds (:class:`YamlLimitError`).
     """
+    if not text.isascii():
+        try:
+            text.encode("utf-8")
+        except UnicodeEncodeError as error:  # bytes the locale could not decode, as surrogates
+            raise NotTextError(error.start) from None
     return yaml.load(text, Loader=UniqueKeyLoader)
+
+
+class NotTextError(yaml.YAMLError):
+    r"""The input holds bytes that are not UTF-8 (a shell's ``$'\xff'``): YAML is text."""
+
+    def __init__(self, position: int) -> None:
+        self.problem = f"not UTF-8 text: character {position + 1} is a byte no text decodes to"
+        super().__init__(self.problem)
 
 
 def _construct_unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode) -> dict[Any, Any]:

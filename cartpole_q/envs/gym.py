@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame, shorten, shown
+from cartpole_q.config.bounds import memory_text
 from cartpole_q.errors import RunError
 from cartpole_q.families import profile_for
 
@@ -383,8 +384,8 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
         fewer = "use fewer bins" if index_starts is None else "use a smaller environment"
         raise ConfigError(
             f"{blame(source, field)}: {field}: the Q-table would hold {math.prod(state_shape):,} "
-            f"states x {n_actions} actions = {_size(table_bytes)}, above the limit of "
-            f"{_size(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
+            f"states x {n_actions} actions = {memory_text(table_bytes)}, above the limit of "
+            f"{memory_text(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
         )
     max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
     threshold = config.train.reward_threshold
@@ -545,10 +546,3 @@ def _wayland_problem(name: str) -> str | None:
         except OSError:
             return f"WAYLAND_DISPLAY={name} cannot be reached (nothing listens on {path})"
     return None
-
-
-def _size(n_bytes: int) -> str:
-    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
-        if n_bytes >= scale:
-            return f"{n_bytes / scale:,.1f} {unit}"
-    return f"{n_bytes} bytes"

@@ -25,6 +25,8 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import ConfigError, parse_seeds, shown_value
+from cartpole_q.config.bounds import check_count, check_memory
+from cartpole_q.errors import RunError
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
@@ -57,6 +59,10 @@ BOOK_OF = ("average_reward", "optimal_percent", "peak")
 parameter study line's best point; with ``above``, the book's claim that one curve lies above
 another over some steps (no value: ours is counted)"""
 ENGINES = ("numba", "gymnasium")
+MAX_STEPS = 10_000_000
+"""the most steps a run may have"""
+MAX_TESTBED_SCALE = 1e6
+"""the largest ``|mean|``, ``spread`` and ``walk`` of a testbed"""
 
 
 @dataclass(frozen=True)
@@ -188,6 +194,12 @@ def load_study(path: Path) -> Study:
     )
     if spread < 0 or walk < 0:
         raise ConfigError(f"{where}: testbed.spread and testbed.walk must not be negative.")
+    for key, value in (("mean", mean), ("spread", spread), ("walk", walk)):
+        if abs(value) > MAX_TESTBED_SCALE:
+            raise ConfigError(
+                f"{where}: testbed.{key}: must be within ±{MAX_TESTBED_SCALE:g} (rewards beyond "
+                f"it overflow the averages), got {value:g}."
+            )
     if "seeds" not in raw:
         raise ConfigError(f"{where}: seeds: is missing; one run per seed, such as 0-1999.")
     try:
@@ -195,6 +207,7 @@ def load_study(path: Path) -> Study:
     except ValueError as error:
         raise ConfigError(f"{where}: seeds: {error}") from None
     steps = _whole(raw, "steps", 1000, where)
+    check_count(where, "steps", steps, MAX_STEPS, "the book's runs are 1,000 and 10,000 steps")
     curves_raw = raw.get("curves")
     if not isinstance(curves_raw, list) or not curves_raw:
         raise ConfigError(
@@ -202,6 +215,14 @@ def load_study(path: Path) -> Study:
             f"epsilon: 0.1}}, got {shown_value(curves_raw)}."
         )
     curves = tuple(_curve(entry, index, where) for index, entry in enumerate(curves_raw))
+    learners = sum(max(1, len(curve.values)) for curve in curves)
+    # per learner two averaged curves (float64), and one run's rewards and flags at a time
+    check_memory(
+        where,
+        "steps",
+        steps * (16 * learners + 25),
+        f"{learners} learners' curves of {steps:,} steps",
+    )
     kind, file, title, metrics = _figure(raw.get("figure"), name, where)
     varied = [curve.vary is not None for curve in curves]
     if kind == "parameter_study" and not all(varied):
@@ -302,6 +323,8 @@ def _check_range(key: str, value: float, where: str) -> None:
         raise ConfigError(f"{where}: c must not be negative, got {value:g}.")
     if key == "alpha" and value < 0.0:
         raise ConfigError(f"{where}: alpha must be positive, got {value:g}.")
+    if abs(value) > MAX_TESTBED_SCALE:
+        raise ConfigError(f"{where}: {key} must be within ±{MAX_TESTBED_SCALE:g}, got {value:g}.")
 
 
 def _default_label(method: str, settings: Mapping[str, float | bool]) -> str:
@@ -411,7 +434,25 @@ def run_study(
             results.append(result)
         rewards.append(np.array([result.average_reward for result in results]))
         optimal.append(np.array([result.optimal_percent for result in results]))
+        _check_finite(curve, rewards[-1], study.where)
     return Outcome(rewards, optimal, engine, time.perf_counter() - start)
+
+
+def _check_finite(curve: Curve, average_reward: np.ndarray, where: str) -> None:
+    """Refuse a curve whose averages overflowed: no figure is drawn of infinities.
+
+    Raises:
+        RunError: naming the curve and the first step that is not a finite number.
+    """
+    bad = np.flatnonzero(~np.isfinite(average_reward))
+    if bad.size:
+        learner, step = divmod(int(bad[0]), average_reward.shape[-1])
+        value = f" ({curve.vary} {curve.values[learner]:g})" if curve.vary is not None else ""
+        raise RunError(
+            f"{where}: the curve {curve.label!r}{value} overflowed: its average reward at step "
+            f"{step + 1} is {average_reward.flat[bad[0]]}. Its rewards or parameters are too "
+            "large for float64; scale them down."
+        )
 
 
 def mean_over_steps(curve: np.ndarray, first: int = 1, last: int | None = None) -> float:

@@ -409,8 +409,16 @@ def outcome_line(label: str, result: SeedResult) -> str:
 
     >>> outcome_line("seed 3", SeedResult(3, 180, 9000, 180, 9000, None, 500.0, True))
     'seed 3: solved at episode 180, greedy eval mean 500.0'
+    >>> outcome_line("walk", SeedResult(0, 100, 600, None, None, None, None, None, rms_error=0.05, predicts=True))
+    'walk: learnt V in 100 episodes, RMS error 0.05'
     """
     tail = f", greedy eval mean {result.eval_mean:.1f}" if result.eval_mean is not None else ""
+    if result.predicts:  # nothing to solve: its figure is the error of V
+        if result.rms_error is not None:
+            tail = f", RMS error {result.rms_error:.4g}"
+        else:
+            tail = " (no exact values to measure V against)"
+        return f"{label}: {'interrupted after' if result.interrupted else 'learnt V in'} {result.episodes} episodes{tail}"
     if result.interrupted:
         return f"{label}: interrupted after episode {result.episodes}{tail}"
     if result.solved_episode is not None:

@@ -793,9 +793,19 @@ def sweep_png(
     from cartpole_q.figures import SweepAxis, sweep_figure
 
     axes = [SweepAxis(key, [axis_cell(v) for v in values]) for key, values in spec.grid.items()]
-    if spec.zip:  # the zip group is one more axis
-        first = next(iter(spec.zip.values()))
-        axes.append(SweepAxis(" + ".join(spec.zip), [axis_cell(v) for v in first]))
+    if spec.zip:  # the zip group is one more axis, each value naming all its keys' values
+        labels = [
+            ", ".join(axis_cell(v) for v in values)
+            for values in zip(*spec.zip.values(), strict=True)
+        ]
+        axes.append(SweepAxis(" + ".join(spec.zip), labels))
+    if point_rows and all(row.statistics.mean_rms_error is not None for row in point_rows):
+        from cartpole_q.figures import prediction_sweep_figure
+
+        ids = [spec.point_id(point.index) for point in spec.points]
+        return prediction_sweep_figure(
+            spec.name, axes, ids, [row.statistics.as_row() for row in point_rows]
+        )
     eval_means = []
     for point in spec.points:
         rows = by_point.get(spec.point_id(point.index), [])

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import ConfigError, parse_seeds, shown_value
+from cartpole_q.config.bounds import check_count, check_memory
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
@@ -205,6 +206,11 @@ def load_study(path: Path) -> Study:
     tolerance = _number(raw, "tolerance", 1e-9, where)
     if kind == "expected_vs_sample":
         branching = _branching(raw, where, 2)
+        for b in branching:
+            check_count(where, "branching", b, MAX_BRANCHING)
+            # per problem its b values, and the sample and expected errors after 0..2b updates
+            check_memory(where, "branching", len(seeds) * (2 * b + 1) * 8 * 4,
+                         f"{len(seeds):,} problems of branching factor {b:,}")  # fmt: skip
     elif kind == "until_optimal":
         return _until_optimal_study(raw, name, seeds, file, title, where)
     else:
@@ -223,7 +229,9 @@ def load_study(path: Path) -> Study:
                 f"{where}: panels: must be a list such as [{{states: 1000, branching: [1, 3], "
                 f"updates: 20000, every: 500}}], got {shown_value(panels_raw)}."
             )
-        panels = tuple(_panel(entry, index, where) for index, entry in enumerate(panels_raw))
+        panels = tuple(
+            _panel(entry, index, where, actions) for index, entry in enumerate(panels_raw)
+        )
     return Study(
         name, kind, seeds, branching, initial_error, panels, actions, epsilon, termination,
         tolerance, file, title, where,
@@ -267,7 +275,14 @@ def _until_optimal_study(
     if theta < 0:
         raise ConfigError(f"{where}: theta: must not be negative, got {theta:g}.")
     planning_steps = _whole(raw, "planning_steps", 5, where, 0)
+    check_count(where, "planning_steps", planning_steps, MAX_BRANCHING)
     max_updates = _whole(raw, "max_updates", 10_000_000, where, 1)
+    check_count(where, "max_updates", max_updates)
+    for scale in scales:
+        check_count(where, "scales", scale, MAX_SCALE,
+                    f"a maze of {maze_states(MAX_SCALE):,} states; the book's largest has about 6,000")  # fmt: skip
+        check_memory(where, "scales", maze_states(scale) * MAZE_BYTES_PER_STATE,
+                     f"the maze of scale {scale} ({maze_states(scale):,} states)")  # fmt: skip
     return Study(
         name, "until_optimal", seeds, (), 1.0, (), 4, epsilon, 0.0, 0.0, file, title, where,
         tuple(scales), tuple(methods), alpha, gamma, planning_steps, theta, max_updates,
@@ -319,7 +334,7 @@ def until_optimal_curves(study: Study, runs: Mapping[tuple[str, int], list[Any]]
     return curves
 
 
-def _panel(raw: Any, index: int, where: str) -> Panel:
+def _panel(raw: Any, index: int, where: str, actions: int) -> Panel:
     here = f"{where}: panels[{index}]"
     if not isinstance(raw, Mapping):
         raise ConfigError(
@@ -336,7 +351,32 @@ def _panel(raw: Any, index: int, where: str) -> Panel:
     every = _whole(raw, "every", None, here, 1)
     if updates % every:
         raise ConfigError(f"{here}.every: must divide updates ({updates:,}), got {every:,}.")
+    key = f"panels[{index}]"
+    check_count(where, f"{key}.updates", updates)
+    check_count(where, f"{key}.states", states, MAX_TASK_STATES)
+    for b in branching:
+        check_count(where, f"{key}.branching", b, MAX_BRANCHING)
+        # a task's next states (int64) and rewards (float64) per state, action and branch;
+        # its values and the curve
+        needed = 16 * states * actions * b + 8 * states * actions + 8 * (updates // every + 1)
+        check_memory(
+            where,
+            f"{key}.states",
+            needed,
+            f"a task of {states:,} states x {actions} actions x branching {b:,}",
+        )
     return Panel(states, branching, updates, every)
+
+
+MAX_BRANCHING = 10_000_000
+"""the largest branching factor (and planning steps): far beyond the book's 10,000"""
+MAX_TASK_STATES = 100_000_000
+"""the most states of a Figure 8.8 task (the book's largest: 10,000)"""
+MAX_SCALE = 100
+"""the largest maze scale ``k`` of ``until_optimal``"""
+MAZE_BYTES_PER_STATE = 4_096
+"""what a maze state costs while it is built and played: its transition table in Python
+(four lists of one outcome each) and the run's arrays"""
 
 
 def _averaged(label: str, x: np.ndarray, rows: np.ndarray, interval: bool) -> Curve:

@@ -62,11 +62,13 @@ RESULT_COLUMNS = (
     "env_steps",
     "train_seconds",
     "mean_return",
+    "rms_error",
 )
 """the ``results.csv`` columns after ``point`` and the axes"""
-ADDED_COLUMNS = ("mean_return",)
-"""columns added since the first ``results.csv``: a file without them (an older sweep) is
-read, and resumed, with their cells empty"""
+ADDED_COLUMNS = ("mean_return", "rms_error")
+"""columns added since the first ``results.csv``, in the order they were added: a file
+that stops before one of them (an older sweep) is read, and resumed, with their cells
+empty"""
 TIMING_COLUMNS = ("train_seconds",)
 """the only columns that depend on the machine, the backend or an interruption"""
 
@@ -204,6 +206,8 @@ def parse_row(cells: Mapping[str, str], axes: Sequence[str], where: Path) -> Res
                 success=_flag(cells["success"]),
                 train_seconds=_finite(cells["train_seconds"] or "0"),
                 mean_return=_finite(mean) if (mean := cells.get("mean_return")) else None,
+                # a diverged prediction run's error is inf (or nan): a figure it produced
+                rms_error=float(error) if (error := cells.get("rms_error")) else None,
             ),
         )
     except (KeyError, ValueError, TypeError, OverflowError):
@@ -259,13 +263,23 @@ def read_results(directory: Path, axes: Sequence[str]) -> list[ResultRow]:
         return []
     with path.open(newline="", encoding="utf-8") as file:
         reader = csv.DictReader(file)
-        older = [column for column in result_header(axes) if column not in ADDED_COLUMNS]
-        if reader.fieldnames not in (result_header(axes), older):
+        if reader.fieldnames not in _readable_headers(axes):
             raise RunError(
                 f"{path}: its columns are not the ones {SWEEP_FILE} gives; the sweep directory "
                 "was changed by hand. Start a new sweep."
             )
         return [parse_row(cells, axes, path) for cells in reader]
+
+
+def _readable_headers(axes: Sequence[str]) -> list[list[str]]:
+    """This version's ``results.csv`` header and each older one (stopping before an added column).
+
+    >>> [header[-1] for header in _readable_headers([])]
+    ['rms_error', 'mean_return', 'train_seconds']
+    """
+    header = result_header(axes)
+    older = [header[: header.index(column)] for column in reversed(ADDED_COLUMNS)]
+    return [header, *older]
 
 
 def seed_key(seed: int, seeds: Sequence[int]) -> str:

@@ -1,0 +1,176 @@
+"""What a new user met at the edges of the study commands and prediction runs (issue 47).
+
+Each test failed on the code before the fix: a traceback (exit 1) where a one-paragraph
+refusal belongs, a NaN printed with exit 0, or a prediction sweep reported as a failed
+control sweep.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from cartpole_q.store import sweepdir
+from tests.conftest import invoke, write_yaml
+from tests.test_cli import assert_refused
+
+WALK = {
+    "env": {"id": "cartpole_q/RandomWalk5-v0"},
+    "agent": {"algorithm": "td", "policy": "random", "gamma": 1.0, "alpha": 0.1, "q_init": 0.5},
+    "train": {"episodes": 20, "eval_every": 0, "checkpoint_every": 0},
+    "eval": {"episodes": 1},
+}
+
+
+# -- item 3: a --set value that is not UTF-8 -------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "command", [("train", "--episodes", 1), ("optimum", "FrozenLake-v1")], ids=["train", "optimum"]
+)
+def test_a_set_value_that_is_not_utf8_is_refused_naming_it(
+    command: tuple[Any, ...], tmp_path: Path
+) -> None:
+    # the shell's $'agent.gamma=\xff' reaches Python as a surrogate escape
+    with_out = ("--out", tmp_path / "run") if command[0] == "train" else ()
+    result = invoke(*command, "--set", "agent.gamma=\udcff", *with_out)
+    assert_refused(result, "--set 'agent.gamma=\\udcff'", "not UTF-8 text")
+    assert not (tmp_path / "run").exists()
+
+
+# -- items 4 and 5: a prediction run reports its error -------------------------------------
+
+
+def test_a_prediction_run_reports_its_error_not_a_solve(tmp_path: Path) -> None:
+    config = write_yaml(tmp_path / "walk.yaml", WALK)
+    result = invoke("train", "-c", config, "--out", tmp_path / "run")
+    assert result.exit_code == 0, result.output
+    assert "not solved" not in result.output
+    summary = json.loads((tmp_path / "run" / "summary.json").read_text())
+    with (tmp_path / "run" / "metrics.csv").open(newline="") as file:
+        last = list(csv.DictReader(file))[-1]
+    assert summary["rms_error"] == float(last["rms_error"])  # the error after the last episode
+    assert summary["v_table"] == {"episode": 20, "source": "last episode"}
+    assert "q_table" not in summary
+    assert f"RMS error {summary['rms_error']:.4g}" in result.output
+    from cartpole_q import load_run
+
+    assert load_run(tmp_path / "run").result.rms_error == summary["rms_error"]
+
+
+def test_a_prediction_sweep_reports_every_runs_error_and_each_points_mean(tmp_path: Path) -> None:
+    sweep = write_yaml(
+        tmp_path / "s.yaml",
+        {"name": "walk", "base": WALK, "seeds": "0-2", "grid": {"agent.alpha": [0.05, 0.2]}},
+    )
+    out = tmp_path / "sweep"
+    result = invoke("sweep", sweep, "--out", out, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert "RMS error after the last episode" in result.output
+    with (out / sweepdir.RESULTS_FILE).open(newline="") as file:
+        rows = list(csv.DictReader(file))
+    curves = np.load(sweepdir.curves_path(out, "000"))
+    assert float(rows[0]["rms_error"]) == float(curves["seed-000.rms_error"][-1])
+    with (out / sweepdir.POINTS_FILE).open(newline="") as file:
+        points = list(csv.DictReader(file))
+    for point in points:
+        errors = [float(row["rms_error"]) for row in rows if row["point"] == point["point"]]
+        assert point["seeds"] == "3"  # every seed ran, though none is evaluated greedily
+        assert float(point["mean_rms_error"]) == float(np.mean(errors))
+        assert float(point["mean_rms_error_low"]) <= float(point["mean_rms_error"])
+    drawn = (out / "sweep.csv").read_text()
+    assert "RMS error after the last episode" in drawn and "success rate" not in drawn
+
+
+# -- item 8: overflow refused, not printed as NaN -------------------------------------------
+
+BANDIT = {
+    "name": "b",
+    "testbed": {"k": 10, "mean": 0, "spread": 1},
+    "seeds": "0-1",
+    "steps": 10,
+    "curves": [{"method": "epsilon_greedy", "epsilon": 0.1}],
+    "figure": {"kind": "curves", "file": "b.png"},
+}
+
+
+def test_a_testbed_whose_rewards_overflow_is_refused_when_read(tmp_path: Path) -> None:
+    study = write_yaml(tmp_path / "b.yaml", {**BANDIT, "testbed": {"spread": 1.0e308}})
+    result = invoke("bandit", study, "--out", tmp_path / "b.png")
+    assert_refused(result, "testbed.spread: must be within", "1e+308")
+    assert not (tmp_path / "b.png").exists()
+
+
+def test_a_curve_that_overflowed_is_refused_with_its_step() -> None:
+    from cartpole_q.errors import RunError
+    from cartpole_q.experiments.bandits import Curve, _check_finite
+
+    curve = Curve("wild", "gradient", {"alpha": 1.0}, "alpha", (0.5, 2.0))
+    averages = np.array([[0.1, 0.2, 0.3], [0.1, np.inf, np.nan]])
+    with pytest.raises(RunError, match=r"'wild' \(alpha 2\) overflowed: .* at step 2 is inf"):
+        _check_finite(curve, averages, "b.yaml")
+
+
+# -- item 2: sizes bounded when read --------------------------------------------------------
+
+UPDATES = {"name": "u", "seeds": "0-1"}
+
+
+@pytest.mark.parametrize(
+    ("command", "study", "named"),
+    [
+        ("bandit", {**BANDIT, "steps": 10**12}, ("steps: must be at most 10,000,000",)),
+        (
+            "bandit",
+            {**BANDIT, "steps": 5_000_000,
+             "curves": [{"method": "epsilon_greedy", "vary": "epsilon", "values": [0.1] * 60}]},
+            ("steps: 60 learners' curves of 5,000,000 steps would take", "GiB of memory"),
+        ),
+        (
+            "updates",
+            {**UPDATES, "branching": [10**12], "figure": {"kind": "expected_vs_sample"}},
+            ("branching: must be at most 10,000,000",),
+        ),
+        (
+            "updates",
+            {**UPDATES, "seeds": "0-99", "branching": [5_000_000],
+             "figure": {"kind": "expected_vs_sample"}},
+            ("branching: 100 problems of branching factor 5,000,000 would take", "GiB"),
+        ),
+        (
+            "updates",
+            {**UPDATES, "panels": [{"states": 10**12, "branching": [1], "updates": 10, "every": 5}],
+             "figure": {"kind": "trajectory_sampling"}},
+            ("panels[0].states: must be at most",),
+        ),
+        (
+            "updates",
+            {**UPDATES, "panels": [{"states": 10**7, "branching": [40], "updates": 10, "every": 5}],
+             "figure": {"kind": "trajectory_sampling"}},
+            ("panels[0].states: a task of 10,000,000 states", "GiB of memory"),
+        ),
+        (
+            "updates",
+            {**UPDATES, "scales": [1], "max_updates": 10**21, "figure": {"kind": "until_optimal"}},
+            ("max_updates: must be at most",),
+        ),
+        (
+            "updates",
+            {**UPDATES, "scales": [100000], "figure": {"kind": "until_optimal"}},
+            ("scales: must be at most 100",),
+        ),
+    ],
+    ids=["bandit-steps", "bandit-memory", "branching", "branching-memory", "panel-states",
+         "panel-memory", "max-updates", "maze-scale"],
+)  # fmt: skip
+def test_a_size_no_study_needs_is_refused_when_read(
+    command: str, study: dict[str, Any], named: tuple[str, ...], tmp_path: Path
+) -> None:
+    path = write_yaml(tmp_path / "s.yaml", study)
+    assert_refused(invoke(command, path, "--out", tmp_path / "s.png"), *named)
+    assert not list(tmp_path.glob("s.*[!l]"))  # nothing written (the study file aside)
