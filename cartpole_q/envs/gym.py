@@ -1,8 +1,9 @@
 """Gymnasium environments: making them, and checking a config against one.
 
 Everything that can be wrong about a config only once the environment is known (an
-unknown id, unsupported spaces, a grid of the wrong dimension, a Q-table too large to
-allocate) is found here, before any run directory exists.
+unknown id, an argument of a type its constructor does not take, unsupported spaces, a grid
+of the wrong dimension, a Q-table too large to allocate) is found here, before any run
+directory exists.
 """
 
 from __future__ import annotations
@@ -18,8 +19,19 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import Config, ConfigError, EnvConfig, Provenance, blame, shorten, shown
+from cartpole_q.config import (
+    Config,
+    ConfigError,
+    EnvConfig,
+    Provenance,
+    blame,
+    shorten,
+    shown,
+    shown_value,
+)
 from cartpole_q.config.bounds import memory_text
+from cartpole_q.config.messages import type_name
+from cartpole_q.envs.arguments import NUMBER, Rule, constructor_parameters, declared, rule_of
 from cartpole_q.errors import RunError
 from cartpole_q.families import profile_for
 
@@ -236,6 +248,65 @@ def kwargs_error(env: EnvConfig, error: Exception, source: str | Provenance) -> 
     )
 
 
+DECLARED_ELSEWHERE: Mapping[tuple[str, str], Rule] = {
+    # Gymnasium writes `goal_velocity=0` with no annotation, but documents a float velocity
+    # (and MountainCar's compiled twin takes any finite number): 0 is no whole-number rule.
+    ("gymnasium.envs.classic_control.mountain_car:MountainCarEnv", "goal_velocity"): NUMBER,
+}
+"""the rules of arguments whose signature says less than their documentation, by the
+constructor (``module:qualname``) and the argument"""
+
+
+def check_env_kwargs(env: EnvConfig, spec: Any, source: str | Provenance = "config") -> None:
+    """Refuse an ``env.kwargs`` value of a type the world's constructor does not take.
+
+    The constructor is the entry point of the registered ``spec``; what each argument takes
+    is read from its signature (:mod:`cartpole_q.envs.arguments`). The arguments
+    ``gymnasium.make`` takes itself (``max_episode_steps``, ``disable_env_checker``,
+    ``render_mode``) are not the constructor's (the config's reading checks the time limit
+    and refuses a render mode); a key the constructor does not name, or a constructor whose
+    signature cannot be read, is left to ``gymnasium.make``, which names what it refuses.
+
+    >>> import gymnasium
+    >>> from cartpole_q.config import load_config
+    >>> env = load_config(overrides={"env.id": "FrozenLake-v1", "env.kwargs.is_slippery": 1}).env
+    >>> check_env_kwargs(env, gymnasium.spec("FrozenLake-v1"), "a.yaml")
+    Traceback (most recent call last):
+    ...
+    cartpole_q.errors.ConfigError: a.yaml: env.kwargs.is_slippery: 'FrozenLake-v1' expects is_slippery to be a boolean (true or false), got 1 (a number); FrozenLakeEnv declares is_slippery: bool = True.
+
+    Raises:
+        ConfigError: naming ``env.kwargs.<key>``, what the world expects and what was given.
+    """
+    import inspect
+
+    import gymnasium
+    from gymnasium.envs.registration import load_env_creator
+
+    make_parameters = inspect.signature(gymnasium.make).parameters.values()
+    own = {p.name for p in make_parameters if p.kind is not p.VAR_KEYWORD} | {"render_mode"}
+    entry_point = spec.entry_point
+    try:
+        creator = load_env_creator(entry_point) if isinstance(entry_point, str) else entry_point
+        owner, parameters, namespace = constructor_parameters(creator)
+    except Exception:  # an entry point that cannot be read: gymnasium.make says what is wrong
+        return
+    where = f"{getattr(creator, '__module__', '')}:{getattr(creator, '__qualname__', '')}"
+    for name, value in env.kwargs.items():
+        parameter = parameters.get(name)
+        if name in own or parameter is None:
+            continue
+        rule = DECLARED_ELSEWHERE.get((where, name)) or rule_of(parameter, namespace)
+        if rule is None or rule.accepts(value):
+            continue
+        field = f"env.kwargs.{shorten(name)}"
+        given = "null" if value is None else f"{shown_value(value)} (a {type_name(value)})"
+        raise ConfigError(
+            f"{blame(source, field)}: {field}: {shown(env.id)} expects {shorten(name)} to be "
+            f"{rule.text}, got {given}; {owner} declares {shorten(declared(parameter))}."
+        )
+
+
 def set_physics(env: Any, physics: Mapping[str, float | str]) -> None:
     """Set physics on ``env.unwrapped`` as the environment's profile does it.
 
@@ -301,17 +372,25 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
 
     Raises:
         ConfigError: naming ``env.id``, ``env.kwargs``, ``discretization`` or
-            ``agent.max_q_table_bytes``, when the environment cannot be made, its actions
+            ``agent.max_q_table_bytes``, when the environment cannot be made or an
+            ``env.kwargs`` value does not fit its constructor's signature, its actions
             are not a Discrete from 0, its observations not a 1-D Box, a Discrete or a Tuple
             of Discrete spaces, a Box has no grid or one of another dimension, a Discrete
             observation is given a grid, or the Q-table would exceed the size limit.
     """
+    import gymnasium
     from gymnasium import spaces
 
     env_id = config.env.id
+    # Before the world is made: its constructor may take a value of the wrong type silently.
+    registered = gymnasium.registry.get(env_id.rpartition(":")[2])
+    if registered is not None:
+        check_env_kwargs(config.env, registered, source)
     env = make_env(config.env, source=source)
     try:
         observation_space, action_space, spec = env.observation_space, env.action_space, env.spec
+        if registered is None and spec is not None:  # registered by the module make imported
+            check_env_kwargs(config.env, spec, source)
         try:  # some arguments are only used, and refused, at the first reset
             env.reset(seed=0)
         except Exception as error:
