@@ -181,16 +181,20 @@ def small_study(tmp_path: Path, name: str, **change: Any) -> Path:
 
 
 def test_bandit_draws_a_figure_with_its_data_and_prints_the_books_numbers(tmp_path: Path) -> None:
-    out = tmp_path / "fig2_2.png"
+    out = tmp_path / "fig2_2"
     path = small_study(tmp_path, "fig2_2_epsilon_greedy")
     result = invoke("bandit", path, "--out", out)
     assert result.exit_code == 0, result.output
-    lines = result.stdout.splitlines()
+    assert "bandit: 60/60 runs, 3/3 learners" in result.stdout  # progress, counted in runs
+    lines = [line for line in result.stdout.splitlines() if not line.startswith("bandit: ")]
     assert lines[0].startswith("fig2_2_epsilon_greedy: 20 runs x 100 steps on the 10-armed")
     assert any(line.startswith("  ε = 0.1, average reward at step 1,000: book ~1.35, ours ")
                for line in lines)  # fmt: skip
-    assert lines[-1] == str(out) and out.read_bytes().startswith(b"\x89PNG")
-    rows = list(csv.DictReader((tmp_path / "fig2_2.csv").read_text(encoding="utf-8").splitlines()))
+    figure = out / "fig2_2_epsilon_greedy.png"
+    assert lines[-1] == str(out) and figure.read_bytes().startswith(b"\x89PNG")
+    assert (out / "summary.txt").read_text(encoding="utf-8").splitlines() == lines[:-1]
+    data = out / "fig2_2_epsilon_greedy.csv"
+    rows = list(csv.DictReader(data.read_text(encoding="utf-8").splitlines()))
     curve = [
         row for row in rows if row["panel"] == "% Optimal action" and row["series"] == "ε = 0.1"
     ]
@@ -199,13 +203,15 @@ def test_bandit_draws_a_figure_with_its_data_and_prints_the_books_numbers(tmp_pa
     expected = play_curve(agent_of(LEARNERS["epsilon 0.1"]), TESTBEDS["stationary"],
                           list(range(20)), 100)  # fmt: skip
     assert [float(row["y"]) for row in curve] == expected.optimal_percent.tolist()
-    # The gymnasium engine writes the same data.
-    other = tmp_path / "other.png"
+    # The gymnasium engine writes the same data; `study` runs the same file the same way.
+    other = tmp_path / "other"
     assert invoke("bandit", path, "--out", other, "--engine", "gymnasium").exit_code == 0
-    assert (tmp_path / "other.csv").read_bytes() == (tmp_path / "fig2_2.csv").read_bytes()
+    assert (other / data.name).read_bytes() == data.read_bytes()
+    assert "engine: gymnasium" in (other / "study.yaml").read_text(encoding="utf-8")
+    assert invoke("study", path, "--out", tmp_path / "third", "-q").exit_code == 0
+    assert (tmp_path / "third" / data.name).read_bytes() == data.read_bytes()
     again = invoke("bandit", path, "--out", out)
-    assert again.exit_code == 2 and "already exists; pass --force" in again.stderr
-    assert invoke("bandit", path, "--out", out, "--force").exit_code == 0
+    assert again.exit_code == 2 and "points at a non-empty directory" in again.stderr
 
 
 @pytest.mark.parametrize(
@@ -240,21 +246,27 @@ def test_bandit_refuses_bad_study_files_with_exit_code_2(
     tmp_path: Path, change: dict[str, Any], message: str
 ) -> None:
     path = small_study(tmp_path, "fig2_2_epsilon_greedy", **change)
-    result = invoke("bandit", path, "--out", tmp_path / "figure.png")
+    result = invoke("bandit", path, "--out", tmp_path / "study")
     assert result.exit_code == 2, result.output
     assert message in result.stderr, result.stderr
     assert result.stderr.startswith(f"error: {path}") and "Traceback" not in result.stderr
-    assert not (tmp_path / "figure.png").exists()
+    assert not (tmp_path / "study").exists()
 
 
 def test_bandit_refuses_a_missing_file_a_bad_out_and_a_bad_engine(tmp_path: Path) -> None:
     result = invoke("bandit", tmp_path / "nope.yaml")
     assert result.exit_code == 2 and "study file not found" in result.stderr
     study = BOOK / "fig2_2_epsilon_greedy.yaml"
+    (tmp_path / "f.txt").write_text("x")
     result = invoke("bandit", study, "--out", tmp_path / "f.txt")
-    assert result.exit_code == 2 and "--out cannot write files ending in .txt" in result.stderr
-    result = invoke("bandit", study, "--engine", "jax")
-    assert result.exit_code == 2 and "--engine: must be one of numba, gymnasium" in result.stderr
+    assert (
+        result.exit_code == 2 and "--out must be a directory, but this is a file" in result.stderr
+    )
+    result = invoke("bandit", study, "--engine", "jax", "--out", tmp_path / "s")
+    assert result.exit_code == 2 and "engine: must be one of numba, gymnasium" in result.stderr
+    result = invoke("bandit", REPO / "examples" / "book" / "fig4_1_small_gridworld.yaml")
+    assert result.exit_code == 2 and "is a dp study, not a bandit study" in result.stderr
+    assert not (tmp_path / "s").exists()
 
 
 # -- the book's figures ---------------------------------------------------------------------------
@@ -272,10 +284,11 @@ def test_each_shipped_study_runs_on_few_runs(tmp_path: Path, study: Path) -> Non
     assert data["seeds"] == "0-1999"
     assert data["steps"] == (10_000 if study.stem.startswith("exercise") else 1000)
     path = small_study(tmp_path, study.stem, seeds="0-1", steps=20)
-    out = tmp_path / "figure.png"
-    result = invoke("bandit", path, "--out", out)
+    out = tmp_path / "study"
+    result = invoke("study", path, "--out", out, "--workers", 1)
     assert result.exit_code == 0, result.output
-    assert out.is_file() and (tmp_path / "figure.csv").is_file()
+    figure = out / data["figure"]["file"]
+    assert figure.is_file() and figure.with_suffix(".csv").is_file()
     assert (BOOK_DATA / data["figure"]["file"]).is_file()
 
 
@@ -343,10 +356,10 @@ def test_ctrl_c_stops_a_study_within_seconds_with_exit_code_130(tmp_path: Path) 
     import sys
     import time
 
-    out = tmp_path / "figure.png"
+    out = tmp_path / "study"
     process = subprocess.Popen(
         [sys.executable, "-m", "cartpole_q", "bandit", str(BOOK / "fig2_6_parameter_study.yaml"),
-         "--out", str(out), "--engine", "gymnasium"],
+         "--out", str(out), "--engine", "gymnasium", "--workers", "1"],
         cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
         stdout=subprocess.PIPE, stderr=subprocess.PIPE,
     )  # fmt: skip
@@ -356,12 +369,10 @@ def test_ctrl_c_stops_a_study_within_seconds_with_exit_code_130(tmp_path: Path) 
     _, stderr = process.communicate(timeout=30)
     assert process.returncode == 130, stderr
     assert time.monotonic() - sent < 5.0
-    assert (
-        b"stopping after the current run" in stderr
-        and b"interrupted: nothing was written" in stderr
-    )
+    assert b"stopping after the runs in flight" in stderr
+    assert f"finish it with `cartpole-q bandit --resume {out}`".encode() in stderr
     assert b"Traceback" not in stderr
-    assert not out.exists()
+    assert not (out / "fig2_6_parameter_study.png").exists()
 
 
 def test_a_study_reads_fractions_defaults_and_sample_averages(tmp_path: Path) -> None:

@@ -226,17 +226,17 @@ def test_the_small_gridworld_plays_its_table() -> None:
 
 
 def test_dp_draws_fig_4_1_with_its_data_and_prints_the_books_numbers(tmp_path: Path) -> None:
-    out = tmp_path / "fig4_1.png"
+    out = tmp_path / "fig4_1"
     result = invoke("dp", BOOK / "fig4_1_small_gridworld.yaml", "--out", out)
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
-    assert "426 synchronous sweeps" in lines[0]
+    assert "426 synchronous sweeps" in lines[0]  # no progress line: the study is one run
     assert "  k = ∞, state (0, 3): book -22, ours -22 (-22; same)" in lines
     assert "  k = 2, next to a corner (0, 1): book -1.7, ours -1.7 (-1.75; same)" in lines
     assert "differs" not in result.stdout
-    assert lines[-1] == str(out) and lines[-2] == str(tmp_path / "fig4_1_sweeps.csv")
-    assert out.read_bytes().startswith(b"\x89PNG")
-    data = (tmp_path / "fig4_1.csv").read_text(encoding="utf-8").splitlines()
+    assert lines[-1] == str(out)
+    assert (out / "fig4_1_small_gridworld.png").read_bytes().startswith(b"\x89PNG")
+    data = (out / "fig4_1_small_gridworld.csv").read_text(encoding="utf-8").splitlines()
     assert data[0] == "panel,series,x,y,y_low,y_high,value"
     final = {
         (row["x"], row["y"]): float(row["value"])
@@ -245,16 +245,17 @@ def test_dp_draws_fig_4_1_with_its_data_and_prints_the_books_numbers(tmp_path: P
     }
     assert len(final) == 16 and final["3", "0"] == pytest.approx(-22.0, abs=1e-8)
     assert '"greedy w.r.t. v_k, k = 1",greedy actions,1,0,,,left' in data
-    sweeps = (tmp_path / "fig4_1_sweeps.csv").read_text(encoding="utf-8").splitlines()
-    assert sweeps[0] == "record,step,state,value"
-    assert "values,2,1,-1.75" in sweeps and "policy,1,1,2" in sweeps  # left is action 2
-    assert len(sweeps) == 1 + 427 * 16 * 2
-    # The files exist now: a second run needs --force.
+    sweeps = (out / "fig4_1_small_gridworld_sweeps.csv").read_text(encoding="utf-8")
+    sweeps_lines = sweeps.splitlines()
+    assert sweeps_lines[0] == "record,step,state,value"
+    assert "values,2,1,-1.75" in sweeps_lines and "policy,1,1,2" in sweeps_lines  # left: 2
+    assert len(sweeps_lines) == 1 + 427 * 16 * 2
+    # The directory holds a study now: a second one is refused there, `study` makes the same.
     again = invoke("dp", BOOK / "fig4_1_small_gridworld.yaml", "--out", out)
-    assert again.exit_code == 2 and "already exists; pass --force" in again.stderr
-    assert (
-        invoke("dp", BOOK / "fig4_1_small_gridworld.yaml", "--out", out, "--force").exit_code == 0
-    )
+    assert again.exit_code == 2 and "points at a non-empty directory" in again.stderr
+    other = tmp_path / "other"
+    assert invoke("study", BOOK / "fig4_1_small_gridworld.yaml", "--out", other).exit_code == 0
+    assert (other / "fig4_1_small_gridworld_sweeps.csv").read_text(encoding="utf-8") == sweeps
 
 
 @pytest.mark.parametrize(
@@ -269,7 +270,16 @@ def test_dp_draws_fig_4_1_with_its_data_and_prints_the_books_numbers(tmp_path: P
         ({"book": [{"label": "x", "value": 1, "state": 99}]}, "book[0].state: 99 is not a state"),
         ({"book": [{"label": "x", "value": 1, "state": 1, "sweep": 9999}]}, "made only 426"),
         ({"policy": 7}, "policy: action 7 does not exist"),
-        ({"max_sweeps": 5}, "did not converge in 5 sweeps"),
+        ({"max_sweeps": 11}, "did not converge in 11 sweeps"),
+        ({"max_sweeps": 5}, "figure.show: sweep 10 is beyond max_sweeps (5)"),
+        (
+            {"figure": {"kind": "gambler"}},
+            "cartpole_q/SmallGridworld-v0 is not the gambler's problem",
+        ),
+        (
+            {"algorithm": "value_iteration", "policy": 0},
+            "policy: value iteration starts from v = 0",
+        ),
         ({"tolerance": "fast"}, "tolerance: must be a number"),
         ({"tolerance": 0}, "tolerance: must be positive"),
         ({"policy": "greedy"}, "policy: must be random or an action"),
@@ -292,18 +302,21 @@ def test_dp_refuses_bad_study_files_with_exit_code_2(
     study = yaml.safe_load((BOOK / "fig4_1_small_gridworld.yaml").read_text(encoding="utf-8"))
     study.update(change)
     path = write_yaml(tmp_path / "study.yaml", study)
-    result = invoke("dp", path, "--out", tmp_path / "figure.png")
+    result = invoke("dp", path, "--out", tmp_path / "out")
     assert result.exit_code == 2, result.output
     assert message in result.stderr, result.stderr
     assert result.stderr.startswith(f"error: {path}") and "Traceback" not in result.stderr
-    assert not (tmp_path / "figure.png").exists()
+    assert not (tmp_path / "out").exists()  # also when only the run found it
 
 
 def test_dp_refuses_a_missing_study_file_and_a_bad_out(tmp_path: Path) -> None:
     result = invoke("dp", tmp_path / "nope.yaml")
     assert result.exit_code == 2 and "study file not found" in result.stderr
+    (tmp_path / "f.txt").write_text("x")
     result = invoke("dp", BOOK / "fig4_1_small_gridworld.yaml", "--out", tmp_path / "f.txt")
-    assert result.exit_code == 2 and "--out cannot write files ending in .txt" in result.stderr
+    assert (
+        result.exit_code == 2 and "--out must be a directory, but this is a file" in result.stderr
+    )
 
 
 # -- Figure 4.3: the gambler ------------------------------------------------------------------
@@ -406,7 +419,7 @@ DP_STUDIES = {
 
 @pytest.mark.parametrize("name", DP_STUDIES)
 def test_each_dp_study_agrees_with_the_book_and_the_docs_data(name: str, tmp_path: Path) -> None:
-    result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / f"{name}.png")
+    result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / "out")
     assert result.exit_code == 0, result.output
     differs = {
         line.strip().partition(": book")[0]
@@ -414,11 +427,11 @@ def test_each_dp_study_agrees_with_the_book_and_the_docs_data(name: str, tmp_pat
         if line.endswith("differs)")
     }
     assert differs == DP_STUDIES[name]
-    assert (tmp_path / f"{name}_sweeps.csv").is_file()
+    assert (tmp_path / "out" / f"{name}_sweeps.csv").is_file()
     # docs/book holds the figure's data as the command writes it; the numbers agree to 1e-9
     # (another machine's BLAS may sum in another order), the rest exactly.
     shipped = (REPO / "docs" / "book" / f"{name}.csv").read_text(encoding="utf-8")
-    made = (tmp_path / f"{name}.csv").read_text(encoding="utf-8")
+    made = (tmp_path / "out" / f"{name}.csv").read_text(encoding="utf-8")
     rows = zip(csv.reader(made.splitlines()), csv.reader(shipped.splitlines()), strict=True)
     for ours, theirs in rows:
         assert ours[:2] == theirs[:2]
@@ -457,17 +470,23 @@ def test_the_figures_data_is_what_they_draw(tmp_path: Path) -> None:
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(figures, "figure_bytes", keep)
         for name in ("fig4_3_gambler", "fig4_2_car_rental"):
-            result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / f"{name}.png")
+            result = invoke("dp", BOOK / f"{name}.yaml", "--out", tmp_path / name)
             assert result.exit_code == 0, result.output
     gambler, rental = drawn
-    rows = list(csv.DictReader((tmp_path / "fig4_3_gambler.csv").open(encoding="utf-8")))
+    rows = list(
+        csv.DictReader((tmp_path / "fig4_3_gambler" / "fig4_3_gambler.csv").open(encoding="utf-8"))
+    )
     top, bottom = gambler.axes
     for line in top.get_lines():
         series = [row for row in rows if row["series"] == line.get_label()]
         assert [float(row["y"]) for row in series] == list(line.get_ydata())
     stakes = [int(row["y"]) for row in rows if row["series"] == "stake"]
     assert stakes == list(bottom.get_lines()[0].get_ydata()) and stakes[49] == 50
-    rows = list(csv.DictReader((tmp_path / "fig4_2_car_rental.csv").open(encoding="utf-8")))
+    rows = list(
+        csv.DictReader(
+            (tmp_path / "fig4_2_car_rental" / "fig4_2_car_rental.csv").open(encoding="utf-8")
+        )
+    )
     last = {(int(r["y"]), int(r["x"])): int(r["value"]) for r in rows if r["panel"] == "pi_4"}
     drawn_moves = rental.axes[4].collections[0].get_array().reshape(21, 21)
     assert all(drawn_moves[key] == move for key, move in last.items()) and len(last) == 441

@@ -144,3 +144,38 @@ def test_two_tunes_on_one_out(
     name, trials = [("a", 2), ("b", 3)][winner]
     assert yaml.safe_load((out / tunedir.TUNE_FILE).read_text())["name"] == name
     assert len((out / tunedir.TRIALS_FILE).read_text().splitlines()) == 1 + trials
+
+
+BOOK = Path(__file__).resolve().parents[1] / "examples" / "book"
+
+
+@pytest.mark.parametrize("instant", INSTANTS)
+@pytest.mark.parametrize("command", ["dp", "study"])
+def test_two_studies_on_one_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, instant: str, command: str
+) -> None:
+    """Issue 47 item 6: two dp (or bandit, updates) commands on one --out both exited 0."""
+    from cartpole_q.store import studydir
+
+    files = [BOOK / "fig4_1_small_gridworld.yaml", BOOK / "fig3_2_gridworld.yaml"]
+    out = tmp_path / "out"
+    first, second = ((command, file, "--out", out, "-q") for file in files)
+    results = _race(monkeypatch, instant, (studydir, "write_start"), first, second)
+    winner, _ = _one_wins(out, *results)
+    name = files[winner].stem
+    assert yaml.safe_load((out / studydir.STUDY_FILE).read_text())["name"] == name
+    assert sorted(path.name for path in out.glob("*.png")) == [f"{name}.png"]
+    assert (out / studydir.SUMMARY_FILE).read_text().startswith(f"{name}: ")
+    resumed = invoke(command, "--resume", out, "-q")  # whole: nothing left to run
+    assert resumed.exit_code == 0, resumed.output
+
+
+def test_a_dangling_symlink_out_is_refused_not_replaced(tmp_path: Path) -> None:
+    """Issue 47 item 6: a dangling-symlink --out was replaced without --force."""
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "nowhere")
+    for command in ("dp", "study", "sweep"):
+        result = invoke(command, BOOK / "fig4_1_small_gridworld.yaml", "--out", link, "-q")
+        assert result.exit_code == 2, result.output
+        assert "dangling symbolic link" in result.stderr, result.stderr
+        assert link.is_symlink() and not (tmp_path / "nowhere").exists()

@@ -96,29 +96,29 @@ def rows(path: Path) -> list[dict[str, str]]:
 
 def test_updates_draws_figure_8_7_with_its_data(tmp_path: Path) -> None:
     path = small_study(tmp_path, "fig8_7_expected_vs_sample")
-    out = tmp_path / "f.png"
+    out = tmp_path / "study"
     result = invoke("updates", path, "--out", out)
     assert result.exit_code == 0, result.output
     assert "b = 10: t = b/10: " in result.stdout and "then 0 (the largest" in result.stdout
-    assert result.stdout.splitlines()[-1] == str(out) and out.stat().st_size > 0
-    data = rows(out.with_suffix(".csv"))
+    figure = out / "fig8_7_expected_vs_sample.png"
+    assert result.stdout.splitlines()[-1] == str(out) and figure.stat().st_size > 0
+    data = rows(figure.with_suffix(".csv"))
     b10 = [float(r["y"]) for r in data if r["series"] == "sample updates, b = 10"]
     assert b10 == rms_curve(list(range(5)), 10)
     assert [float(r["x"]) for r in data if r["series"] == "sample updates, b = 10"][10] == 1.0
     expected = [(float(r["x"]), float(r["y"])) for r in data if r["series"] == "expected updates"]
     assert expected == [(0.0, 1.0), (1.0, 1.0), (1.0, 0.0), (2.0, 0.0)]
     again = invoke("updates", path, "--out", out)
-    assert again.exit_code == 2 and "already exists; pass --force" in again.stderr
-    assert invoke("updates", path, "--out", out, "--force").exit_code == 0
+    assert again.exit_code == 2 and "points at a non-empty directory" in again.stderr
 
 
 def test_updates_draws_figure_8_8_with_its_data(tmp_path: Path) -> None:
     path = small_study(tmp_path, "fig8_8_trajectory_sampling")
-    out = tmp_path / "f.png"
+    out = tmp_path / "study"
     result = invoke("updates", path, "--out", out)
     assert result.exit_code == 0, result.output
     assert "b = 3, on-policy vs uniform at " in result.stdout
-    data = rows(out.with_suffix(".csv"))
+    data = rows(out / "fig8_8_trajectory_sampling.csv")
     series = [r for r in data if r["series"] == "b = 3, on-policy" and r["panel"] == "20 states"]
     curves = [start_values(s, 20, 2, 3, 200, 50, 0.1, 0.1, 1e-9, True) for s in (0, 1)]
     assert [float(r["x"]) for r in series] == [0.0, 50.0, 100.0, 150.0, 200.0]
@@ -152,11 +152,11 @@ def test_updates_refuses_bad_study_files_with_exit_code_2(
     tmp_path: Path, figure: str, change: dict[str, Any], message: str
 ) -> None:
     path = small_study(tmp_path, figure, **change)
-    result = invoke("updates", path, "--out", tmp_path / "figure.png")
+    result = invoke("updates", path, "--out", tmp_path / "out")
     assert result.exit_code == 2, result.output
     assert message in result.stderr, result.stderr
     assert result.stderr.startswith(f"error: {path}") and "Traceback" not in result.stderr
-    assert not (tmp_path / "figure.png").exists()
+    assert not (tmp_path / "out").exists()
 
 
 def test_updates_refuses_a_missing_file(tmp_path: Path) -> None:

@@ -290,7 +290,10 @@ def test_a_sweep_without_axes_says_it_is_one_point(in_tmp: Path) -> None:
     path = write_yaml(in_tmp / "one.yaml", {"base": {"train": {"episodes": 5}}, "seeds": "0-1"})
     result = invoke("sweep", path, "--out", in_tmp / "out", *QUICK)
     assert result.exit_code == 0, result.output
-    assert "has no grid or zip axes: every seed runs the base config (one point)" in result.stderr
+    assert (
+        "1 point x 2 seeds = 2 runs (no grid or zip axes: every seed runs the base config)"
+        in result.stderr
+    )
 
 
 def test_usage_errors_are_one_line_with_exit_2() -> None:

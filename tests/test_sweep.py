@@ -185,7 +185,7 @@ def test_the_command_refuses_bad_input_with_exit_2_and_writes_nothing(in_tmp: Pa
     assert invoke("sweep", big, "--resume", in_tmp).exit_code == 2
     result = invoke("sweep", "--resume", in_tmp)
     assert result.exit_code == 2
-    assert "is not a sweep directory" in result.output
+    assert "is not a study directory" in result.output
 
 
 # -- running a sweep ------------------------------------------------------------------------

@@ -184,11 +184,11 @@ def test_the_command_draws_the_figure_and_its_numbers(tmp_path: Path) -> None:
     )
     study = tmp_path / "study.yaml"
     study.write_text(text)
-    out = tmp_path / "figure.png"
+    out = tmp_path / "study"
     result = invoke("updates", study, "--out", out)
     assert result.exit_code == 0, result.output
     assert "k = 1 (47 states, shortest path 14 steps)" in result.output
-    with out.with_suffix(".csv").open() as handle:
+    with (out / "example8_4_prioritized_sweeping.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     assert [(row["series"], row["x"]) for row in rows] == [
         ("Prioritized sweeping", "47.0"),

@@ -1,21 +1,25 @@
 """The ``cartpole-q`` command line: every command registered on one Typer app.
 
-Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``, ``cli/planning.py``, ``cli/bandits.py``,
-``cli/updates.py``)
-parses its options, calls one library function and prints what it returns; what they share
-(exit codes, the stop routine, the options declared once) is in ``cli/base.py`` and
-``cli/options.py``.
+Each command (``cli/train.py``, ``cli/runs.py``, ``cli/studies.py``; the study aliases in
+``cli/bandits.py``, ``cli/planning.py`` and ``cli/updates.py``) parses its options, calls
+one library function and prints what it returns; what they share (exit codes, the stop
+routine, the options declared once) is in ``cli/base.py`` and ``cli/options.py``.
 """
 
 from __future__ import annotations
 
-from cartpole_q.cli import bandits, planning, runs, studies, train, updates
+import importlib
+
 from cartpole_q.cli.base import app
 
 __all__ = ["app", "main"]
 
-COMMAND_MODULES = (train, runs, studies, planning, bandits, updates)
-"""the modules whose commands are registered on :data:`app` (imported for that)"""
+COMMAND_MODULES = tuple(
+    importlib.import_module(f"cartpole_q.cli.{name}")
+    for name in ("train", "runs", "studies", "bandits", "planning", "updates")
+)
+"""the modules whose commands are registered on :data:`app`, in the order ``--help`` lists
+them: training and its runs first, then the studies, then the studies' older aliases"""
 
 
 def main() -> None:

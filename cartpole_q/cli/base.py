@@ -218,12 +218,14 @@ def exit_codes() -> Iterator[None]:
 
 
 @contextmanager
-def stoppable(hint: str | Callable[[], str]) -> Iterator[StopRequest]:
+def stoppable(
+    hint: str | Callable[[], str], stop_point: str = "the current episode"
+) -> Iterator[StopRequest]:
     """The one stop routine of every command that can stop cleanly.
 
-    A first SIGINT or SIGTERM asks the work to stop at its next safe point (the request is
-    yielded: pass ``stop.is_set`` down); a second stops at once, and the command says so
-    with ``hint`` (how to go on) and exits with 130.
+    A first SIGINT or SIGTERM asks the work to stop at its next safe point, ``stop_point``
+    (the request is yielded: pass ``stop.is_set`` down); a second stops at once, and the
+    command says so with ``hint`` (how to go on) and exits with 130.
 
     An exception with a ``text`` attribute (a sweep's, saying exactly what was saved) puts
     it before the hint (a callable hint is asked then, for what is known only later).
@@ -231,7 +233,8 @@ def stoppable(hint: str | Callable[[], str]) -> Iterator[StopRequest]:
     """
     from cartpole_q.experiments.run import StopRequest
 
-    with StopRequest(announce=lambda message: typer.echo(message, err=True)) as stop:
+    announce = lambda message: typer.echo(message, err=True)  # noqa: E731
+    with StopRequest(announce, stop_point) as stop:
         try:
             yield stop
         except KeyboardInterrupt as error:

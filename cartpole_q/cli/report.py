@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import math
 import sys
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from cartpole_q.results import MultiSeedSummary, RunSummary, Spread, is_success
-from cartpole_q.store.sweepdir import PointRow
 
 
 def _rows_single(run_dir: Path, summary: RunSummary) -> list[tuple[str, str]]:
@@ -221,98 +218,3 @@ def eval_seeds_text(parent: Path, result: dict[str, Any]) -> str:
         f"lowest {result['min']:.2f}"
     )
     return "\n".join(lines)
-
-
-SWEEP_TABLE_ROWS = 15
-"""``sweep`` prints at most this many points, the best first"""
-
-
-def _interval(value: float | None, low: float | None, high: float | None, digits: int) -> str:
-    if value is None or low is None or high is None:
-        return "-"
-    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
-
-
-def sweep_table(
-    axes: Sequence[str], point_rows: Sequence[PointRow], limit: int = SWEEP_TABLE_ROWS
-) -> list[str]:
-    """The points as text lines, best first (success rate, then IQM eval return).
-
-    >>> from cartpole_q.statistics import PointStatistics
-    >>> stats = PointStatistics(2, 1.0, 0.34, 1.0, 500.0, 500.0, 500.0, 175.0, 170.0, 180.0,
-    ...     9000.0, 8000.0, 10000.0)
-    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
-    ...     print(line)
-    point  agent.alpha  seeds  success rate [95%]  IQM eval return [95%]  median solve episode [95%]
-    000    0.1          2      1.00 [0.34, 1.00]   500.0 [500.0, 500.0]   175 [170, 180]
-    """
-    if point_rows and all(row.statistics.mean_rms_error is not None for row in point_rows):
-        return _prediction_table(axes, point_rows, limit)
-
-    def rank(row: PointRow) -> tuple[float, float]:
-        stats = row.statistics
-        rate = -1.0 if stats.success_rate is None else stats.success_rate
-        iqm = -math.inf if stats.iqm_eval_return is None else stats.iqm_eval_return
-        return (-rate, -iqm)
-
-    ordered = sorted(point_rows, key=rank)[:limit]
-    header = ["point", *axes, "seeds", "success rate [95%]", "IQM eval return [95%]",
-              "median solve episode [95%]"]  # fmt: skip
-    table = [header]
-    for row in ordered:
-        s = row.statistics
-        table.append([
-            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
-            _interval(s.success_rate, s.success_rate_low, s.success_rate_high, 2),
-            _interval(s.iqm_eval_return, s.iqm_eval_return_low, s.iqm_eval_return_high, 1),
-            _interval(s.median_solved_episode, s.median_solved_episode_low,
-                      s.median_solved_episode_high, 0),
-        ])  # fmt: skip
-    return _aligned(table)
-
-
-def _prediction_table(axes: Sequence[str], point_rows: Sequence[PointRow], limit: int) -> list[str]:
-    """Prediction points, the lowest final RMS error first.
-
-    >>> from cartpole_q.statistics import PointStatistics
-    >>> stats = PointStatistics(100, *[None] * 12, 0.0512, 0.049, 0.0533)
-    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
-    ...     print(line)
-    point  agent.alpha  seeds  RMS error after the last episode, mean [95%]
-    000    0.1          100    0.0512 [0.0490, 0.0533]
-    """
-    ordered = sorted(point_rows, key=lambda row: row.statistics.mean_rms_error or 0.0)[:limit]
-    table = [["point", *axes, "seeds", "RMS error after the last episode, mean [95%]"]]
-    for row in ordered:
-        s = row.statistics
-        table.append([
-            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
-            _interval(s.mean_rms_error, s.mean_rms_error_low, s.mean_rms_error_high, 4)
-            if s.mean_rms_error is None or math.isfinite(s.mean_rms_error)
-            else f"{s.mean_rms_error} (a run diverged)",
-        ])  # fmt: skip
-    return _aligned(table)
-
-
-def _aligned(table: list[list[str]]) -> list[str]:
-    """The rows of a table as lines, each column as wide as its widest cell."""
-    header = table[0]
-    widths = [max(len(line[i]) for line in table) for i in range(len(header))]
-    return ["  ".join(text.ljust(width) for text, width in zip(line, widths, strict=True)).rstrip()
-            for line in table]  # fmt: skip
-
-
-def print_sweep_summary(outcome: Any) -> None:
-    """Print a finished sweep's points (the best first) and where its files are."""
-    spec, directory = outcome.spec, outcome.directory
-    rows = outcome.points
-    shown = min(len(rows), SWEEP_TABLE_ROWS)
-    title = f"{len(rows)} points x {len(spec.seeds)} seeds"
-    if shown < len(rows):
-        title += f" (the best {shown} shown; all in points.csv)"
-    print(title)
-    for line in sweep_table(spec.axes, rows):
-        print(line)
-    print(f"points.csv, results.csv and sweep.png in {directory}")
-    if getattr(outcome, "figure", None) is not None:
-        print(f"the sweep file's figure: {outcome.figure}")

@@ -16,106 +16,215 @@ from cartpole_q.cli.base import (
     exit_codes,
     exit_if_stopped,
     kept_on_write_error,
-    note,
     say_if_compiling,
     stoppable,
 )
 from cartpole_q.cli.options import Address, Backend, Quiet, Workers, Yes
 from cartpole_q.errors import UserError
 
+STUDY_FILE_HELP = (
+    "The study file; its `kind` says what it is: sweep (a grid of configs on many seeds, "
+    "the default), bandit (the k-armed testbed), dp (dynamic programming on a model), "
+    "updates (chapter 8's planning studies)."
+)
+StudyFileArgument = Annotated[
+    Path | None,
+    typer.Argument(metavar="STUDY.yaml", help=STUDY_FILE_HELP, show_default=False),
+]
+Resume = Annotated[
+    Path | None,
+    typer.Option(metavar="DIR", help="Finish an interrupted study directory (a sweep's too)."),
+]
+StudyOut = Annotated[
+    Path | None,
+    typer.Option(
+        metavar="DIR",
+        help="Study directory to create; it must not exist or be empty.",
+        show_default="sweeps/<name>-<YYYYmmdd-HHMMSS> (a sweep), else studies/<name>-<...>",
+    ),
+]
+MaxRuns = Annotated[
+    int,
+    typer.Option(
+        metavar="N",
+        min=1,
+        help="Refuse studies of more runs (a sweep: points x seeds) than this, unless --yes.",
+    ),
+]
+Check = Annotated[
+    bool,
+    typer.Option(
+        "--check",
+        help="Read and check the study file, say what it would run, run nothing (exit 0 or 2).",
+    ),
+]
+
+
+STOP_POINT = "the runs in flight, saving what has finished"
+"""what a study does on a first signal"""
+
+
+@app.command("study", cls=Command)
+def study_command(
+    study_file: StudyFileArgument = None,
+    resume: Resume = None,
+    out: StudyOut = None,
+    workers: Workers = None,
+    backend: Backend = BackendChoice.local,
+    address: Address = None,
+    max_runs: MaxRuns = 20_000,
+    yes: Yes = False,
+    quiet: Quiet = False,
+    check: Check = False,
+) -> None:
+    """Run any study file (a sweep, bandits, dynamic programming, planning updates); the last line is its directory."""
+    run_study_command("study", None, study_file, resume, out, workers, backend, address,
+                      max_runs, yes, quiet, check)  # fmt: skip
+
 
 @app.command("sweep", cls=Command)
 def sweep_command(
     sweep_file: Annotated[
         Path | None,
-        typer.Argument(
-            metavar="SWEEP.yaml",
-            help="The sweep file: base config, seeds, grid and zip axes over dotted config keys.",
-            show_default=False,
-        ),
+        typer.Argument(metavar="SWEEP.yaml", help=STUDY_FILE_HELP, show_default=False),
     ] = None,
-    resume: Annotated[
-        Path | None,
-        typer.Option(metavar="DIR", help="Finish an interrupted sweep directory."),
-    ] = None,
-    out: Annotated[
-        Path | None,
-        typer.Option(
-            metavar="DIR",
-            help="Sweep directory to create; it must not exist or be empty.",
-            show_default="sweeps/<name>-<YYYYmmdd-HHMMSS>",
-        ),
-    ] = None,
+    resume: Resume = None,
+    out: StudyOut = None,
     workers: Workers = None,
     backend: Backend = BackendChoice.local,
     address: Address = None,
-    max_runs: Annotated[
-        int,
-        typer.Option(
-            metavar="N",
-            min=1,
-            help="Refuse sweeps of more runs (points x seeds) than this, unless --yes.",
-        ),
-    ] = 20_000,
+    max_runs: MaxRuns = 20_000,
     yes: Yes = False,
     quiet: Quiet = False,
+    check: Check = False,
 ) -> None:
-    """Train and evaluate every point of a sweep on every seed; the last line printed is its directory."""
-    # Connected (or refused) before the sweep directory is created.
+    """Train and evaluate every point of a sweep on every seed (`study` under its first name); the last line is its directory."""
+    run_study_command("sweep", None, sweep_file, resume, out, workers, backend, address,
+                      max_runs, yes, quiet, check)  # fmt: skip
+
+
+def run_study_command(
+    command: str,
+    required: str | None,
+    study_file: Path | None,
+    resume: Path | None,
+    out: Path | None,
+    workers: int | None,
+    backend: BackendChoice,
+    address: str | None,
+    max_runs: int,
+    yes: bool,
+    quiet: bool,
+    check: bool,
+    overrides: dict[str, object] | None = None,
+) -> None:
+    """``study`` and its aliases: read (or take up) a study, run it, print, exit.
+
+    Args:
+        command: the command's name, for messages (``cartpole-q sweep --resume ...``).
+        required: the kind an alias runs (``bandit``), or ``None``: any.
+        study_file: the study file (``None`` with ``resume``).
+        resume: the directory to finish.
+        out: the new directory.
+        workers: worker processes (``None``: one per core).
+        backend: local processes or Ray.
+        address: a running Ray cluster.
+        max_runs: the size guard (more runs need ``yes``).
+        yes: go ahead however large.
+        quiet: print only the directory.
+        check: read and check, run nothing.
+        overrides: study file keys an alias's options set (``bandit --engine``).
+    """
+    # Connected (or refused) before the study directory is created.
     with exit_codes(), backend_connection(backend, workers, address):
-        from cartpole_q.experiments import sweep as sweeping
-        from cartpole_q.store import sweepdir
+        from cartpole_q.experiments import study as studies
+        from cartpole_q.experiments.study_kinds import registered
         from cartpole_q.store.lock import directory_lock
 
+        kinds = registered()
+        started: list[Path] = []
+        hint = _resume_hint(command, "finish", lambda: started[0] if started else None)
         if resume is not None:
-            if sweep_file is not None or out is not None:
+            if study_file is not None or out is not None or check or overrides:
                 raise UserError(
-                    "--resume finishes a sweep exactly as it was started, so it takes neither "
-                    "a SWEEP.yaml nor --out."
+                    "--resume finishes a study exactly as it was started, so it takes neither "
+                    "a study file, --out, --check nor options that change the study."
                 )
-            sweepdir.sweep_file(resume)  # a sweep directory, before a lock file goes into it
-            hint = _resume_hint("sweep", "finish", lambda: resume)
-            with directory_lock(resume, "sweep"), stoppable(hint) as stop:
-                spec = sweeping.load_sweep_dir(resume)
-                outcome = _run_sweep(spec, resume, workers, backend, address, quiet, stop)
+            kind = studies.kind_of_directory(resume)
+            _check_kind(kind.name, required, str(resume), command)
+            started.append(resume)
+            what = "sweep" if kind.name == "sweep" else "study"
+            with directory_lock(resume, what), stoppable(hint, STOP_POINT) as stop:
+                spec = kind.load(resume)
+                outcome = kind.run(spec, resume, _options(workers, backend, address, quiet, stop))
         else:
-            if sweep_file is None:
-                raise UserError("give a SWEEP.yaml file, or --resume DIR to finish a sweep.")
-            spec = sweeping.prepare_sweep(sweep_file)
-            if not spec.axes:
-                note(
-                    f"{sweep_file} has no grid or zip axes: every seed runs the base config "
-                    "(one point)."
-                )
-            _check_size(
-                spec.runs, max_runs, yes, str(sweep_file),
-                f"{len(spec.points)} points x {len(spec.seeds)} seeds",
-            )  # fmt: skip
+            if study_file is None:
+                raise UserError("give a study file, or --resume DIR to finish a study.")
+            label = "sweep file" if command == "sweep" else "study file"
+            study = studies.read_study_file(study_file, default=required, label=label)
+            if overrides:
+                study = studies.study_of({**study.raw, **overrides}, study.where, study.stem,
+                                         study.base_dir, study.kind)  # fmt: skip
+            _check_kind(study.kind, required, str(study_file), command)
+            kind = kinds[study.kind]
+            spec = kind.read(study)
+            runs, what = kind.describe(spec)
+            if check:
+                typer.echo(f"{study_file}: {what}; nothing was run (--check).")
+                return
+            _check_size(runs, max_runs, yes, str(study_file), what)
             # A signal from the moment the directory exists is a request to stop that the
-            # sweep answers (saying what it saved), however early it comes.
-            started: list[Path] = []
-            hint = _resume_hint("sweep", "finish", lambda: started[0] if started else None)
-            with stoppable(hint) as stop, sweeping.new_sweep(spec, out) as directory:
+            # study answers (saying what it saved), however early it comes.
+            with stoppable(hint, STOP_POINT) as stop, kind.start(spec, study, out) as directory:
                 started.append(directory)
-                outcome = _run_sweep(spec, directory, workers, backend, address, quiet, stop)
+                typer.echo(f"{study_file}: {what}", err=True)  # a note: also when quiet
+                outcome = kind.run(
+                    spec, directory, _options(workers, backend, address, quiet, stop)
+                )
         if not quiet and outcome.complete:
-            from cartpole_q.cli.report import print_sweep_summary
-
-            print_sweep_summary(outcome)
+            for line in outcome.lines:
+                typer.echo(line)
         typer.echo(str(outcome.directory))
-        saved = sweeping.saved_text(outcome.directory, outcome.done_runs, outcome.total_runs)
         exit_if_stopped(
             not outcome.complete,
-            f"{saved}; finish it with `cartpole-q sweep --resume {outcome.directory}`",
+            f"{outcome.saved}; finish it with `cartpole-q {command} --resume {outcome.directory}`",
         )
 
 
-def _check_size(runs: int, max_runs: int, yes: bool, where: str, product: str) -> None:
-    """Refuse a study of more runs than ``--max-runs`` without ``--yes``."""
+def _check_kind(kind: str, required: str | None, where: str, command: str) -> None:
+    """Refuse a study of another kind than the alias runs, naming the command that runs it."""
+    if required is not None and kind != required:
+        raise UserError(
+            f"{where}: is a {kind} study, not a {required} study; run it with `cartpole-q study "
+            f"{where}` (`{command}` runs {required} studies)."
+        )
+
+
+def _options(
+    workers: int | None, backend: BackendChoice, address: str | None, quiet: bool, stop: Any
+) -> Any:
+    from cartpole_q.experiments.study import Options
+    from cartpole_q.progress import make_sweep_progress
+
+    def say(text: str) -> None:
+        typer.echo(text, err=True)
+
+    return Options(
+        workers=workers or 0, backend=backend.value, address=address, quiet=quiet,
+        should_stop=stop.is_set, progress=lambda units: make_sweep_progress(quiet, units=units),
+        say=say,
+    )  # fmt: skip
+
+
+def _check_size(runs: int, max_runs: int, yes: bool, where: str, what: str) -> None:
+    """Refuse a study of more runs than ``--max-runs`` without ``--yes``.
+
+    ``what`` says what the runs are (``a sweep: 2 points x 100 seeds = 200 runs``).
+    """
     if runs > max_runs and not yes:
         raise UserError(
-            f"{where}: {product} = {runs:,} runs, more than --max-runs {max_runs:,}; pass "
-            "--yes to run them all (or raise --max-runs)."
+            f"{where}: {what}, more than --max-runs {max_runs:,}; pass --yes to run them all "
+            "(or raise --max-runs)."
         )
 
 
@@ -126,46 +235,11 @@ def _resume_hint(
 
     def hint() -> str:
         where = directory()
-        if where is None:
-            return f"no {command} directory was created"
+        if where is None or not where.exists():  # never made, or removed again: nothing saved
+            return f"no {command} directory was kept"
         return f"{verb} it with `cartpole-q {command} --resume {where}`"
 
     return hint
-
-
-def _run_sweep(
-    spec: Any,
-    directory: Path,
-    workers: int | None,
-    backend: BackendChoice,
-    address: str | None,
-    quiet: bool,
-    stop: Any,
-) -> Any:
-    """Run a (locked) sweep directory until done or ``stop`` is set."""
-    from cartpole_q.experiments import sweep as sweeping
-    from cartpole_q.experiments.workers import default_workers
-    from cartpole_q.progress import make_sweep_progress
-
-    def say_compiling(loops: int) -> None:
-        if not quiet:
-            typer.echo(
-                f"compiling {loops} training loop{'s' if loops > 1 else ''} first: once per "
-                "machine and version, a few seconds each...",
-                err=True,
-            )
-
-    if not quiet and backend is BackendChoice.ray:
-        say_if_compiling(spec.points[0].config)
-    progress = make_sweep_progress(quiet)
-    kept = f"The sweep directory {directory} keeps every run saved so far"
-    how = f"finish it with `cartpole-q sweep --resume {directory}`"
-    with kept_on_write_error(kept, how):
-        return sweeping.run_sweep(
-            spec, directory, workers=workers or default_workers(spec.runs),
-            backend=backend.value, address=address, progress=progress, should_stop=stop.is_set,
-            on_compile=say_compiling,
-        )  # fmt: skip
 
 
 @app.command("tune", cls=Command)
@@ -269,8 +343,9 @@ def tune_command(
 
 def _check_tune_size(spec: Any, trials: int | None, max_runs: int, yes: bool, where: str) -> None:
     total = trials or spec.trials
-    product = f"{total:,} trials x {len(spec.seeds):,} seeds"
-    _check_size(total * len(spec.seeds), max_runs, yes, where, product)
+    runs = total * len(spec.seeds)
+    product = f"{total:,} trials x {len(spec.seeds):,} seeds = {runs:,} runs"
+    _check_size(runs, max_runs, yes, where, product)
 
 
 def _tune(

@@ -157,11 +157,12 @@ def play_curve(
     engine: str = "numba",
     keep_runs: bool = False,
     stop: Callable[[], bool] | None = None,
+    progress: Callable[[int], None] | None = None,
 ) -> CurveResult | None:
     """Play one run per seed, in order, and average each step over the runs.
 
     ``stop`` is asked before each run; when it says so, nothing more is played and the
-    result is ``None``.
+    result is ``None``. ``progress`` is told how many runs are done after each.
     """
     reward_total = np.zeros(steps)
     optimal_count = np.zeros(steps, dtype=np.int64)
@@ -179,6 +180,8 @@ def play_curve(
         optimal_count += optimal
         if kept_rewards is not None and kept_optimal is not None:
             kept_rewards[index], kept_optimal[index] = rewards, optimal
+        if progress is not None:
+            progress(index + 1)
     runs = len(seeds)
     return CurveResult(
         reward_total / runs, 100.0 * optimal_count / runs, kept_rewards, kept_optimal

@@ -15,27 +15,31 @@ all the steps against each method's parameter, on a log2 axis).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import re
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, parse_seeds, shown_value
+from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
 from cartpole_q.config.bounds import check_count, check_memory
 from cartpole_q.errors import RunError
+from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
     checked_list,
-    read_study_file,
+    checked_study,
 )
+from cartpole_q.progress import Units
 from cartpole_q.rl.bandits import RULES, BanditAgent
+from cartpole_q.store.studydir import Cell, RunRecord
 
-STUDY_KEYS = ("name", "testbed", "seeds", "steps", "curves", "figure", "book")
+STUDY_KEYS = ("name", "testbed", "seeds", "steps", "engine", "curves", "figure", "book")
 """the keys a study file may have"""
 TESTBED_KEYS = ("k", "mean", "spread", "walk")
 CURVE_KEYS = (
@@ -129,6 +133,8 @@ class Study:
     metrics: tuple[str, ...]
     book: tuple[BookNumber, ...]
     where: str
+    engine: str = "numba"
+    """``numba`` (the compiled testbed) or ``gymnasium`` (``gymnasium.make``): the same numbers"""
 
 
 @dataclass(frozen=True)
@@ -140,7 +146,7 @@ class Outcome:
     optimal_percent: list[np.ndarray]
     """per curve: ``(learners, steps)``"""
     engine: str
-    seconds: float
+    seconds: float = 0.0
 
 
 def _number(value: Any, where: str) -> float:
@@ -169,13 +175,23 @@ def _whole(raw: Mapping[str, Any], key: str, default: int, where: str, least: in
 
 
 def load_study(path: Path) -> Study:
-    """Read and check a study file.
+    """Read and check a bandit study file.
 
     Raises:
         ConfigError: naming the file and the key, with what is wrong.
     """
-    raw, where, name = read_study_file(
-        path,
+    raw = read_yaml_mapping(path, "study file")
+    return read_study(StudyFile(raw, "bandit", str(path), path.stem, path.parent))
+
+
+def read_study(study: StudyFile) -> Study:
+    """Check a bandit study file.
+
+    Raises:
+        ConfigError: naming the file and the key, with what is wrong.
+    """
+    raw, where, name = checked_study(
+        study,
         STUDY_KEYS,
         "`seeds`, `steps`, `curves` and `figure`",
         "examples/book/fig2_2_epsilon_greedy.yaml",
@@ -241,9 +257,14 @@ def load_study(path: Path) -> Study:
         _book(entry, index, len(curves), steps, kind, where)
         for index, entry in enumerate(checked_list(raw, "book", where))
     )
+    engine = raw.get("engine", "numba")
+    if engine not in ENGINES:
+        raise ConfigError(
+            f"{where}: engine: must be one of {', '.join(ENGINES)}, got {shown_value(engine)}."
+        )
     return Study(
         name, (k, mean, spread, walk), seeds, steps, curves, kind, file, title, metrics, book,
-        where,
+        where, str(engine),
     )  # fmt: skip
 
 
@@ -410,32 +431,79 @@ def _book(raw: Any, index: int, curves: int, steps: int, kind: str, where: str) 
 
 
 def run_study(
-    study: Study, engine: str = "numba", stop: Callable[[], bool] | None = None
+    study: Study, engine: str | None = None, stop: Callable[[], bool] | None = None
 ) -> Outcome | None:
-    """Play every curve's learners, one run per seed each.
+    """Play every curve's learners in this process, one run per seed each.
 
-    ``stop`` is asked before every run; when it says so the study ends, returning ``None``.
+    ``engine`` overrides the study's. ``stop`` is asked before every run; when it says so
+    the study ends, returning ``None``.
     """
     import time
 
+    start = time.perf_counter()
+    if engine is not None:
+        study = dataclasses.replace(study, engine=engine)
+    keys = BANDIT.runs(study)
+    records = []
+    for key in keys:
+        record = play_learner(study, key, stop)
+        if record is None:
+            return None
+        records.append(record)
+    outcome = study_outcome(study, keys, records)
+    return dataclasses.replace(outcome, seconds=time.perf_counter() - start)
+
+
+def play_learner(
+    study: Study,
+    key: Mapping[str, Cell],
+    stop: Callable[[], bool] | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> RunRecord | None:
+    """One learner (``key``: its curve and its index there) on every seed, in order.
+
+    Returns ``None`` when ``stop`` ended it early.
+    """
     from cartpole_q.engines.bandit import play_curve
     from cartpole_q.families.bandit.twin import ArmedTestbed
 
-    start = time.perf_counter()
-    testbed = ArmedTestbed(*study.testbed)
-    seeds = list(study.seeds)
-    rewards, optimal = [], []
-    for curve in study.curves:
-        results = []
-        for agent in curve.agents():
-            result = play_curve(agent, testbed, seeds, study.steps, engine, stop=stop)
-            if result is None:
-                return None
-            results.append(result)
-        rewards.append(np.array([result.average_reward for result in results]))
-        optimal.append(np.array([result.optimal_percent for result in results]))
-        _check_finite(curve, rewards[-1], study.where)
-    return Outcome(rewards, optimal, engine, time.perf_counter() - start)
+    curve = study.curves[int(key["curve"] or 0)]
+    agent = curve.agents()[int(key["learner"] or 0)]
+    result = play_curve(
+        agent, ArmedTestbed(*study.testbed), list(study.seeds), study.steps, study.engine,
+        stop=stop, progress=progress,
+    )  # fmt: skip
+    if result is None:
+        return None
+    # an overflow is refused before the run is saved
+    average = np.zeros((len(curve.agents()), study.steps))
+    average[int(key["learner"] or 0)] = result.average_reward
+    _check_finite(curve, average, study.where)
+    return RunRecord(
+        {"mean_reward": mean_over_steps(result.average_reward)},
+        {"average_reward": result.average_reward, "optimal_percent": result.optimal_percent},
+    )
+
+
+def study_outcome(
+    study: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+) -> Outcome:
+    """Every curve's learners' averages, from their records (in run order).
+
+    Raises:
+        RunError: a curve overflowed (:func:`_check_finite`).
+    """
+    rewards: list[list[np.ndarray]] = [[] for _ in study.curves]
+    optimal: list[list[np.ndarray]] = [[] for _ in study.curves]
+    for key, record in zip(keys, records, strict=True):
+        rewards[int(key["curve"] or 0)].append(record.arrays["average_reward"])
+        optimal[int(key["curve"] or 0)].append(record.arrays["optimal_percent"])
+    outcome = Outcome(
+        [np.array(rows) for rows in rewards], [np.array(rows) for rows in optimal], study.engine
+    )
+    for curve, average in zip(study.curves, outcome.average_reward, strict=True):
+        _check_finite(curve, average, study.where)
+    return outcome
 
 
 def _check_finite(curve: Curve, average_reward: np.ndarray, where: str) -> None:
@@ -562,7 +630,7 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
         testbed += f", walking by N(0, {walk:g}^2) per step"
     lines = [
         f"{study.name}: {len(study.seeds)} runs x {study.steps} steps on the {testbed}, "
-        f"{outcome.engine} engine, {outcome.seconds:.1f} s"
+        f"{outcome.engine} engine"
     ]
     last = study.steps
     first = max(1, last - 99)
@@ -624,3 +692,75 @@ def check_outputs(out: Path, force: bool) -> None:
 def default_out(study: Study) -> Path:
     """The figure file when ``--out`` is not given: the study's ``figure.file`` here."""
     return Path(study.file)
+
+
+class BanditKind(RunsKind):
+    """``kind: bandit``: one run per learner, the figure and the book's numbers from all.
+
+    A learner is a curve, or one value of a parameter study's curve; its run plays every
+    seed in order (the averages are summed in seed order).
+    """
+
+    name = "bandit"
+    figure_kinds = FIGURE_KINDS
+    units = Units("bandit", "runs", "learners")
+    runs_per_task = 1  # a learner plays every seed: each is a job of its own
+
+    def read(self, study: StudyFile) -> Study:
+        """Check the file (:func:`read_study`)."""
+        return read_study(study)
+
+    def runs(self, spec: Study) -> list[dict[str, Cell]]:
+        """Each curve's learners, in order: ``curve``, ``learner``."""
+        return [
+            {"curve": index, "learner": learner}
+            for index, curve in enumerate(spec.curves)
+            for learner in range(len(curve.agents()))
+        ]
+
+    def describe(self, spec: Study) -> tuple[int, str]:
+        """Learners x seeds."""
+        learners = len(self.runs(spec))
+        return learners, (
+            f"a bandit study: {_count(learners, 'learner')} x {_count(len(spec.seeds), 'seed')} "
+            f"({spec.steps:,} steps each, the {spec.engine} engine)"
+        )
+
+    def result_columns(self, spec: Study) -> tuple[str, ...]:
+        """The learner's average reward over all its steps (Figure 2.6's measure)."""
+        return ("mean_reward",)
+
+    def run_size(self, spec: Study, key: Mapping[str, Cell]) -> int:
+        """A learner plays one run per seed."""
+        return len(spec.seeds)
+
+    def before_runs(self, spec: Study) -> str | None:
+        """The compile notice of the study's engine."""
+        from cartpole_q.engines.bandit import compile_notice
+
+        return compile_notice(spec.engine)
+
+    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
+        """Play one learner on every seed (:func:`play_learner`)."""
+        return play_learner(spec, key, handle.should_stop, handle.report)
+
+    def finish(
+        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+    ) -> Finished:
+        """The figure, the summary and the book's numbers beside ours."""
+        outcome = study_outcome(spec, keys, records)
+        lines = summary(spec, outcome)
+        rows = book_rows(spec, outcome)
+        if rows:
+            lines.append("the book's numbers (read off its figure) and ours:")
+            lines.extend(f"  {row.text()}" for row in rows)
+        return Finished([(spec.file, study_figure(spec, outcome))], (), lines)
+
+
+BANDIT = register_kind(BanditKind())
+"""the bandit kind (registered)"""
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 seed``, ``2,000 seeds``."""
+    return f"{n:,} {noun}{'' if n == 1 else 's'}"

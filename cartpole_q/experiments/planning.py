@@ -11,22 +11,25 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, EnvConfig, load_config, shown_value
+from cartpole_q.config import ConfigError, EnvConfig, load_config, read_yaml_mapping, shown_value
 from cartpole_q.envs.models import PlanningModel, planning_model
+from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
     checked_list,
-    read_study_file,
+    checked_study,
 )
+from cartpole_q.progress import Units
 from cartpole_q.rl import dynamic_programming as dp
+from cartpole_q.store.studydir import Cell, RunRecord
 
 STUDY_KEYS = (
     "name", "env", "algorithm", "gamma", "policy", "sweeps", "tolerance", "max_sweeps",
@@ -161,13 +164,23 @@ def _decimals_of(value: Any) -> int:
 
 
 def load_study(path: Path) -> Study:
-    """Read and check a study file.
+    """Read and check a dynamic-programming study file.
 
     Raises:
         ConfigError: naming the file and the key, with what is wrong.
     """
-    raw, where, name = read_study_file(
-        path,
+    raw = read_yaml_mapping(path, "study file")
+    return read_study(StudyFile(raw, "dp", str(path), path.stem, path.parent))
+
+
+def read_study(study: StudyFile) -> Study:
+    """Check a dynamic-programming study file.
+
+    Raises:
+        ConfigError: naming the file and the key, with what is wrong.
+    """
+    raw, where, name = checked_study(
+        study,
         STUDY_KEYS,
         "`env`, `algorithm`, `gamma` and `figure`",
         "examples/book/fig4_1_small_gridworld.yaml",
@@ -217,14 +230,44 @@ def load_study(path: Path) -> Study:
     max_sweeps = _integer(raw, "max_sweeps", 100_000, where) or 0
     if max_sweeps < 1:
         raise ConfigError(f"{where}: max_sweeps: must be at least 1.")
+    if algorithm == "value_iteration" and "policy" in raw:
+        raise ConfigError(
+            f"{where}: policy: value iteration starts from v = 0 and follows no policy; leave "
+            "policy out (policy evaluation and policy iteration take one)."
+        )
     figure = _figure(raw.get("figure"), name, where)
+    late = [k for k in figure.show if k > max_sweeps]
+    if late:
+        raise ConfigError(
+            f"{where}: figure.show: sweep {late[0]:,} is beyond max_sweeps ({max_sweeps:,}); "
+            "show sweeps the study can make."
+        )
     book = tuple(
         _book(entry, index, where) for index, entry in enumerate(checked_list(raw, "book", where))
     )
-    return Study(
+    checked = Study(
         name, env, str(algorithm), gamma, policy, str(order), tolerance, max_sweeps,
         tie_tolerance, figure, book, where,
     )  # fmt: skip
+    _check_fits(checked, _model(checked))
+    return checked
+
+
+def _model(study: Study) -> PlanningModel:
+    """The world's model.
+
+    Raises:
+        ConfigError: it has none, or the policy's action is not one of its actions.
+    """
+    world = planning_model(study.env, source=study.where)
+    if isinstance(world, str):
+        raise ConfigError(f"{study.where}: env.id: {world}; dynamic programming needs a model.")
+    if isinstance(study.policy, int) and study.policy >= world.model.n_actions:
+        raise ConfigError(
+            f"{study.where}: policy: action {study.policy} does not exist ({study.env.id} has "
+            f"{world.model.n_actions} actions)."
+        )
+    return world
 
 
 def _figure(raw: Any, name: str, where: str) -> FigureSpec:
@@ -278,15 +321,8 @@ def run_study(study: Study) -> Outcome:
         ConfigError: the world has no model, the policy's action or a state is out of
             range, or the algorithm does not converge (naming the file and the key).
     """
-    world = planning_model(study.env, source=study.where)
-    if isinstance(world, str):
-        raise ConfigError(f"{study.where}: env.id: {world}; dynamic programming needs a model.")
+    world = _model(study)
     model = world.model
-    if isinstance(study.policy, int) and study.policy >= model.n_actions:
-        raise ConfigError(
-            f"{study.where}: policy: action {study.policy} does not exist ({study.env.id} has "
-            f"{model.n_actions} actions)."
-        )
     _check_fits(study, world)
     try:
         if study.algorithm == "policy_iteration":
@@ -342,12 +378,27 @@ def _check_fits(study: Study, world: PlanningModel) -> None:
         )
     if kind == "gambler" and study.algorithm == "policy_iteration":
         raise ConfigError(f"{where}: figure.kind: gambler draws sweeps, not policy iteration.")
+    if kind == "gambler" and not _is_gambler(world):
+        raise ConfigError(
+            f"{where}: figure.kind: gambler draws a capital's value and stake (Figure 4.3); "
+            f"{study.env.id} is not the gambler's problem (cartpole_q/Gambler-v0)."
+        )
     for index, number in enumerate(study.book):
         if number.state is not None and number.state >= world.model.n_states:
             raise ConfigError(
                 f"{where}: book[{index}].state: {number.state} is not a state of {study.env.id} "
                 f"(0 to {world.model.n_states - 1})."
             )
+
+
+def _is_gambler(world: PlanningModel) -> bool:
+    """A world whose states are capitals 0..goal and whose actions are stakes 0..goal/2."""
+    states, stakes = world.model.n_states, world.action_values
+    return (
+        states >= 3
+        and stakes == tuple(float(s) for s in range(len(stakes)))
+        and (len(stakes) == (states - 1) // 2 + 1)
+    )
 
 
 def book_rows(study: Study, outcome: Outcome) -> list[BookRow]:
@@ -520,3 +571,74 @@ def check_outputs(out: Path, force: bool) -> None:
 def default_out(study: Study) -> Path:
     """The figure file when ``--out`` is not given: the study's ``figure.file`` here."""
     return Path(study.figure.file)
+
+
+class PlanningKind(RunsKind):
+    """``kind: dp``: one run, the algorithm on the world's model, every sweep recorded."""
+
+    name = "dp"
+    figure_kinds = FIGURE_KINDS
+    units = Units("dp", "solves", "solves")
+
+    def read(self, study: StudyFile) -> Study:
+        """Check the file (:func:`read_study`)."""
+        return read_study(study)
+
+    def runs(self, spec: Study) -> list[dict[str, Cell]]:
+        """One run: the algorithm."""
+        return [{"algorithm": spec.algorithm}]
+
+    def describe(self, spec: Study) -> tuple[int, str]:
+        """One solve."""
+        what = spec.algorithm.replace("_", " ")
+        return 1, f"a dp study: {what} on {spec.env.id}, gamma {spec.gamma:g} (one run)"
+
+    def result_columns(self, spec: Study) -> tuple[str, ...]:
+        """Sweeps (policy iteration: improvements) made."""
+        return ("steps",)
+
+    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
+        """Solve: every sweep's values, greedy policies and tied actions."""
+        outcome = run_study(spec)
+        book_rows(spec, outcome)  # a book number at a sweep never made: refused before saving
+        return RunRecord(
+            {"steps": outcome.steps},
+            {"values": outcome.values, "policies": outcome.policies, "tied": outcome.tied},
+        )
+
+    def finish(
+        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+    ) -> Finished:
+        """The figure, the recorded sweeps, the summary and the book's numbers beside ours."""
+        (record,) = records
+        world = planning_model(spec.env, source=spec.where)
+        assert not isinstance(world, str)  # run_one solved it
+        arrays = record.arrays
+        outcome = Outcome(
+            world,
+            arrays["values"],
+            arrays["policies"],
+            arrays["tied"],
+            int(record.row["steps"] or 0),
+        )
+        lines = [summary(spec, outcome)]
+        beyond = [k for k in spec.figure.show if k > outcome.steps]
+        if beyond:
+            lines.append(
+                f"  figure.show: {', '.join(map(str, beyond))} not drawn: the study made "
+                f"{outcome.steps} {'improvements' if spec.algorithm == 'policy_iteration' else 'sweeps'}"
+            )
+        rows = book_rows(spec, outcome)
+        if rows:
+            lines.append("the book's numbers and ours (rounded as the book prints them):")
+            lines.extend(f"  {row.text()}" for row in rows)
+        sweeps = sweeps_path(Path(spec.figure.file)).name
+        return Finished(
+            [(spec.figure.file, study_figure(spec, outcome))],
+            [(sweeps, sweeps_csv_text(outcome))],
+            lines,
+        )
+
+
+PLANNING = register_kind(PlanningKind())
+"""the dynamic-programming kind (registered)"""

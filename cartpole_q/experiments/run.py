@@ -62,9 +62,14 @@ class StopRequest:
     A second signal raises ``KeyboardInterrupt`` for an immediate stop.
     """
 
-    def __init__(self, announce: Callable[[str], None] | None = None) -> None:
+    def __init__(
+        self,
+        announce: Callable[[str], None] | None = None,
+        stop_point: str = "the current episode",
+    ) -> None:
         self._event = threading.Event()
         self._announce = announce
+        self._stop_point = stop_point
         self._previous: dict[int, Any] = {}
 
     def is_set(self) -> bool:
@@ -81,7 +86,7 @@ class StopRequest:
         self._event.set()
         if self._announce is not None:
             self._announce(
-                f"{signal.Signals(signum).name}: stopping after the current episode "
+                f"{signal.Signals(signum).name}: stopping after {self._stop_point} "
                 "(send it again to stop at once)"
             )
 

@@ -32,7 +32,20 @@ from cartpole_q.engines.plan import env_facts, planned, planning
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
-from cartpole_q.experiments.sweep_spec import POLICY_FIGURE, VALUES_FIGURE, SweepSpec, load_sweep
+from cartpole_q.experiments.study import (
+    Options,
+    Outcome,
+    StudyFile,
+    StudyInterrupted,
+    register_kind,
+)
+from cartpole_q.experiments.sweep_spec import (
+    POLICY_FIGURE,
+    VALUES_FIGURE,
+    SweepSpec,
+    load_sweep,
+    safe_name,
+)
 from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.families import profile_for
 from cartpole_q.figures import (
@@ -42,7 +55,7 @@ from cartpole_q.figures import (
     summary_line_figure,
 )
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
-from cartpole_q.progress import NullSweepProgress, SweepProgress
+from cartpole_q.progress import NullSweepProgress, SweepProgress, Units
 from cartpole_q.results import SeedResult, summarize_seeds
 from cartpole_q.store import sweepdir
 from cartpole_q.store.figure_file import write_figure
@@ -841,3 +854,178 @@ def _state_values(table: np.ndarray, rows: np.ndarray) -> np.ndarray:
     for t in range(rows.shape[1]):
         values = values + weights[rows[:, t]]
     return values
+
+
+# -- the sweep as a study kind -------------------------------------------------------------
+
+
+SWEEP_TABLE_ROWS = 15
+"""``sweep`` prints at most this many points, the best first"""
+
+
+def _interval(value: float | None, low: float | None, high: float | None, digits: int) -> str:
+    if value is None or low is None or high is None:
+        return "-"
+    return f"{value:.{digits}f} [{low:.{digits}f}, {high:.{digits}f}]"
+
+
+def sweep_table(
+    axes: Sequence[str], point_rows: Sequence[PointRow], limit: int = SWEEP_TABLE_ROWS
+) -> list[str]:
+    """The points as text lines, best first (success rate, then IQM eval return).
+
+    >>> from cartpole_q.statistics import PointStatistics
+    >>> stats = PointStatistics(2, 1.0, 0.34, 1.0, 500.0, 500.0, 500.0, 175.0, 170.0, 180.0,
+    ...     9000.0, 8000.0, 10000.0)
+    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
+    ...     print(line)
+    point  agent.alpha  seeds  success rate [95%]  IQM eval return [95%]  median solve episode [95%]
+    000    0.1          2      1.00 [0.34, 1.00]   500.0 [500.0, 500.0]   175 [170, 180]
+    """
+    if point_rows and all(row.statistics.mean_rms_error is not None for row in point_rows):
+        return _prediction_table(axes, point_rows, limit)
+
+    def rank(row: PointRow) -> tuple[float, float]:
+        stats = row.statistics
+        rate = -1.0 if stats.success_rate is None else stats.success_rate
+        iqm = -math.inf if stats.iqm_eval_return is None else stats.iqm_eval_return
+        return (-rate, -iqm)
+
+    ordered = sorted(point_rows, key=rank)[:limit]
+    header = ["point", *axes, "seeds", "success rate [95%]", "IQM eval return [95%]",
+              "median solve episode [95%]"]  # fmt: skip
+    table = [header]
+    for row in ordered:
+        s = row.statistics
+        table.append([
+            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
+            _interval(s.success_rate, s.success_rate_low, s.success_rate_high, 2),
+            _interval(s.iqm_eval_return, s.iqm_eval_return_low, s.iqm_eval_return_high, 1),
+            _interval(s.median_solved_episode, s.median_solved_episode_low,
+                      s.median_solved_episode_high, 0),
+        ])  # fmt: skip
+    return _aligned(table)
+
+
+def _prediction_table(axes: Sequence[str], point_rows: Sequence[PointRow], limit: int) -> list[str]:
+    """Prediction points, the lowest final RMS error first.
+
+    >>> from cartpole_q.statistics import PointStatistics
+    >>> stats = PointStatistics(100, *[None] * 12, 0.0512, 0.049, 0.0533)
+    >>> for line in sweep_table(["agent.alpha"], [PointRow("000", {"agent.alpha": "0.1"}, stats)]):
+    ...     print(line)
+    point  agent.alpha  seeds  RMS error after the last episode, mean [95%]
+    000    0.1          100    0.0512 [0.0490, 0.0533]
+    """
+    ordered = sorted(point_rows, key=lambda row: row.statistics.mean_rms_error or 0.0)[:limit]
+    table = [["point", *axes, "seeds", "RMS error after the last episode, mean [95%]"]]
+    for row in ordered:
+        s = row.statistics
+        table.append([
+            row.point, *(row.axes[axis] for axis in axes), str(s.seeds),
+            _interval(s.mean_rms_error, s.mean_rms_error_low, s.mean_rms_error_high, 4)
+            if s.mean_rms_error is None or math.isfinite(s.mean_rms_error)
+            else f"{s.mean_rms_error} (a run diverged)",
+        ])  # fmt: skip
+    return _aligned(table)
+
+
+def _aligned(table: list[list[str]]) -> list[str]:
+    """The rows of a table as lines, each column as wide as its widest cell."""
+    header = table[0]
+    widths = [max(len(line[i]) for line in table) for i in range(len(header))]
+    return ["  ".join(text.ljust(width) for text, width in zip(line, widths, strict=True)).rstrip()
+            for line in table]  # fmt: skip
+
+
+def summary_lines(outcome: SweepOutcome) -> list[str]:
+    """A finished sweep's points (the best first) and where its files are."""
+    spec, directory = outcome.spec, outcome.directory
+    rows = outcome.points
+    shown = min(len(rows), SWEEP_TABLE_ROWS)
+    title = f"{len(rows)} points x {len(spec.seeds)} seeds"
+    if shown < len(rows):
+        title += f" (the best {shown} shown; all in points.csv)"
+    lines = [
+        title,
+        *sweep_table(spec.axes, rows),
+        f"points.csv, results.csv and sweep.png in {directory}",
+    ]
+    if outcome.figure is not None:
+        lines.append(f"the sweep file's figure: {outcome.figure}")
+    return lines
+
+
+class SweepKind:
+    """``kind: sweep`` (the default): a grid of configs, each trained on every seed.
+
+    Its directory keeps the sweep layout (``sweep.yaml``, ``points/``, ``results.csv``,
+    design.md's "Sweep directory"); the machinery is this module's.
+    """
+
+    name = "sweep"
+    figure_kinds: tuple[str, ...] = ()
+
+    def read(self, study: StudyFile) -> SweepSpec:
+        """Check the file and every point's config against its environment."""
+        spec = load_sweep(
+            study.body, label=study.where, base_dir=study.base_dir,
+            default_name=safe_name(study.stem),
+        )  # fmt: skip
+        check_points(spec, study.where)
+        return spec
+
+    def describe(self, spec: SweepSpec) -> tuple[int, str]:
+        """Points times seeds."""
+        points = f"{len(spec.points):,} point{'' if len(spec.points) == 1 else 's'}"
+        seeds = f"{len(spec.seeds):,} seed{'' if len(spec.seeds) == 1 else 's'}"
+        alone = "" if spec.axes else " (no grid or zip axes: every seed runs the base config)"
+        runs = f"{spec.runs:,} run{'' if spec.runs == 1 else 's'}"
+        return spec.runs, f"a sweep: {points} x {seeds} = {runs}{alone}"
+
+    def start(
+        self, spec: SweepSpec, study: StudyFile, out: Path | None
+    ) -> contextlib.AbstractContextManager[Path]:
+        """Claim the sweep directory (:func:`new_sweep`)."""
+        return new_sweep(spec, out)
+
+    def is_directory(self, directory: Path) -> bool:
+        """A directory with a ``sweep.yaml``."""
+        return (directory / sweepdir.SWEEP_FILE).is_file()
+
+    def load(self, directory: Path) -> SweepSpec:
+        """The sweep of a sweep directory (:func:`load_sweep_dir`)."""
+        return load_sweep_dir(directory)
+
+    def run(self, spec: SweepSpec, directory: Path, options: Options) -> Outcome:
+        """Run the sweep (:func:`run_sweep`); when complete, its table of points."""
+        from cartpole_q.experiments.workers import default_workers
+
+        def say_compiling(loops: int) -> None:
+            options.note(
+                f"compiling {loops} training loop{'s' if loops > 1 else ''} first: once per "
+                "machine and version, a few seconds each..."
+            )
+
+        make = options.progress or (lambda units: NullSweepProgress())
+        try:
+            found = run_sweep(
+                spec, directory, workers=options.workers or default_workers(spec.runs),
+                backend=options.backend, address=options.address, progress=make(Units()),
+                should_stop=options.should_stop, on_compile=say_compiling,
+            )  # fmt: skip
+        except SweepInterrupted as error:
+            stopped = StudyInterrupted(error.text)
+            raise stopped from None
+        outcome = Outcome(directory, found.total_runs, found.done_runs, found.complete)
+        outcome.saved = saved_text(directory, found.done_runs, found.total_runs)
+        if found.complete:
+            outcome.lines = summary_lines(found)
+            outcome.files = [directory / sweepdir.POINTS_FILE, directory / sweepdir.FIGURE_FILE]
+            if found.figure is not None:
+                outcome.files.append(found.figure)
+        return outcome
+
+
+SWEEP = register_kind(SweepKind())
+"""the sweep kind (registered)"""

@@ -28,6 +28,7 @@ from cartpole_q.config import (
     shown,
     shown_value,
 )
+from cartpole_q.experiments.study import StudyFile
 from cartpole_q.store import sweepdir
 from cartpole_q.store.sweepdir import axis_cell
 
@@ -180,13 +181,21 @@ class SweepSpec:
         return resolved
 
 
-def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) -> SweepSpec:
+def load_sweep(
+    source: Path | Mapping[str, Any],
+    *,
+    label: str | None = None,
+    base_dir: Path | None = None,
+    default_name: str = "sweep",
+) -> SweepSpec:
     """Read and check a sweep file (or a mapping laid out like one) and expand its points.
 
     Args:
-        source: a sweep YAML file, or a mapping with the same keys (a ``base`` path in it
-            is then relative to the current directory).
+        source: a sweep YAML file, or a mapping with the same keys.
         label: how errors name the sweep (default: the file's path, or "sweep mapping").
+        base_dir: for a mapping, the directory a ``base`` path in it is relative to
+            (default: the current directory).
+        default_name: for a mapping, its name when it gives none.
 
     Returns:
         The checked sweep, every point's config resolved and validated.
@@ -197,8 +206,7 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
     if isinstance(source, Mapping):
         raw: Mapping[str, Any] = source
         where = label or "sweep mapping"
-        base_dir = Path()
-        default_name = "sweep"
+        base_dir = base_dir or Path()
     else:
         raw = read_yaml_mapping(source, "sweep file")
         where = label or str(source)
@@ -209,6 +217,13 @@ def load_sweep(source: Path | Mapping[str, Any], *, label: str | None = None) ->
             f"{where}: is empty; a sweep file gives `grid` (or `zip`) axes over config keys, "
             "and usually `base` and `seeds` (see docs/commands.md, `cartpole-q sweep`)."
         )
+    kind = raw.get("kind", "sweep")
+    if kind != "sweep":
+        raise ConfigError(
+            f"{where}: kind: is {shown_value(kind)}, not sweep; run it with `cartpole-q study "
+            f"{where}`."
+        )
+    raw = {key: value for key, value in raw.items() if key != "kind"}
     check_top_keys(raw, SWEEP_KEYS, where)
     name = checked_name(raw, default_name, where)
     base = load_base(raw.get("base"), where, base_dir)
@@ -650,23 +665,22 @@ def checked_figure_section(
     return str(kind), file, title
 
 
-def read_study_file(
-    path: Path, keys: Sequence[str], gives: str, example: str
+def checked_study(
+    study: StudyFile, keys: Sequence[str], gives: str, example: str
 ) -> tuple[Mapping[str, Any], str, str]:
-    """A study file's mapping, its name for messages, and its study name (``name``, or the stem).
+    """A study file's mapping (``kind`` aside), its name for messages, and its study name.
 
     Args:
-        path: the file.
-        keys: its top-level keys.
+        study: the file as read.
+        keys: its top-level keys (besides ``kind``).
         gives: what a study file gives, for the message of an empty one.
         example: a shipped study file to point to.
 
     Raises:
-        ConfigError: an empty or unreadable file, an unknown key, a bad name.
+        ConfigError: an empty file, an unknown key, a bad name.
     """
-    raw = read_yaml_mapping(path, "study file")
-    where = str(path)
+    raw, where = study.body, study.where
     if not raw:
         raise ConfigError(f"{where}: is empty; a study file gives {gives} (see {example}).")
     check_top_keys(raw, tuple(keys), where)
-    return raw, where, checked_name(raw, safe_name(path.stem), where)
+    return raw, where, checked_name(raw, safe_name(study.stem), where)

@@ -21,22 +21,32 @@ Three kinds of study (``figure.kind``), all run outside the engines' training ru
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import ConfigError, parse_seeds, shown_value
+from cartpole_q.config import ConfigError, parse_seeds, read_yaml_mapping, shown_value
 from cartpole_q.config.bounds import check_count, check_memory
+from cartpole_q.experiments.study import (
+    Finished,
+    RunHandle,
+    RunsKind,
+    StudyFile,
+    register_kind,
+)
 from cartpole_q.experiments.sweep_spec import (
     check_top_keys,
     checked_figure_section,
-    read_study_file,
+    checked_study,
 )
+from cartpole_q.progress import Units
+from cartpole_q.store.studydir import Cell, RunRecord
 
 STUDY_KEYS = (
     "name", "seeds", "branching", "initial_error", "panels", "actions", "epsilon",
@@ -127,7 +137,9 @@ class Outcome:
     largest_expected_error: float
     """``expected_vs_sample``: the largest ``|error|`` of the expected update after ``b``
     computations, over every problem (0 exactly)"""
-    seconds: float
+    seconds: float = 0.0
+    """how long :func:`run_study` took (not part of the summary, which a resumed study
+    must print byte for byte as one run in one go)"""
     runs: dict[tuple[str, int], list[Any]] | None = None
     """``until_optimal``: per ``(method, scale)`` each seed's
     :class:`~cartpole_q.engines.until_optimal.Result`"""
@@ -167,13 +179,23 @@ def _branching(raw: Mapping[str, Any], where: str, least: int) -> tuple[int, ...
 
 
 def load_study(path: Path) -> Study:
-    """Read and check a study file.
+    """Read and check a planning-updates study file.
 
     Raises:
         ConfigError: naming the file and the key, with what is wrong.
     """
-    raw, where, name = read_study_file(
-        path,
+    raw = read_yaml_mapping(path, "study file")
+    return read_study(StudyFile(raw, "updates", str(path), path.stem, path.parent))
+
+
+def read_study(study: StudyFile) -> Study:
+    """Check a planning-updates study file.
+
+    Raises:
+        ConfigError: naming the file and the key, with what is wrong.
+    """
+    raw, where, name = checked_study(
+        study,
         STUDY_KEYS,
         "`seeds`, `figure` and the figure kind's keys",
         "examples/book/fig8_7_expected_vs_sample.yaml",
@@ -298,29 +320,6 @@ def maze_states(scale: int) -> int:
     return 47 * scale * scale
 
 
-def _until_optimal_runs(
-    study: Study, stop: Callable[[], bool] | None
-) -> dict[tuple[str, int], list[Any]] | None:
-    from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
-    from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
-
-    runs: dict[tuple[str, int], list[Any]] = {}
-    for scale in study.scales:
-        maze = maze_arrays(DynaMazeEnv(scale))
-        for method in study.methods:
-            settings = Settings(
-                method, study.alpha, study.gamma, study.epsilon, study.planning_steps,
-                study.theta, "random", np.iinfo(np.int64).max, study.max_updates,
-            )  # fmt: skip
-            results = []
-            for seed in study.seeds:
-                if stop is not None and stop():
-                    return None
-                results.append(until_optimal(maze, settings, seed))
-            runs[(method, scale)] = results
-    return runs
-
-
 def until_optimal_curves(study: Study, runs: Mapping[tuple[str, int], list[Any]]) -> list[Curve]:
     """Per method, the mean updates over the seeds at each maze size, with the least and most."""
     curves = []
@@ -395,52 +394,122 @@ def _averaged(label: str, x: np.ndarray, rows: np.ndarray, interval: bool) -> Cu
     return Curve(label, x, mean, mean - half, mean + half)
 
 
-def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome | None:
-    """Compute every curve; ``None`` when ``stop`` (asked before each task) says so."""
-    start = time.perf_counter()
+def study_runs(study: Study) -> list[dict[str, Cell]]:
+    """Every run's key, in run order.
+
+    ``expected_vs_sample``: one run per branching factor (its problems, one per seed);
+    ``trajectory_sampling``: one per panel, branching factor and seed (a task, run with
+    uniform and on-policy updates); ``until_optimal``: one per maze scale, method and seed.
+    """
+    if study.kind == "expected_vs_sample":
+        return [{"branching": branching} for branching in study.branching]
+    if study.kind == "until_optimal":
+        return [
+            {"scale": scale, "method": method, "seed": seed}
+            for scale in study.scales
+            for method in study.methods
+            for seed in study.seeds
+        ]
+    return [
+        {"panel": index, "branching": branching, "seed": seed}
+        for index, panel in enumerate(study.panels)
+        for branching in panel.branching
+        for seed in study.seeds
+    ]
+
+
+def run_one(
+    study: Study,
+    key: Mapping[str, Cell],
+    stop: Callable[[], bool] | None = None,
+    progress: Callable[[int], None] | None = None,
+) -> RunRecord | None:
+    """One run of :func:`study_runs`; ``None`` when ``stop`` ended it early."""
     if study.kind == "expected_vs_sample":
         from cartpole_q.rl.planning_updates import rms_over_problems, sample_update_errors
 
-        curves, largest = [], 0.0
-        for branching in study.branching:
-            if stop is not None and stop():
-                return None
-            sample, expected = sample_update_errors(
-                list(study.seeds), branching, study.initial_error
-            )
-            largest = max(largest, float(np.max(np.abs(expected[:, branching:]))))
-            x = np.arange(2 * branching + 1) / branching
-            curves.append(Curve(f"b = {branching}", x, rms_over_problems(sample), None, None))
-        return Outcome([curves], largest, time.perf_counter() - start)
+        branching = int(key["branching"] or 0)
+        sample, expected = sample_update_errors(list(study.seeds), branching, study.initial_error)
+        largest = float(np.max(np.abs(expected[:, branching:])))
+        return RunRecord({"largest_expected_error": largest}, {"rms": rms_over_problems(sample)})
     if study.kind == "until_optimal":
-        runs = _until_optimal_runs(study, stop)
-        if runs is None:
+        from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
+        from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
+
+        maze = maze_arrays(DynaMazeEnv(int(key["scale"] or 1)))
+        settings = Settings(
+            str(key["method"]), study.alpha, study.gamma, study.epsilon, study.planning_steps,
+            study.theta, "random", np.iinfo(np.int64).max, study.max_updates,
+        )  # fmt: skip
+        result = until_optimal(maze, settings, int(key["seed"] or 0))
+        if result is None:
             return None
-        curves = until_optimal_curves(study, runs)
-        return Outcome([curves], 0.0, time.perf_counter() - start, runs)
+        return RunRecord(
+            {"updates": result.updates, "episodes": result.episodes, "steps": result.steps,
+             "reached": result.reached}
+        )  # fmt: skip
     from cartpole_q.engines.trajectory import task_curves
 
+    panel = study.panels[int(key["panel"] or 0)]
+    uniform, on_policy = task_curves(
+        int(key["seed"] or 0), panel.states, study.actions, int(key["branching"] or 1),
+        panel.updates, panel.every, study.termination, study.epsilon, study.tolerance,
+    )  # fmt: skip
+    return RunRecord({}, {"uniform": uniform, "on_policy": on_policy})
+
+
+def study_outcome(
+    study: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+) -> Outcome:
+    """The curves of every run's record (in :func:`study_runs` order)."""
+    if study.kind == "expected_vs_sample":
+        curves = [
+            Curve(f"b = {key['branching']}", np.arange(2 * int(key["branching"] or 0) + 1)
+                  / int(key["branching"] or 1), record.arrays["rms"], None, None)
+            for key, record in zip(keys, records, strict=True)
+        ]  # fmt: skip
+        largest = max(float(record.row["largest_expected_error"] or 0.0) for record in records)
+        return Outcome([curves], largest, 0.0)
+    if study.kind == "until_optimal":
+        from cartpole_q.engines.until_optimal import Result
+
+        runs: dict[tuple[str, int], list[Any]] = {}
+        for key, record in zip(keys, records, strict=True):
+            row = record.row
+            result = Result(int(row["updates"] or 0), int(row["episodes"] or 0),
+                            int(row["steps"] or 0), bool(row["reached"]))  # fmt: skip
+            runs.setdefault((str(key["method"]), int(key["scale"] or 1)), []).append(result)
+        return Outcome([until_optimal_curves(study, runs)], 0.0, 0.0, runs)
+    tasks: dict[tuple[int, int], list[RunRecord]] = {}
+    for key, record in zip(keys, records, strict=True):
+        tasks.setdefault((int(key["panel"] or 0), int(key["branching"] or 1)), []).append(record)
     panels = []
-    for panel in study.panels:
+    for index, panel in enumerate(study.panels):
         points = np.arange(panel.updates // panel.every + 1) * panel.every
         curves = []
         for branching in panel.branching:
-            uniform, on_policy = [], []
-            for seed in study.seeds:
-                if stop is not None and stop():
-                    return None
-                one, other = task_curves(
-                    seed, panel.states, study.actions, branching, panel.updates, panel.every,
-                    study.termination, study.epsilon, study.tolerance,
-                )  # fmt: skip
-                uniform.append(one)
-                on_policy.append(other)
-            curves.append(_averaged(f"b = {branching}, uniform", points, np.array(uniform), True))
-            curves.append(
-                _averaged(f"b = {branching}, on-policy", points, np.array(on_policy), True)
-            )
+            found = tasks[(index, branching)]
+            for name, label in (("uniform", "uniform"), ("on_policy", "on-policy")):
+                rows = np.array([record.arrays[name] for record in found])
+                curves.append(_averaged(f"b = {branching}, {label}", points, rows, True))
         panels.append(curves)
-    return Outcome(panels, 0.0, time.perf_counter() - start)
+    return Outcome(panels, 0.0, 0.0)
+
+
+def run_study(study: Study, stop: Callable[[], bool] | None = None) -> Outcome | None:
+    """Compute every curve in this process; ``None`` when ``stop`` (asked before each run) says so."""
+    start = time.perf_counter()
+    keys = study_runs(study)
+    records = []
+    for key in keys:
+        if stop is not None and stop():
+            return None
+        record = run_one(study, key, stop)
+        if record is None:
+            return None
+        records.append(record)
+    outcome = study_outcome(study, keys, records)
+    return dataclasses.replace(outcome, seconds=time.perf_counter() - start)
 
 
 def _panel_name(panel: Panel) -> str:
@@ -453,7 +522,7 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
     if study.kind == "expected_vs_sample":
         lines = [
             f"{study.name}: {seeds} problems per branching factor, initial error "
-            f"{study.initial_error:g}, {outcome.seconds:.1f} s",
+            f"{study.initial_error:g}",
             "  RMS error of sample updates after t computations; the book's sqrt((b-1)/(b t)) "
             "in brackets:",
         ]
@@ -473,7 +542,7 @@ def summary(study: Study, outcome: Outcome) -> list[str]:
         return _until_optimal_summary(study, outcome)
     lines = [
         f"{study.name}: {seeds} tasks per curve, {study.actions} actions, epsilon "
-        f"{study.epsilon:g}, termination {study.termination:g}, {outcome.seconds:.1f} s"
+        f"{study.epsilon:g}, termination {study.termination:g}"
     ]
     for panel, curves in zip(study.panels, outcome.curves, strict=True):
         lines.append(f"  {_panel_name(panel)} (start state's greedy value, mean over tasks):")
@@ -497,7 +566,7 @@ def _until_optimal_summary(study: Study, outcome: Outcome) -> list[str]:
     lines = [
         f"{study.name}: {len(study.seeds)} runs per point, alpha {study.alpha:g}, gamma "
         f"{study.gamma:g}, epsilon {study.epsilon:g}, {study.planning_steps} planning steps, "
-        f"theta {study.theta:g}, {outcome.seconds:.1f} s",
+        f"theta {study.theta:g}",
         "  updates until the greedy path is shortest (mean over runs [least, most]):",
     ]
     for scale in study.scales:
@@ -587,3 +656,71 @@ def check_outputs(out: Path, force: bool) -> None:
 def default_out(study: Study) -> Path:
     """The figure file when ``--out`` is not given: the study's ``figure.file`` here."""
     return Path(study.file)
+
+
+class UpdatesKind(RunsKind):
+    """``kind: updates``: chapter 8's planning studies (Figures 8.7, 8.8, Example 8.4)."""
+
+    name = "updates"
+    figure_kinds = FIGURE_KINDS
+    units = Units("updates", "runs", "runs")
+    runs_per_task = 4
+
+    def read(self, study: StudyFile) -> Study:
+        """Check the file (:func:`read_study`)."""
+        return read_study(study)
+
+    def runs(self, spec: Study) -> list[dict[str, Cell]]:
+        """The runs (:func:`study_runs`)."""
+        return study_runs(spec)
+
+    def describe(self, spec: Study) -> tuple[int, str]:
+        """The runs, by what they are made of."""
+        runs = len(study_runs(spec))
+        seeds = _count(len(spec.seeds), "seed")
+        if spec.kind == "expected_vs_sample":
+            parts = f"{_count(len(spec.branching), 'branching factor')}, {seeds} of problems each"
+        elif spec.kind == "until_optimal":
+            parts = (
+                f"{_count(len(spec.scales), 'maze size')} x {_count(len(spec.methods), 'method')} "
+                f"x {seeds}"
+            )
+        else:
+            parts = f"{_count(len(spec.panels), 'panel')}' branching factors x {seeds}"
+        return runs, f"an updates study ({spec.kind}): {_count(runs, 'run')}: {parts}"
+
+    def result_columns(self, spec: Study) -> tuple[str, ...]:
+        """Figure 8.7: the expected update's largest error; Example 8.4: what a run took."""
+        if spec.kind == "expected_vs_sample":
+            return ("largest_expected_error",)
+        if spec.kind == "until_optimal":
+            return ("updates", "episodes", "steps", "reached")
+        return ()
+
+    def before_runs(self, spec: Study) -> str | None:
+        """Figure 8.8's compile notice."""
+        if spec.kind != "trajectory_sampling":
+            return None
+        from cartpole_q.engines.trajectory import compile_notice
+
+        return compile_notice()
+
+    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
+        """One run (:func:`run_one`)."""
+        return run_one(spec, key, handle.should_stop, handle.report)
+
+    def finish(
+        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+    ) -> Finished:
+        """The figure and the summary."""
+        outcome = study_outcome(spec, keys, records)
+        return Finished([(spec.file, study_figure(spec, outcome))], (), summary(spec, outcome))
+
+
+UPDATES = register_kind(UpdatesKind())
+"""the planning-updates kind (registered)"""
+
+
+def _count(n: int, noun: str) -> str:
+    """``1 seed``, ``2,000 seeds``."""
+    return f"{n:,} {noun}{'' if n == 1 else 's'}"

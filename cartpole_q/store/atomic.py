@@ -127,10 +127,9 @@ def check_output_file(path: Path, option: str, suffixes: tuple[str, ...], force:
             f"{path}: {option} cannot write {'files ending in ' + suffix if suffix else 'a file without an extension'}; "
             f"give a file name ending in one of {supported}."
         )
-    if path.exists() and not force:
-        raise WriteError(
-            f"{path}: already exists; pass --force to replace it, or choose another name."
-        )
+    if (path.exists() or path.is_symlink()) and not force:  # a dangling link too
+        what = "is a symbolic link" if path.is_symlink() else "already exists"
+        raise WriteError(f"{path}: {what}; pass --force to replace it, or choose another name.")
     probe = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
     try:
         with open(probe, "xb"):

@@ -24,6 +24,7 @@ import csv
 import dataclasses
 import functools
 import io
+import os
 import platform
 import shutil
 import time
@@ -158,6 +159,11 @@ def check_output_dir(out: Path, runs_root: Path = Path("runs"), kind: str = "run
     Raises:
         RunError: naming the path and what is wrong with it.
     """
+    if out.is_symlink() and not out.exists():
+        raise RunError(
+            f"{out}: --out is a dangling symbolic link (to {os.readlink(out)}); cartpole-q "
+            "creates no directory through one. Give a new directory, or make the link's target."
+        )
     if out.exists() and not out.is_dir():
         raise RunError(f"{out}: --out must be a directory, but this is a file.")
     if out.is_dir() and any(entry.name != lock.LOCK_FILE for entry in out.iterdir()):
