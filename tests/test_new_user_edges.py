@@ -119,6 +119,7 @@ def test_a_curve_that_overflowed_is_refused_with_its_step() -> None:
 # -- item 2: sizes bounded when read --------------------------------------------------------
 
 UPDATES = {"name": "u", "seeds": "0-1"}
+BOOK = Path(__file__).resolve().parents[1] / "examples" / "book"
 
 
 @pytest.mark.parametrize(
@@ -174,3 +175,67 @@ def test_a_size_no_study_needs_is_refused_when_read(
     path = write_yaml(tmp_path / "s.yaml", study)
     assert_refused(invoke(command, path, "--out", tmp_path / "s.png"), *named)
     assert not list(tmp_path.glob("s.*[!l]"))  # nothing written (the study file aside)
+
+
+# -- item 10: messages that pointed the wrong way --------------------------------------------
+
+
+def test_optimum_names_its_own_gamma_option_when_values_are_undefined() -> None:
+    result = invoke("optimum", "cartpole_q/Gridworld-v0", "--policy", "random")
+    assert_refused(result, "not defined at --gamma 1", "give --gamma below 1")
+    assert "agent.gamma" not in result.stderr
+
+
+def test_a_rule_of_another_world_names_the_world_that_declares_it(tmp_path: Path) -> None:
+    sets = ("--set", "env.id=FrozenLake-v1", "--set", "agent.algorithm=td")
+    result = invoke("train", *sets, "--set", "agent.policy=left", "--out", tmp_path / "r")
+    assert_refused(result, "left is not a rule FrozenLake-v1 declares", "cartpole_q/OneState-v0")
+    assert "stick_20" not in result.stderr
+
+
+@pytest.mark.parametrize("value", [-1, 0, True, "many"])
+def test_dp_max_sweeps_says_the_same_range_for_every_bad_value(tmp_path: Path, value: Any) -> None:
+    import yaml
+
+    study = yaml.safe_load((BOOK / "fig4_1_small_gridworld.yaml").read_text(encoding="utf-8"))
+    path = write_yaml(tmp_path / "s.yaml", {**study, "max_sweeps": value})
+    assert_refused(invoke("dp", path, "--check"), "max_sweeps: must be a whole number >= 1, got")
+
+
+def test_dp_max_sweeps_is_bounded_by_the_memory_of_the_recorded_sweeps(tmp_path: Path) -> None:
+    import yaml
+
+    study = yaml.safe_load((BOOK / "fig4_2_car_rental.yaml").read_text(encoding="utf-8"))
+    path = write_yaml(tmp_path / "s.yaml", {**study, "max_sweeps": 999_999})
+    assert_refused(invoke("study", path, "--check"), "max_sweeps: 999,999 recorded sweeps", "GiB")
+
+
+@pytest.mark.parametrize(
+    ("name", "command"),
+    [("fig2_2_epsilon_greedy", "study"), ("fig4_1_small_gridworld", "study"),
+     ("fig7_2_n_step_td", "study")],
+)  # fmt: skip
+def test_train_given_a_study_file_names_the_command_that_runs_it(
+    name: str, command: str, tmp_path: Path
+) -> None:
+    path = BOOK / f"{name}.yaml"
+    result = invoke("train", "-c", path, "--out", tmp_path / "r")
+    assert_refused(result, "is a study file", f"run it with `cartpole-q {command} {path}`")
+    tune = Path(__file__).resolve().parents[1] / "examples" / "rescue_blog.yaml"
+    assert_refused(invoke("train", "-c", tune), "is a tune file", "`cartpole-q tune")
+
+
+def test_a_prediction_runs_refusals_point_to_what_it_has(tmp_path: Path) -> None:
+    lake = tmp_path / "lake"
+    sets = ("--set", "env.id=FrozenLake-v1", "--set", "train.episodes=20")
+    assert invoke("train", *sets, "--out", lake, "-q").exit_code == 0
+    walk = tmp_path / "walk"
+    prediction = ("--set", "agent.algorithm=td", "--set", "agent.policy=greedy",
+                  "--set", f"agent.policy_run={lake}", "--set", "train.checkpoint_every=10")  # fmt: skip
+    assert invoke("train", *sets, *prediction, "--out", walk, "-q").exit_code == 0
+    # eval: no policy, and it says where the error it measured is drawn
+    assert_refused(invoke("eval", walk), "is a prediction run", "--metric rms_error")
+    # the evaluated run moved: the resume says how to go on
+    lake.rename(tmp_path / "moved")
+    result = invoke("train", "--resume", walk, "--episodes", 30)
+    assert_refused(result, f"agent.policy_run: {lake} does not exist", "put the directory back")

@@ -408,12 +408,12 @@ def test_a_named_policy_plays_its_rule_without_draws() -> None:
 @pytest.mark.parametrize(
     ("overrides", "words"),
     [
-        ({"env.id": WALK5["env.id"], "discretization": None}, "stick_20 is a rule another world"),
+        ({"env.id": WALK5["env.id"], "discretization": None}, "stick_20 is not a rule"),
         (
             {"env.id": "MountainCar-v0", "discretization.tilings": 4,
              "discretization.bins": [4, 4], "discretization.low": [-1.2, -0.07],
              "discretization.high": [0.6, 0.07]},
-            "stick_20 is a rule another world",
+            "stick_20 is not a rule",
         ),
     ],
 )  # fmt: skip

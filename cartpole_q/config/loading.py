@@ -29,6 +29,7 @@ from cartpole_q.config.overrides import (
     leaf_paths,
     merge,
     nest,
+    refuse_study_file,
 )
 from cartpole_q.config.schema import Config
 from cartpole_q.config.validation import read_config
@@ -85,6 +86,7 @@ def load_config(
         file = resolve_config_path(path)
         named = str(path) if file == Path(path) else str(file)
         user = read_yaml_mapping(file)
+        refuse_study_file(user, named)
     else:
         user = {}
     named = source or named

@@ -164,6 +164,36 @@ def check_known_keys(user: Mapping[Any, Any], source: str) -> None:
         _check_keys(value, names + params, f"{section}.", source)
 
 
+STUDY_FILE_KEYS = ("kind", "base", "grid", "zip", "testbed", "curves", "panels", "scales",
+                   "branching", "figure", "book")  # fmt: skip
+"""keys of study files that no config has: a file holding one is a study, not a config"""
+TUNE_FILE_KEYS = ("trials", "space", "objective")
+"""keys of tune files that no config has"""
+
+
+def refuse_study_file(user: Mapping[Any, Any], source: str) -> None:
+    """Refuse a study or tune file given as a config, naming the command that runs it.
+
+    Raises:
+        ConfigError: the mapping has a key only study (or tune) files have.
+    """
+    if not isinstance(user, Mapping):
+        return
+    found = next((key for key in user if key in TUNE_FILE_KEYS), None)
+    if found is not None:
+        raise ConfigError(
+            f"{source}: is a tune file, not a config (it has `{found}`): run it with "
+            f"`cartpole-q tune {source}`."
+        )
+    found = next((key for key in user if key in STUDY_FILE_KEYS), None)
+    if found is not None:
+        kind = user.get("kind", "sweep")
+        raise ConfigError(
+            f"{source}: is a study file ({'kind: ' + str(kind) if 'kind' in user else 'a sweep'}),"
+            f" not a config (it has `{found}`): run it with `cartpole-q study {source}`."
+        )
+
+
 def algorithm_param_keys() -> list[str]:
     """Every key some registered algorithm adds under ``agent`` (``n``, ``lambda``, ...)."""
     keys: dict[str, None] = {}

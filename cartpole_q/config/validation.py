@@ -194,9 +194,24 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
         rules = ", ".join(declared) or "none"
         raise reader.error(
             "agent.policy",
-            f"{name} is a rule another world declares; {env_id} declares {rules}. Use "
-            "random, or an env.id whose rule it is (stick_20: Blackjack-v1).",
+            f"{name} is not a rule {env_id} declares (it declares {rules}). Use random, "
+            f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(name)}",
         )
+
+
+def _rule_owners(name: str) -> str:
+    """Which worlds declare the rule ``name``, or every world's rules when none does.
+
+    >>> _rule_owners("left")
+    'left is the rule of cartpole_q/OneState-v0.'
+    """
+    owners = [profile.ids[0] for profile in all_profiles() if name in profile.policies]
+    if owners:
+        return f"{name} is the rule of {', '.join(owners)}."
+    rules = [
+        f"{rule} ({profile.ids[0]})" for profile in all_profiles() for rule in profile.policies
+    ]
+    return f"no world declares {name}; the worlds' rules: {', '.join(rules)}."
 
 
 def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None:

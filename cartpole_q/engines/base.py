@@ -436,6 +436,13 @@ def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
     """
     run = Path(str(config.agent.params["policy_run"]))
     field = f"agent.policy_run: {run}"
+    if not run.exists():
+        raise ConfigError(
+            f"{field} does not exist (moved or removed?). A prediction run reads the policy it "
+            "evaluates from that run: give a control run's directory; to resume a run that "
+            "evaluated it, put the directory back at that path (its config.yaml names it), or "
+            "start a new run with agent.policy_run where it is now."
+        )
     if not (run / "q_table.npy").is_file():
         what = (
             "is a prediction run: it has state values (v_table.npy), no policy"
@@ -512,12 +519,22 @@ def _policy_values(config: Config, tabular: Any, pi: np.ndarray) -> tuple[np.nda
     try:
         values = evaluate_policy(tabular, pi, config.agent.gamma, reachable)
     except ValueError as error:
-        raise ConfigError(
+        raise UndefinedValuesError(
             f"agent.policy: the {config.agent.params.get('policy')} policy's values on "
             f"{config.env.id} are not defined at agent.gamma {config.agent.gamma:g} ({error}); "
-            "give agent.gamma below 1."
+            "give agent.gamma below 1.",
+            str(error),
         ) from None
     return reachable, values
+
+
+class UndefinedValuesError(ConfigError):
+    """A policy's values are not defined: at ``gamma`` 1 it may never end an episode."""
+
+    def __init__(self, message: str, reason: str) -> None:
+        super().__init__(message)
+        self.reason = reason
+        """why (the solver's words)"""
 
 
 def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = True) -> Truth:

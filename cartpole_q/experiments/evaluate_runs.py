@@ -378,7 +378,7 @@ def policy_values(
             are not defined (it never ends an episode and ``gamma`` is 1).
         ConfigError: the id, an argument or the policy is unknown.
     """
-    from cartpole_q.engines.base import exact_values
+    from cartpole_q.engines.base import UndefinedValuesError, exact_values
     from cartpole_q.engines.plan import env_facts
 
     overrides: dict[str, Any] = {"env.id": env_id}
@@ -394,6 +394,11 @@ def policy_values(
     info = env_facts(config)
     try:
         truth = exact_values(config, info)
+    except UndefinedValuesError as error:
+        raise UserError(
+            f"{env_id}: the {policy} policy's values are not defined at --gamma {gamma:g} "
+            f"({error.reason}); give --gamma below 1, such as --gamma 0.99."
+        ) from None
     except ValueError as error:
         raise UserError(f"{env_id}: the {policy} policy's values: {error}.") from None
     if not truth.measured:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.config import ConfigError, EnvConfig, load_config, read_yaml_mapping, shown_value
+from cartpole_q.config.bounds import check_count, check_memory
 from cartpole_q.envs.models import PlanningModel, planning_model
 from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
 from cartpole_q.experiments.sweep_spec import (
@@ -43,6 +44,8 @@ BOOK_KEYS = ("label", "value", "state", "of", "sweep", "decimals")
 BOOK_OF = ("value", "min", "max", "action", "sweeps", "improvements")
 """what a ``book`` entry compares: a state's value or action, the values' extremes, counts"""
 SWEEPS_SUFFIX = "_sweeps.csv"
+MAX_SWEEPS = 1_000_000
+"""the most sweeps a study may make (every sweep's values are recorded)"""
 
 
 @dataclass(frozen=True)
@@ -227,9 +230,12 @@ def read_study(study: StudyFile) -> Study:
         raise ConfigError(f"{where}: tolerance: must be positive, got {tolerance:g}.")
     if tie_tolerance < 0:
         raise ConfigError(f"{where}: tie_tolerance: must not be negative, got {tie_tolerance:g}.")
-    max_sweeps = _integer(raw, "max_sweeps", 100_000, where) or 0
-    if max_sweeps < 1:
-        raise ConfigError(f"{where}: max_sweeps: must be at least 1.")
+    max_sweeps = raw.get("max_sweeps", 100_000)
+    if isinstance(max_sweeps, bool) or not isinstance(max_sweeps, int) or max_sweeps < 1:
+        raise ConfigError(
+            f"{where}: max_sweeps: must be a whole number >= 1, got {shown_value(max_sweeps)}."
+        )
+    check_count(where, "max_sweeps", max_sweeps, MAX_SWEEPS, "each sweep's values are kept")
     if algorithm == "value_iteration" and "policy" in raw:
         raise ConfigError(
             f"{where}: policy: value iteration starts from v = 0 and follows no policy; leave "
@@ -249,7 +255,12 @@ def read_study(study: StudyFile) -> Study:
         name, env, str(algorithm), gamma, policy, str(order), tolerance, max_sweeps,
         tie_tolerance, figure, book, where,
     )  # fmt: skip
-    _check_fits(checked, _model(checked))
+    world = _model(checked)
+    _check_fits(checked, world)
+    states, actions = world.model.n_states, world.model.n_actions
+    # every sweep's values and greedy policy (8 bytes each) and tied actions (1 byte each)
+    check_memory(where, "max_sweeps", (max_sweeps + 1) * states * (16 + actions),
+                 f"{max_sweeps:,} recorded sweeps of {states:,} states")  # fmt: skip
     return checked
 
 

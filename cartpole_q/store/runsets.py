@@ -128,11 +128,18 @@ def check_tables(run_set: RunSet) -> EnvInfo:
     from cartpole_q.evaluation import check_q_table_shape
 
     if any(run.predicts for run in run_set.runs):
+        measured = all(run.errors is not None for run in run_set.runs)
+        errors = (
+            f"`cartpole-q plot {run_set.path} --metric rms_error` draws its error (metrics.csv's "
+            "rms_error)"
+            if measured
+            else f"`cartpole-q plot {run_set.path}` draws its curves (its world has no model, "
+            "so no error was measured)"
+        )
         raise RunError(
             f"{run_set.path}: is a prediction run ({run_set.config.agent.algorithm}): it "
             "learnt the state values V of agent.policy (v_table.npy), not a policy, so there "
-            "is no greedy policy to evaluate, map or test. `cartpole-q plot "
-            f"{run_set.path}` draws its curves; metrics.csv holds its rms_error."
+            f"is no greedy policy to evaluate, map or test. {errors}."
         )
     info = env_facts(run_set.config, str(run_set.path / rundir.CONFIG_FILE))
     for run in run_set.runs:
