@@ -195,7 +195,7 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
         raise reader.error(
             "agent.policy",
             f"{name} is not a rule {env_id} declares (it declares {rules}). Use random, "
-            f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(name)}",
+            f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(str(name))}",
         )
 
 
