@@ -378,6 +378,7 @@ def summary_line_figure(
     y_limits: tuple[float | None, float | None] = (None, None),
     second: tuple[str, Sequence[float], np.ndarray] | None = None,
     line_styles: Sequence[tuple[int, bool]] | None = None,
+    x_names: Mapping[float, str] | None = None,
 ) -> DataFigure:
     """One summary per point against an axis: a line per group, a 95% band (S&B Fig. 12.10).
 
@@ -387,10 +388,13 @@ def summary_line_figure(
     ys)``, drawn shaded on a second y axis at the right (Figure 9.1's on-policy distribution).
     ``line_styles`` gives each line ``(colour index, dashed)`` (Figure 6.3: a colour per
     algorithm, interim dashed); by default each line has its own colour, solid.
+    ``x_names`` names the x ticks (Example 6.2's states A-E): a tick at each named x.
     """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
+    if x_names:
+        axes.set_xticks(list(x_names), list(x_names.values()))
     if second is not None:
         label, xs, ys = second
         right = axes.twinx()

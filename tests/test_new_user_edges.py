@@ -239,3 +239,30 @@ def test_a_prediction_runs_refusals_point_to_what_it_has(tmp_path: Path) -> None
     lake.rename(tmp_path / "moved")
     result = invoke("train", "--resume", walk, "--episodes", 30)
     assert_refused(result, f"agent.policy_run: {lake} does not exist", "put the directory back")
+
+
+# -- items 9 and 11: dp draws any grid world; figures name the book's states -----------------
+
+
+@pytest.mark.parametrize("env_id", ["FrozenLake-v1", "CliffWalking-v1"])
+def test_dp_draws_frozenlake_and_cliffwalking_as_grids(env_id: str, tmp_path: Path) -> None:
+    path = write_yaml(tmp_path / "s.yaml", {
+        "kind": "dp", "name": "g", "env": {"id": env_id}, "algorithm": "value_iteration",
+        "gamma": 0.9, "figure": {"kind": "grid", "greedy": True},
+    })  # fmt: skip
+    result = invoke("study", path, "--out", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.output
+    rows = (tmp_path / "out" / "g.csv").read_text(encoding="utf-8").splitlines()
+    cells = {line.split(",")[2:4][0] + "," + line.split(",")[3] for line in rows[1:]}
+    columns = 4 if env_id.startswith("Frozen") else 12
+    assert f"{columns - 1},3" in cells  # the bottom-right cell of a 4-row grid
+
+
+def test_example_6_2s_values_figure_names_the_states_a_to_e(tmp_path: Path) -> None:
+    from cartpole_q.config import load_config
+    from cartpole_q.envs.models import state_labels
+
+    walk = load_config({"env": {"id": "cartpole_q/RandomWalk5-v0"}}).env
+    assert state_labels(walk) == {1: "A", 2: "B", 3: "C", 4: "D", 5: "E"}
+    nineteen = load_config({"env": {"id": "cartpole_q/RandomWalk-v0"}}).env
+    assert state_labels(nineteen) == {}

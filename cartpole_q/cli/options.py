@@ -45,6 +45,11 @@ Workers = Annotated[
         show_default="one per core",
     ),
 ]
+LocalWorkers = Annotated[
+    int | None,
+    typer.Option(metavar="N", min=1, help="Worker processes.", show_default="one per core"),
+]
+"""``--workers`` of a command that runs on local processes only (``compile``)"""
 Backend = Annotated[
     BackendChoice,
     typer.Option(

@@ -186,9 +186,10 @@ def plot(
             metavar="METRIC",
             help="Draw learning curves of this per-episode metric instead of the reward "
             "figure: return, length (steps per episode), cumulative-return, episodes "
-            "(episodes completed) or info:KEY (each episode's sum of the environment's "
-            "info[KEY], for runs trained with train.info_metric: KEY), each seed faint, the seeds' aggregate bold with a 95% "
-            "bootstrap band.",
+            "(episodes completed), rms_error (a prediction run's error of V against the true "
+            "values) or info:KEY (each episode's sum of the environment's info[KEY], for runs "
+            "trained with train.info_metric: KEY), each seed faint, the seeds' aggregate bold "
+            "with a 95% bootstrap band.",
             show_default="the reward figure (return, 100-episode average, solve marks)",
         ),
     ] = None,

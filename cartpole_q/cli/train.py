@@ -25,6 +25,7 @@ from cartpole_q.cli.options import (
     Address,
     Backend,
     ConfigFile,
+    LocalWorkers,
     Quiet,
     SetValues,
     Workers,
@@ -280,7 +281,7 @@ def compile_command(
             "averages and env.randomize compile their own loops when first run.",
         ),
     ] = False,
-    workers: Workers = None,
+    workers: LocalWorkers = None,
     quiet: Quiet = False,
 ) -> None:
     """Fill numba's cache ahead of time (CI images, classrooms): later runs start at once."""

@@ -184,6 +184,19 @@ _ARROWS = {
 """the text arrow of each move (a king's diagonal moves have theirs)"""
 
 
+def state_labels(env: EnvConfig) -> dict[int, str]:
+    """The names a world gives some of its states (its ``labels``: Example 6.2's A-E)."""
+    from cartpole_q.envs.gym import make_env
+
+    made = make_env(env)
+    try:
+        return {
+            int(state): str(name) for state, name in getattr(made.unwrapped, "labels", {}).items()
+        }
+    finally:
+        made.close()
+
+
 def grid_layout(env: EnvConfig) -> GridLayout | None:
     """A grid world's map, as its profile says to read it; ``None`` for other environments.
 
@@ -260,6 +273,10 @@ def planning_model(env: EnvConfig, source: str = "config") -> PlanningModel | st
         moves = tuple(getattr(unwrapped, "moves", ()))
         shape = (rows, columns) if isinstance(rows, int) and isinstance(columns, int) else None
         labels = dict(getattr(unwrapped, "labels", {}))
+        if shape is None:  # a world its profile reads as a grid (FrozenLake, CliffWalking)
+            layout = grid_layout(env)
+            if layout is not None:
+                shape, moves = (layout.rows, layout.columns), layout.moves
         if shape is None or shape[0] * shape[1] != model.n_states:
             return PlanningModel(model, action_values, where, None, (), labels)
         return PlanningModel(model, action_values, where, shape, moves, labels)

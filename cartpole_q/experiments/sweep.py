@@ -542,9 +542,13 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         centre, low, high = aggregate_band(per_seed, "mean", rng)
         lines.append((label, states, centre, low, high))
     lines.append(("true values", states, truth.values, truth.values, truth.values))
+    from cartpole_q.envs.models import state_labels
+
+    named = state_labels(first.env)  # where the world names every state drawn, by name
+    names = {x: named[int(x)] for x in states} if all(int(x) in named for x in states) else None
     drawn = summary_line_figure(
         lines, "state", figure.y_label or "estimated value", figure.title or spec.name,
-        figure.log_y, (figure.y_min, figure.y_max), second,
+        figure.log_y, (figure.y_min, figure.y_max), second, x_names=names,
     )  # fmt: skip
     return write_figure(out, drawn)
 

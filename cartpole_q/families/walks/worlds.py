@@ -46,6 +46,8 @@ class RandomWalkEnv(TableWorld):
         self.states = states
         self.left_reward = float(left_reward)
         self.P = self._table()
+        # Example 6.2 names its five states A-E (figures label them so)
+        self.labels = {state: "ABCDE"[state - 1] for state in range(1, 6)} if states == 5 else {}
 
     def _table(self) -> Table:
         """``P``: a step moves one state; the ends are absorbing."""
