@@ -10,6 +10,7 @@ directories, draw with these functions, and write both.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import math
 from collections.abc import Iterable, Mapping, Sequence
@@ -28,6 +29,10 @@ from cartpole_q.rl.solve import SOLVE_WINDOW
 
 DPI = 100
 CURVE_SIZE = (8.0, 4.5)
+DRAWN_POINTS = 1_000
+"""the most points a long line keeps along its x axis, drawn and in its data: a figure 8
+inches wide at 100 dpi has 800 pixel columns, so more points draw nothing more (the full
+record stays in the run or study directory; ``plot --all-points`` draws every point)"""
 """inches; at 100 dpi a reward curve is 800 x 450 pixels"""
 POLICY_SIZE = (13.5, 4.2)
 """inches; at 100 dpi a policy map is 1350 x 420 pixels"""
@@ -207,6 +212,24 @@ CURVE_POINTS = 20_000
 (``ceil(episodes / CURVE_POINTS)``), its data likewise"""
 
 
+def drawn_points(count: int, log: bool = False, most: int | None = DRAWN_POINTS) -> np.ndarray:
+    """The indices of a line's ``count`` points that are drawn, and written as its data.
+
+    Every point when there are at most ``most`` (or ``most`` is ``None``); else ``most``
+    evenly spaced along the axis, log-spaced on a log axis (whose x are 1, 2, ..., as
+    episodes are), the first and the last always kept.
+
+    >>> drawn_points(5).tolist(), drawn_points(10, most=4).tolist()
+    ([0, 1, 2, 3, 4], [0, 3, 6, 9])
+    >>> drawn_points(100_000, log=True)[:12].tolist(), int(drawn_points(100_000, log=True)[-1])
+    ([0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], 99999)
+    """
+    if most is None or count <= most:
+        return np.arange(count)
+    spaced = np.geomspace(1.0, count, most) if log else np.linspace(1.0, count, most)
+    return np.unique(np.rint(spaced).astype(np.int64)) - 1
+
+
 def moving_average(values: np.ndarray, window: int = SOLVE_WINDOW) -> np.ndarray:
     """Trailing mean over the last ``window`` values (fewer at the start).
 
@@ -326,17 +349,24 @@ def metric_curve_figure(
     reference: tuple[float, str] | None = None,
     y_limits: tuple[float | None, float | None] = (None, None),
     log_x: bool = False,
+    most: int | None = DRAWN_POINTS,
 ) -> DataFigure:
     """Learning curves of any metric: each seed faint, the aggregate bold, a 95% band.
 
     One run (a single seed) is drawn as its line alone. ``reference`` is a dashed
     horizontal line and its legend label (an optimum, the book's figure); ``y_limits`` the
-    y axis's ends (``None``: automatic).
+    y axis's ends (``None``: automatic). A band of more than ``most`` points is drawn at
+    ``most`` of them (:func:`drawn_points`, log-spaced on a log x axis).
     """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
-    for band, colour in zip(bands, _colours(len(bands)), strict=True):
+    for whole, colour in zip(bands, _colours(len(bands)), strict=True):
+        kept = drawn_points(len(whole.x), log_x, most)
+        band = dataclasses.replace(
+            whole, x=whole.x[kept], per_seed=whole.per_seed[:, kept], centre=whole.centre[kept],
+            low=whole.low[kept], high=whole.high[kept],
+        )  # fmt: skip
         seeds = band.per_seed.shape[0]
         if seeds == 1:
             axes.plot(band.x, band.centre, color=colour, linewidth=1.6, label=band.label)
@@ -1573,19 +1603,23 @@ def _moves_colour(move: int) -> tuple[float, ...]:
 
 
 def step_curves_figure(
-    panels: Sequence[tuple[str, Sequence[tuple[str, np.ndarray]]]], title: str
+    panels: Sequence[tuple[str, Sequence[tuple[str, np.ndarray]]]],
+    title: str,
+    most: int | None = DRAWN_POINTS,
 ) -> DataFigure:
     """Figures 2.2-2.5: per-step curves (one value per step, steps from 1), panels stacked.
 
     Each panel is ``(y label, [(curve label, values), ...])``; its data panel is named by
-    its y label, the x of each point is the step.
+    its y label, the x of each point is the step. A curve of more than ``most`` steps is
+    drawn at ``most`` of them (:func:`drawn_points`).
     """
     figure = DataFigure(figsize=(8.0, 3.2 * len(panels) + 0.6), dpi=DPI, layout="constrained")
     axes_list = figure.subplots(len(panels), 1, sharex=True, squeeze=False)[:, 0]
     for axes, (y_label, curves) in zip(axes_list, panels, strict=True):
         record = figure.data.panel(y_label)
-        for (label, values), colour in zip(curves, _colours(len(curves)), strict=True):
-            steps = np.arange(1, len(values) + 1)
+        for (label, every), colour in zip(curves, _colours(len(curves)), strict=True):
+            kept = drawn_points(len(every), most=most)
+            steps, values = kept + 1, every[kept]
             axes.plot(steps, values, color=colour, linewidth=1.0, label=label)
             record.line(label, steps.tolist(), values.tolist())
         axes.set_ylabel(y_label)
@@ -1649,13 +1683,15 @@ def expected_vs_sample_figure(
     """Figure 8.7: RMS error against ``max Q`` computations, in units of ``b`` (0 to 2b).
 
     ``curves`` are ``(b, rms)`` with ``rms[t]`` after ``t`` sample updates; the expected
-    update is one line: ``initial_error`` until ``b`` computations, 0 from there.
+    update is one line: ``initial_error`` until ``b`` computations, 0 from there. A curve of
+    more than :data:`DRAWN_POINTS` points is drawn at that many, evenly spaced in ``t``.
     """
     figure = DataFigure(figsize=(8.0, 5.0), dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
-    for (branching, rms), colour in zip(curves, _colours(len(curves)), strict=True):
-        x = (np.arange(rms.shape[0]) / branching).tolist()
+    for (branching, every), colour in zip(curves, _colours(len(curves)), strict=True):
+        kept = drawn_points(every.shape[0])
+        x, rms = (kept / branching).tolist(), every[kept]
         label = f"sample updates, b = {branching:,}"
         axes.plot(x, rms, color=colour, linewidth=1.2, label=label)
         record.line(label, x, rms.tolist())

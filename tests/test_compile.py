@@ -90,3 +90,17 @@ def test_while_inlining_a_functions_blocks_share_one_copy_of_their_scope() -> No
     assert copies[0].scope.get_exact("x").scope is copies[0].scope
     assert not hasattr(ir.Scope, "__deepcopy__")  # only while inlining
     assert len({id(copy.deepcopy(block).scope) for block in blocks}) == 3  # numba's own
+
+
+def test_compile_all_fills_the_cache_with_the_studies_loops_too() -> None:
+    """Issue 47 item 11: compile --all left the bandit, trajectory and Example 8.4 loops."""
+    from cartpole_q.experiments.compiling import STUDY, STUDY_LOOPS, _compile, jobs_for
+    from cartpole_q.experiments.workers import InProcess
+    from cartpole_q.progress import NullReporter
+
+    jobs = [job for job in jobs_for(None, True) if job.engine == STUDY]
+    assert {job.algorithm for job in jobs} == set(STUDY_LOOPS)
+    assert {"bandit_numba", "bandit_gymnasium"} <= set(STUDY_LOOPS)
+    job = next(job for job in jobs if job.algorithm == "bandit_numba")
+    line = _compile(InProcess(None, NullReporter()), job, None)
+    assert line == "compiled bandit_numba (the bandit testbed, a study's loop)"

@@ -215,3 +215,44 @@ def test_a_long_runs_reward_curve_draws_every_kth_episode(episodes: int, stride:
     last = (len(raw) - 1) * stride  # the last drawn episode, 0-based
     assert float(raw[-1]["y"]) == returns[last]
     assert float(average[-1]["y"]) == pytest.approx(returns[last - 99 : last + 1].mean())
+
+
+# -- a figure's data is what it draws, at the resolution drawn (issue 47: 89 MB of docs/book) --
+
+
+BOOK_DATA = Path(__file__).resolve().parents[1] / "docs" / "book"
+
+
+def test_the_books_figure_data_stays_small() -> None:
+    files = sorted(BOOK_DATA.iterdir())
+    assert files, "docs/book holds the book's figures"
+    for path in files:
+        assert path.stat().st_size <= 2**20, f"{path.name}: more than 1 MiB"
+    assert sum(path.stat().st_size for path in files) <= 15 * 2**20
+
+
+@pytest.mark.parametrize("log_x", [False, True])
+def test_a_long_curve_is_drawn_and_written_at_the_resolution_drawn(log_x: bool) -> None:
+    from cartpole_q.figures import DRAWN_POINTS, MetricBand, metric_curve_figure
+
+    count = 100_000
+    x = np.arange(1, count + 1, dtype=float)
+    per_seed = np.vstack([np.sin(x / 1000.0), np.cos(x / 1000.0)])
+    centre = per_seed.mean(axis=0)
+    band = MetricBand("b", x, per_seed, centre, centre - 1, centre + 1, "mean", (0, 1))
+    figure = metric_curve_figure([band], "episode", "y", "t", log_x=log_x)
+    lines = figure.axes[0].get_lines()
+    table = list(csv.reader(figure.data.csv_text().splitlines()))[1:]
+    rows = [row for row in table if row[1] == "b: mean"]
+    drawn_x = lines[-1].get_xdata()
+    assert len(drawn_x) <= DRAWN_POINTS and drawn_x[0] == 1 and drawn_x[-1] == count
+    assert [float(row[2]) for row in rows] == list(drawn_x)  # the data is what is drawn
+    kept = np.asarray(drawn_x, dtype=np.int64) - 1
+    assert [float(row[3]) for row in rows] == centre[kept].tolist()  # exact, not resampled
+    gaps = np.diff(drawn_x)
+    if log_x:  # every early episode, ever wider steps later
+        assert list(drawn_x[:10]) == list(range(1, 11)) and gaps[-1] > 100 * gaps[0]
+    else:
+        assert gaps.max() - gaps.min() <= 1
+    whole = metric_curve_figure([band], "episode", "y", "t", log_x=log_x, most=None)
+    assert len(whole.axes[0].get_lines()[-1].get_xdata()) == count

@@ -216,6 +216,15 @@ def plot(
     log_y: Annotated[
         bool, typer.Option("--log-y", help="With --metric: a logarithmic y axis.")
     ] = False,
+    all_points: Annotated[
+        bool,
+        typer.Option(
+            "--all-points",
+            help="With --metric: draw, and write in the figure's data, every point of a long "
+            "curve (by default at most 1,000 per line, log-spaced on a log axis: what the "
+            "figure can show).",
+        ),
+    ] = False,
 ) -> None:
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with exit_codes():
@@ -223,9 +232,13 @@ def plot(
         from cartpole_q.learning_curves import AGGREGATES, X_AXES, check_metric
         from cartpole_q.store.rundir import CURVE_FILE
 
-        curve_options = x_axis != "episode" or aggregate != "mean" or smooth != 1 or log_y
+        curve_options = (
+            x_axis != "episode" or aggregate != "mean" or smooth != 1 or log_y or all_points
+        )
         if metric is None and curve_options:
-            raise UserError("--x, --aggregate, --smooth and --log-y apply to --metric only.")
+            raise UserError(
+                "--x, --aggregate, --smooth, --log-y and --all-points apply to --metric only."
+            )
         problem = None if metric is None else check_metric(metric)
         if problem is not None:
             raise UserError(f"--metric {metric}: {problem}.")
@@ -246,7 +259,7 @@ def plot(
             replace = force or (out is None and len(run_dirs) == 1)
             path = plot_metric(
                 run_dirs, out or default, metric, x_axis, aggregate, smooth, log_y, replace,
-                on_note=note,
+                on_note=note, all_points=all_points,
             )  # fmt: skip
             typer.echo(str(path))
             return

@@ -120,6 +120,22 @@ def play_run_gymnasium(
     return rewards, optimal
 
 
+def warm_up(engine: str) -> None:
+    """Compile (or load from the cache) ``engine``'s functions: one run of one step.
+
+    The functions take every rule and testbed alike (their types do not change), so one
+    run compiles what every bandit study plays (``cartpole-q compile --all``).
+    """
+    from cartpole_q.rl.bandits import RULES
+
+    agent = BanditAgent(RULES["epsilon_greedy"], 0.1, 0.0, 0.0, 0.0, False)
+    testbed = ArmedTestbed(2, 0.0, 1.0, 0.0)
+    if engine == "gymnasium":
+        play_run_gymnasium(agent, testbed, 0, 1)
+    else:
+        play_run_numba(agent, testbed, 0, 1)
+
+
 def make_env(testbed: ArmedTestbed, steps: int | None = None) -> Any:
     """``gymnasium.make("cartpole_q/Bandit-v0")`` with the testbed's arguments.
 

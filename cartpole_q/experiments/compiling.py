@@ -36,6 +36,8 @@ engine (whose step functions take every observation but tiles' as float64 values
 world covers them all)"""
 
 
+STUDY = "study"
+"""the ``engine`` of a job that compiles a study's loop (:data:`STUDY_LOOPS`)"""
 SKIPPED = "skipped"
 """how the line of a job that could not run its config starts"""
 
@@ -56,20 +58,39 @@ class CompileJob:
         return f"{self.algorithm} on {self.label} ({self.engine} engine)"
 
 
+STUDY_LOOPS = {
+    "bandit_numba": ("the bandit testbed", lambda: _bandit("numba")),
+    "bandit_gymnasium": ("the bandit testbed", lambda: _bandit("gymnasium")),
+}
+"""the compiled loops the studies run outside training (by a name, with what they play
+and how to compile them): ``compile --all`` fills the cache with them too"""
+
+
+def _bandit(engine: str) -> None:
+    from cartpole_q.engines.bandit import warm_up
+
+    warm_up(engine)
+
+
 def jobs_for(config: Config | None, every: bool) -> list[CompileJob]:
-    """What to compile: one config's loops on both engines, or every algorithm's everywhere."""
+    """What to compile: one config's loops on both engines, or every algorithm's everywhere.
+
+    ``every`` adds the studies' own loops (:data:`STUDY_LOOPS`).
+    """
     if not every:
         chosen = config or load_config()
         return [
             CompileJob("", chosen.agent.algorithm, engine, chosen.env.id)
             for engine in ("numba", "gymnasium")
         ]
-    return [
+    training = [
         CompileJob(name, algorithm, engine, load_config(name).env.id)
         for engine, configs in ENGINE_CONFIGS.items()
         for name in configs
         for algorithm in algorithm_names()
     ]
+    studies = [CompileJob("", loop, STUDY, label) for loop, (label, _) in STUDY_LOOPS.items()]
+    return training + studies
 
 
 def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None) -> str:
@@ -84,6 +105,9 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
 
     if handle.should_stop():
         return ""
+    if job.engine == STUDY:
+        STUDY_LOOPS[job.algorithm][1]()
+        return f"compiled {job.algorithm} ({job.label}, a study's loop)"
     config = load_config(mapping if mapping is not None else (job.config or None))
     config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm})
     try:

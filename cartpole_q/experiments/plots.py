@@ -20,6 +20,7 @@ from cartpole_q.errors import RunError, UserError
 from cartpole_q.experiments.compare import Comparison, compare_figure_data
 from cartpole_q.families import profile_for
 from cartpole_q.figures import (
+    DRAWN_POINTS,
     Curve,
     GridMap,
     MetricBand,
@@ -47,6 +48,11 @@ from cartpole_q.rl.tiles import values_on_grid
 from cartpole_q.store import rundir
 from cartpole_q.store.figure_file import check_figure_file, write_figure
 from cartpole_q.store.runsets import check_tables, load_run_set
+
+TILE_MAP_CELLS = 80
+"""a tiled table's policy map is drawn on at most this many cells per axis: 80 x 80 cells
+(a few pixels each) draw what the tilings resolve, and keep the map's data under a
+megabyte"""
 
 
 def plot_rewards(
@@ -141,6 +147,7 @@ def plot_metric(
     force: bool = False,
     on_note: Callable[[str], None] | None = None,
     style: CurveStyle | None = None,
+    all_points: bool = False,
 ) -> Path:
     """Draw a metric's learning curves of runs, multi-seed runs and sweep points.
 
@@ -157,6 +164,8 @@ def plot_metric(
         on_note: Told what is unfinished or left out.
         style: Labels, a transform of the values and a reference line (a sweep file's
             ``figure``); default: the directories' names, the values as they are.
+        all_points: Draw (and write) every point of a long curve, not
+            :data:`~cartpole_q.figures.DRAWN_POINTS` of them.
 
     Raises:
         RunError: A directory is not a complete run, a sweep point kept no curves, or
@@ -208,6 +217,7 @@ def plot_metric(
         style.reference,
         style.y_limits,
         log_x=style.log_x,
+        most=None if all_points else DRAWN_POINTS,
     )
     return write_figure(out, figure)
 
@@ -351,8 +361,12 @@ def plot_policy(
     low, high = grid.low, grid.high
     if grid.tilings > 1:
         # A tiled table has no state per cell: draw the tiles' sums on the fine grid the
-        # tilings make (T cells per bin, at most 120), the other dimensions at their centre.
-        cells = (min(120, bins[dims[0]] * grid.tilings), min(120, bins[dims[1]] * grid.tilings))
+        # tilings make (T cells per bin, at most TILE_MAP_CELLS), the other dimensions at
+        # their centre.
+        cells = (
+            min(TILE_MAP_CELLS, bins[dims[0]] * grid.tilings),
+            min(TILE_MAP_CELLS, bins[dims[1]] * grid.tilings),
+        )
         grids = [values_on_grid(r.q_table, bins, low, high, dims, cells) for r in runs]
         q_table = grids[0]
         if len(grids) > 1:  # the seeds' votes, on the grid (a tile's weights are no state)
