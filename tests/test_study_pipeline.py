@@ -219,3 +219,30 @@ def test_a_full_disk_at_the_end_changes_no_figure_and_resume_draws_them(
     assert resumed.exit_code == 0, resumed.output
     assert invoke("dp", study, "--out", tmp_path / "whole", "-q").exit_code == 0
     assert _files(out) == _files(tmp_path / "whole")
+
+
+@pytest.mark.slow
+def test_studies_of_every_kind_run_on_a_local_ray_cluster_to_the_same_bytes(
+    tmp_path: Path,
+) -> None:
+    ray = pytest.importorskip("ray")
+    from cartpole_q.experiments import study as studies
+    from cartpole_q.experiments.study_kinds import registered
+
+    files = {name: RESUMED[name](tmp_path) for name in ("bandit", "dp", "until_optimal")}
+    local = {}
+    for name, path in files.items():
+        local[name] = tmp_path / f"local-{name}"
+        assert invoke("study", path, "--out", local[name], "--workers", 1, "-q").exit_code == 0
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        for name, path in files.items():
+            study = studies.read_study_file(path)
+            kind = registered()[study.kind]
+            spec = kind.read(study)
+            with kind.start(spec, study, tmp_path / f"ray-{name}") as directory:
+                outcome = kind.run(spec, directory, studies.Options(workers=2, backend="ray"))
+            assert outcome.complete, name
+            assert _files(directory) == _files(local[name]), name
+    finally:
+        ray.shutdown()
