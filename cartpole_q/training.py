@@ -440,6 +440,12 @@ def _restore(state: TrainingState, checkpoint: Checkpoint) -> None:
     episode = checkpoint.episode
     live, saved = state.tables, checkpoint.tables
     growing = state.algorithm.growing_memory
+    older = state.algorithm.older_memory
+    if older is not None and len(live.memory) != len(saved.memory):
+        try:  # a checkpoint written before the algorithm kept its present arrays
+            saved = saved._replace(memory=older(saved.memory))
+        except ValueError as error:
+            raise RunError(f"the checkpoint's memory cannot be continued: {error}.") from None
     if len(live.memory) != len(saved.memory) or any(
         not _fits(a.shape, b.shape, index in growing)
         for index, (a, b) in enumerate(zip(live.memory, saved.memory, strict=False))

@@ -70,6 +70,36 @@ def test_figure_8_8_curves_are_the_re_derivations_byte_for_byte(
         assert on_policy.tolist() == start_values(*settings, on_policy=True)
 
 
+@pytest.mark.parametrize("compiled", [True, False])
+def test_figure_8_8_in_small_chunks_is_figure_8_8_in_one(compiled: bool, monkeypatch: Any) -> None:
+    from cartpole_q.engines import trajectory
+
+    whole = task_curves(2, 15, 2, 3, 240, 20, 0.1, 0.1, 1e-9, compiled=compiled)
+    asked: list[int] = []
+
+    def never() -> bool:
+        asked.append(1)
+        return False
+
+    monkeypatch.setattr(trajectory, "CHUNK_WORK", 4)  # two updates (b = 3) a chunk
+    chunked = task_curves(2, 15, 2, 3, 240, 20, 0.1, 0.1, 1e-9, compiled=compiled,
+                          should_stop=never)  # fmt: skip
+    assert chunked is not None
+    assert [curve.tolist() for curve in chunked] == [curve.tolist() for curve in whole]
+    assert len(asked) >= 2 * 240 // 2  # two updates a chunk, in both runs
+
+
+def test_figure_8_8_stops_between_chunks_with_none() -> None:
+    asked: list[int] = []
+
+    def stop() -> bool:
+        asked.append(1)
+        return len(asked) > 1
+
+    assert task_curves(0, 2000, 2, 1, 10**7, 1000, 0.1, 0.1, 1e-9, should_stop=stop) is None
+    assert len(asked) == 2  # one chunk, not ten million updates
+
+
 def test_a_task_valued_at_the_start_is_the_policy_of_action_0() -> None:
     uniform, on_policy = task_curves(3, 10, 2, 2, 20, 10, 0.1, 0.1, 1e-9)
     assert uniform[0] == on_policy[0]  # Q = 0: the greedy policy takes action 0 everywhere

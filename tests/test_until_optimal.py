@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 from typing import Any
 
@@ -15,9 +16,14 @@ from cartpole_q.config import ConfigError
 from cartpole_q.engines import until_optimal as loop
 from cartpole_q.engines.until_optimal import Settings, greedy_path_length, maze_arrays
 from cartpole_q.experiments import updates
-from cartpole_q.families.gridworlds.worlds import DynaMazeEnv, scaled_cells, shortest_path
+from cartpole_q.families.gridworlds.worlds import (
+    DynaMazeEnv,
+    doubled_block,
+    scaled_cells,
+    shortest_path,
+)
 from cartpole_q.rl.algorithms import prioritized_sweeping
-from tests.conftest import invoke
+from tests.conftest import invoke, write_yaml
 
 STUDY = Path(__file__).resolve().parents[1] / "examples/book/example8_4_prioritized_sweeping.yaml"
 
@@ -147,11 +153,92 @@ def test_a_run_that_does_not_get_there_stops_at_max_updates() -> None:
     assert result.episodes == 1 and result.updates >= 100
 
 
+@pytest.mark.parametrize("doublings", range(8))
+def test_the_doubled_mazes_have_the_books_sizes(doublings: int) -> None:
+    world = DynaMazeEnv(doubled_block(doublings))
+    rows, columns = doubled_block(doublings)
+    assert world.open_cells() == 47 * 2**doublings
+    assert (world.rows, world.columns) == (6 * rows, 9 * columns)
+    assert world.start == (2 * rows, 0) and world.goal == (0, 8 * columns)
+    assert shortest_path(world) == [14, 20, 28, 40, 56, 80, 112, 160][doublings]
+
+
+def test_a_pair_scale_of_equal_sides_is_the_whole_number_scale() -> None:
+    assert DynaMazeEnv((3, 3)).P == DynaMazeEnv(3).P
+    assert DynaMazeEnv([2, 1]).block == (2, 1)  # as YAML gives it
+    for bad in ([2], [0, 1], [1, 2, 3], (1.0, 2)):
+        with pytest.raises(ValueError, match="scale"):
+            DynaMazeEnv(bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+@pytest.mark.parametrize("algorithm", ["prioritized_sweeping", "dyna_q", "q_learning"])
+def test_a_run_in_small_chunks_is_the_run_in_one(
+    monkeypatch: Any, algorithm: str, compiled: bool
+) -> None:
+    maze = maze_arrays(DynaMazeEnv(2 if compiled else 1))
+    whole = loop.until_optimal(maze, settings(algorithm), 1, compiled=compiled)
+    seen: list[int] = []
+    monkeypatch.setattr(loop, "CHUNK_UPDATES", 7)  # one real step per chunk and more
+    chunked = loop.until_optimal(maze, settings(algorithm), 1, compiled=compiled,
+                                 progress=seen.append)  # fmt: skip
+    assert chunked == whole
+    assert whole is not None and len(seen) > whole.episodes  # paused inside episodes
+    assert seen == sorted(seen) and seen[-1] == whole.updates
+
+
+def test_a_stop_between_chunks_returns_none_at_once() -> None:
+    maze = maze_arrays(DynaMazeEnv(doubled_block(4)))
+    asked: list[int] = []
+
+    def stop() -> bool:
+        asked.append(1)
+        return len(asked) > 2
+
+    made: list[int] = []
+    result = loop.until_optimal(
+        maze, settings("prioritized_sweeping"), 0, should_stop=stop, progress=made.append
+    )
+    assert result is None
+    assert len(asked) == 3 and len(made) == 2  # two chunks, then nothing more
+    assert 0 < made[-1] <= 2 * loop.CHUNK_UPDATES
+    assert loop.until_optimal(maze, settings("dyna_q"), 0, should_stop=lambda: True) is None
+
+
+def test_the_relaxed_criterion_stops_no_later_than_the_exact_one() -> None:
+    # The same draws until the greedy path is within 1.2 x shortest, which a shortest path is.
+    maze = maze_arrays(DynaMazeEnv(2))
+    for algorithm in ("prioritized_sweeping", "dyna_q"):
+        exact = loop.until_optimal(maze, settings(algorithm), 0)
+        relaxed = loop.until_optimal(maze, settings(algorithm, optimal_within=1.2), 0)
+        assert exact is not None and relaxed is not None and relaxed.reached
+        assert relaxed.episodes <= exact.episodes and relaxed.updates <= exact.updates
+
+
+@pytest.mark.parametrize("within", [0.9, math.nan, math.inf])
+def test_a_criterion_below_the_shortest_path_is_refused(within: float) -> None:
+    with pytest.raises(ValueError, match="optimal_within"):
+        settings("dyna_q", optimal_within=within)
+
+
+def test_a_run_whose_updates_stop_growing_gives_up_at_max_steps() -> None:
+    # theta above every priority: nothing is ever queued, no update is ever made.
+    maze = maze_arrays(DynaMazeEnv(1))
+    result = loop.until_optimal(
+        maze, settings("prioritized_sweeping", theta=2.0, max_steps=5_000), 0
+    )
+    assert result is not None and not result.reached
+    assert result.updates == 0 and result.steps >= 5_000
+
+
 def test_the_shipped_study_loads() -> None:
     study = updates.load_study(STUDY)
     assert study.kind == "until_optimal"
     assert study.methods == ("prioritized_sweeping", "dyna_q")
-    assert (study.alpha, study.planning_steps, study.theta) == (0.5, 5, 0.0001)
+    assert (study.alpha, study.planning_steps, study.theta) == (0.5, 5, 0.00001)
+    # the book's axis: 47 x 2^j states, 47 to 6,016, both criteria, 10 runs each
+    assert [updates.maze_states(block) for block in study.scales] == [47 * 2**j for j in range(8)]
+    assert study.optimal_within == (1.0, 1.2) and len(study.seeds) == 10
 
 
 @pytest.mark.parametrize(
@@ -177,17 +264,14 @@ def test_a_bad_study_is_refused_naming_the_key(tmp_path: Path, change: str, key:
 
 
 def test_the_command_draws_the_figure_and_its_numbers(tmp_path: Path) -> None:
-    text = (
-        STUDY.read_text()
-        .replace("seeds: 0-4", "seeds: 0-1")
-        .replace("scales: [1, 2, 3, 4]", "scales: [1]")
-    )
-    study = tmp_path / "study.yaml"
-    study.write_text(text)
+    study = write_yaml(tmp_path / "study.yaml", {
+        "kind": "updates", "name": "example8_4_prioritized_sweeping", "seeds": "0-1",
+        "scales": [1], "theta": 0.0001, "figure": {"kind": "until_optimal"},
+    })  # fmt: skip
     out = tmp_path / "study"
     result = invoke("updates", study, "--out", out)
     assert result.exit_code == 0, result.output
-    assert "k = 1 (47 states, shortest path 14 steps)" in result.output
+    assert "1 x 1 blocks (47 states, shortest path 14 steps)" in result.output
     with (out / "example8_4_prioritized_sweeping.csv").open() as handle:
         rows = list(csv.DictReader(handle))
     assert [(row["series"], row["x"]) for row in rows] == [
@@ -195,3 +279,20 @@ def test_the_command_draws_the_figure_and_its_numbers(tmp_path: Path) -> None:
         ("Dyna-Q", "47.0"),
     ]
     assert float(rows[0]["y"]) == (820 + 905) / 2  # seeds 0 and 1
+
+
+def test_blocks_and_criteria_are_axes_of_the_study(tmp_path: Path) -> None:
+    study = write_yaml(tmp_path / "study.yaml", {
+        "kind": "updates", "name": "u", "seeds": "0", "scales": [[2, 1]],
+        "optimal_within": [1, 1.2], "methods": ["prioritized_sweeping"],
+        "figure": {"kind": "until_optimal"},
+    })  # fmt: skip
+    result = invoke("study", study, "--out", tmp_path / "out", "-q")
+    assert result.exit_code == 0, result.output
+    with (tmp_path / "out" / "u.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [(row["series"], row["x"]) for row in rows] == [
+        ("Prioritized sweeping (shortest path)", "94.0"),
+        ("Prioritized sweeping (within 1.2x)", "94.0"),
+    ]
+    assert float(rows[1]["y"]) <= float(rows[0]["y"])  # a longer path is found no later

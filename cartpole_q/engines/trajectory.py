@@ -1,20 +1,32 @@
 """Figure 8.8's runs, compiled: one task, uniform or on-policy updates, its greedy values.
 
 :func:`~cartpole_q.rl.planning_updates.trajectory_run` compiled with numba once per
-machine (cached on disk); :func:`task_curve` draws a task and runs it. ``compiled=False``
-runs the same Python (for tests on tiny tasks).
+machine (cached on disk); :func:`task_curves` draws a task and runs it, in chunks of about
+:data:`CHUNK_WORK` units of work (a fraction of a second each), so that a caller's
+``should_stop`` is asked between them. ``compiled=False`` runs the same Python (for tests
+on tiny tasks).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, overload
 
 import numpy as np
 
 from cartpole_q.engines.compile import specialise
-from cartpole_q.rl.planning_updates import task_draws, trajectory_run
+from cartpole_q.rl.planning_updates import (
+    TRAJECTORY_CARRY,
+    task_draws,
+    trajectory_run,
+    trajectory_tables,
+)
 
 LOOP_NAME = "planning_trajectory_run"
+CHUNK_WORK = 500_000
+"""a chunk's work in :func:`~cartpole_q.rl.planning_updates.trajectory_run`'s units (``b``
+per update, ``S * b`` per valuation, whose tens of sweeps make it the dearer): measured at
+0.02-0.2 s on 2 shared cores for the book's tasks"""
 _compiled: dict[str, Any] = {}
 
 
@@ -33,6 +45,22 @@ def _loop() -> Any:
     return _compiled[LOOP_NAME]
 
 
+@overload
+def task_curves(
+    seed: int, states: int, actions: int, branching: int, updates: int, every: int,
+    termination: float, epsilon: float, tolerance: float, compiled: bool = True, *,
+    should_stop: None = None,
+) -> tuple[np.ndarray, np.ndarray]: ...  # fmt: skip
+
+
+@overload
+def task_curves(
+    seed: int, states: int, actions: int, branching: int, updates: int, every: int,
+    termination: float, epsilon: float, tolerance: float, compiled: bool = True, *,
+    should_stop: Callable[[], bool],
+) -> tuple[np.ndarray, np.ndarray] | None: ...  # fmt: skip
+
+
 def task_curves(
     seed: int,
     states: int,
@@ -44,17 +72,29 @@ def task_curves(
     epsilon: float,
     tolerance: float,
     compiled: bool = True,
-) -> tuple[np.ndarray, np.ndarray]:
+    *,
+    should_stop: Callable[[], bool] | None = None,
+) -> tuple[np.ndarray, np.ndarray] | None:
     """Task ``seed``'s two curves, ``(uniform, on_policy)``, each ``updates // every + 1`` values.
 
     Both run on the same task (:func:`~cartpole_q.rl.planning_updates.task_draws`); the
-    on-policy run draws from the task's run generator.
+    on-policy run draws from the task's run generator. ``should_stop`` is asked before
+    each chunk; when it says stop, ``None`` is returned at once.
     """
     next_states, rewards, rng = task_draws(seed, states, actions, branching)
     run = _loop() if compiled else trajectory_run
     curves = []
     for on_policy in (False, True):
         out = np.empty(updates // every + 1)
-        run(next_states, rewards, termination, epsilon, on_policy, every, tolerance, rng, out)
+        tables = trajectory_tables(states, actions)
+        carry = np.zeros(TRAJECTORY_CARRY, dtype=np.int64)
+        complete = False
+        while not complete:
+            if should_stop is not None and should_stop():
+                return None
+            complete = run(
+                next_states, rewards, termination, epsilon, on_policy, every, tolerance, rng,
+                out, tables, carry, CHUNK_WORK,
+            )  # fmt: skip
         curves.append(out)
     return curves[0], curves[1]

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -51,7 +52,7 @@ from cartpole_q.store.studydir import Cell, RunRecord
 STUDY_KEYS = (
     "name", "seeds", "branching", "initial_error", "panels", "actions", "epsilon",
     "termination", "tolerance", "scales", "methods", "alpha", "gamma", "planning_steps", "theta",
-    "max_updates", "figure",
+    "max_updates", "max_steps", "optimal_within", "figure",
 )  # fmt: skip
 """the keys a study file may have"""
 KIND_KEYS = {
@@ -59,7 +60,7 @@ KIND_KEYS = {
     "trajectory_sampling": ("panels", "actions", "epsilon", "termination", "tolerance"),
     "until_optimal": (
         "scales", "methods", "alpha", "gamma", "epsilon", "planning_steps", "theta",
-        "max_updates",
+        "max_updates", "max_steps", "optimal_within",
     ),
 }  # fmt: skip
 """the keys each figure kind takes (beside ``name``, ``seeds`` and ``figure``)"""
@@ -106,14 +107,19 @@ class Study:
     file: str
     title: str
     where: str
-    scales: tuple[int, ...] = ()
-    """``until_optimal``: the maze scales ``k``"""
+    scales: tuple[tuple[int, int], ...] = ()
+    """``until_optimal``: the mazes' blocks ``(rows, columns)`` (a scale ``k``: ``(k, k)``)"""
     methods: tuple[str, ...] = ()
     alpha: float = 0.5
     gamma: float = 0.95
     planning_steps: int = 5
     theta: float = 0.0001
     max_updates: int = 10_000_000
+    max_steps: int = 20_000_000
+    """``until_optimal``: a run gives up after the episode in which it took this many steps"""
+    optimal_within: tuple[float, ...] = (1.0,)
+    """``until_optimal``: the criteria, each a run's stop when its greedy path is at most
+    that many times the shortest (1: a shortest path)"""
 
 
 @dataclass(frozen=True)
@@ -140,8 +146,8 @@ class Outcome:
     seconds: float = 0.0
     """how long :func:`run_study` took (not part of the summary, which a resumed study
     must print byte for byte as one run in one go)"""
-    runs: dict[tuple[str, int], list[Any]] | None = None
-    """``until_optimal``: per ``(method, scale)`` each seed's
+    runs: dict[tuple[str, float, tuple[int, int]], list[Any]] | None = None
+    """``until_optimal``: per ``(method, criterion, block)`` each seed's
     :class:`~cartpole_q.engines.until_optimal.Result`"""
 
 
@@ -263,16 +269,21 @@ def read_study(study: StudyFile) -> Study:
 def _until_optimal_study(
     raw: Mapping[str, Any], name: str, seeds: tuple[int, ...], file: str, title: str, where: str
 ) -> Study:
+    from cartpole_q.families.gridworlds.worlds import maze_block
+
     scales = raw.get("scales")
-    if (
-        not isinstance(scales, list)
-        or not scales
-        or not all(isinstance(k, int) and not isinstance(k, bool) and k >= 1 for k in scales)
-        or len(set(scales)) != len(scales)
-    ):
+    blocks: list[tuple[int, int]] = []
+    for scale in scales if isinstance(scales, list) else []:
+        try:
+            blocks.append(maze_block(scale))
+        except ValueError:
+            blocks = []
+            break
+    if not blocks or len(set(blocks)) != len(blocks):
         raise ConfigError(
-            f"{where}: scales: must be a list of distinct whole numbers >= 1 (each cell of the "
-            f"Dyna maze becomes a k x k block), such as [1, 2, 3], got {shown_value(scales)}."
+            f"{where}: scales: must be a list of distinct mazes, each a whole number k >= 1 "
+            "(every cell of the Dyna maze becomes a k x k block) or [rows, columns] (blocks of "
+            f"that many rows and columns), such as [1, 2, [4, 2]], got {shown_value(scales)}."
         )
     methods = raw.get("methods", ["prioritized_sweeping", "dyna_q"])
     if (
@@ -296,40 +307,93 @@ def _until_optimal_study(
             raise ConfigError(f"{where}: {key}: must be in (0, 1], got {value:g}.")
     if theta < 0:
         raise ConfigError(f"{where}: theta: must not be negative, got {theta:g}.")
+    within = _criteria(raw.get("optimal_within", 1.0), where)
     planning_steps = _whole(raw, "planning_steps", 5, where, 0)
     check_count(where, "planning_steps", planning_steps, MAX_BRANCHING)
     max_updates = _whole(raw, "max_updates", 10_000_000, where, 1)
     check_count(where, "max_updates", max_updates)
-    for scale in scales:
-        check_count(where, "scales", scale, MAX_SCALE,
-                    f"a maze of {maze_states(MAX_SCALE):,} states; the book's largest has about 6,000")  # fmt: skip
-        check_memory(where, "scales", maze_states(scale) * MAZE_BYTES_PER_STATE,
-                     f"the maze of scale {scale} ({maze_states(scale):,} states)")  # fmt: skip
+    max_steps = _whole(raw, "max_steps", 20_000_000, where, 1)
+    check_count(where, "max_steps", max_steps)
+    for rows, columns in blocks:
+        for side in (rows, columns):
+            check_count(where, "scales", side, MAX_SCALE,
+                        f"a maze of {maze_states((MAX_SCALE, MAX_SCALE)):,} states; the book's largest has 6,016")  # fmt: skip
+        states = maze_states((rows, columns))
+        check_memory(where, "scales", states * MAZE_BYTES_PER_STATE,
+                     f"the maze of {states:,} states")  # fmt: skip
     return Study(
         name, "until_optimal", seeds, (), 1.0, (), 4, epsilon, 0.0, 0.0, file, title, where,
-        tuple(scales), tuple(methods), alpha, gamma, planning_steps, theta, max_updates,
+        tuple(blocks), tuple(methods), alpha, gamma, planning_steps, theta, max_updates,
+        max_steps, within,
     )  # fmt: skip
 
 
-def maze_states(scale: int) -> int:
-    """The open cells of the Dyna maze at ``scale`` (the book's number of states): 47 k².
+def _criteria(value: Any, where: str) -> tuple[float, ...]:
+    """``optimal_within``: one number >= 1, or a list of distinct ones."""
+    values = value if isinstance(value, list) else [value]
+    numbers: list[float] = []
+    for item in values:
+        if isinstance(item, str):
+            with contextlib.suppress(ValueError):
+                item = float(item)
+        if (
+            isinstance(item, bool)
+            or not isinstance(item, (int, float))
+            or not (math.isfinite(item) and item >= 1.0)
+        ):
+            numbers = []
+            break
+        numbers.append(float(item))
+    if not numbers or len(set(numbers)) != len(numbers):
+        raise ConfigError(
+            f"{where}: optimal_within: a number >= 1 (1: a shortest path; 1.2: at most 20% "
+            f"longer), or a list of distinct ones, got {shown_value(value)}."
+        )
+    return tuple(numbers)
 
-    >>> [maze_states(k) for k in (1, 2, 3)]
-    [47, 188, 423]
+
+def maze_states(block: tuple[int, int]) -> int:
+    """The open cells of the Dyna maze whose cells are ``(rows, columns)`` blocks: 47 r c.
+
+    >>> [maze_states((k, k)) for k in (1, 2, 3)], maze_states((16, 8))
+    ([47, 188, 423], 6016)
     """
-    return 47 * scale * scale
+    return 47 * block[0] * block[1]
 
 
-def until_optimal_curves(study: Study, runs: Mapping[tuple[str, int], list[Any]]) -> list[Curve]:
-    """Per method, the mean updates over the seeds at each maze size, with the least and most."""
+@functools.cache
+def shortest_path(block: tuple[int, int]) -> int:
+    """The fewest steps from the start to the goal of the maze of ``block``."""
+    from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
+    from cartpole_q.families.gridworlds.worlds import shortest_path as bfs
+
+    return int(bfs(DynaMazeEnv(block)))
+
+
+def _criterion_text(within: float) -> str:
+    """``shortest path`` or ``within 1.2x``."""
+    return "shortest path" if within == 1.0 else f"within {within:g}x"
+
+
+def until_optimal_curves(
+    study: Study, runs: Mapping[tuple[str, float, tuple[int, int]], list[Any]]
+) -> list[Curve]:
+    """Per method (and criterion): the mean updates over the seeds at each size, least, most."""
     curves = []
-    x = np.array([float(maze_states(k)) for k in study.scales])
-    for method in study.methods:
-        rows = [np.array([float(r.updates) for r in runs[(method, k)]]) for k in study.scales]
-        mean = np.array([float(np.mean(row)) for row in rows])
-        low = np.array([float(np.min(row)) for row in rows])
-        high = np.array([float(np.max(row)) for row in rows])
-        curves.append(Curve(METHOD_LABELS[method], x, mean, low, high))
+    x = np.array([float(maze_states(block)) for block in study.scales])
+    for within in study.optimal_within:
+        for method in study.methods:
+            rows = [
+                np.array([float(r.updates) for r in runs[(method, within, block)]])
+                for block in study.scales
+            ]
+            mean = np.array([float(np.mean(row)) for row in rows])
+            low = np.array([float(np.min(row)) for row in rows])
+            high = np.array([float(np.max(row)) for row in rows])
+            label = METHOD_LABELS[method]
+            if len(study.optimal_within) > 1:
+                label += f" ({_criterion_text(within)})"
+            curves.append(Curve(label, x, mean, low, high))
     return curves
 
 
@@ -405,8 +469,9 @@ def study_runs(study: Study) -> list[dict[str, Cell]]:
         return [{"branching": branching} for branching in study.branching]
     if study.kind == "until_optimal":
         return [
-            {"scale": scale, "method": method, "seed": seed}
-            for scale in study.scales
+            {"rows": rows, "columns": columns, "within": within, "method": method, "seed": seed}
+            for rows, columns in study.scales
+            for within in study.optimal_within
             for method in study.methods
             for seed in study.seeds
         ]
@@ -436,12 +501,13 @@ def run_one(
         from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
         from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
 
-        maze = maze_arrays(DynaMazeEnv(int(key["scale"] or 1)))
+        maze = maze_arrays(DynaMazeEnv((int(key["rows"] or 1), int(key["columns"] or 1))))
         settings = Settings(
             str(key["method"]), study.alpha, study.gamma, study.epsilon, study.planning_steps,
             study.theta, "random", np.iinfo(np.int64).max, study.max_updates,
+            float(key["within"] or 1.0), study.max_steps,
         )  # fmt: skip
-        result = until_optimal(maze, settings, int(key["seed"] or 0))
+        result = until_optimal(maze, settings, int(key["seed"] or 0), should_stop=stop)
         if result is None:
             return None
         return RunRecord(
@@ -451,10 +517,14 @@ def run_one(
     from cartpole_q.engines.trajectory import task_curves
 
     panel = study.panels[int(key["panel"] or 0)]
-    uniform, on_policy = task_curves(
+    curves = task_curves(
         int(key["seed"] or 0), panel.states, study.actions, int(key["branching"] or 1),
         panel.updates, panel.every, study.termination, study.epsilon, study.tolerance,
+        should_stop=stop,
     )  # fmt: skip
+    if curves is None:
+        return None
+    uniform, on_policy = curves
     return RunRecord({}, {"uniform": uniform, "on_policy": on_policy})
 
 
@@ -473,12 +543,15 @@ def study_outcome(
     if study.kind == "until_optimal":
         from cartpole_q.engines.until_optimal import Result
 
-        runs: dict[tuple[str, int], list[Any]] = {}
+        runs: dict[tuple[str, float, tuple[int, int]], list[Any]] = {}
         for key, record in zip(keys, records, strict=True):
             row = record.row
             result = Result(int(row["updates"] or 0), int(row["episodes"] or 0),
                             int(row["steps"] or 0), bool(row["reached"]))  # fmt: skip
-            runs.setdefault((str(key["method"]), int(key["scale"] or 1)), []).append(result)
+            block = (int(key["rows"] or 1), int(key["columns"] or 1))
+            runs.setdefault((str(key["method"]), float(key["within"] or 1.0), block), []).append(
+                result
+            )
         return Outcome([until_optimal_curves(study, runs)], 0.0, 0.0, runs)
     tasks: dict[tuple[int, int], list[RunRecord]] = {}
     for key, record in zip(keys, records, strict=True):
@@ -567,28 +640,36 @@ def _until_optimal_summary(study: Study, outcome: Outcome) -> list[str]:
         f"{study.name}: {len(study.seeds)} runs per point, alpha {study.alpha:g}, gamma "
         f"{study.gamma:g}, epsilon {study.epsilon:g}, {study.planning_steps} planning steps, "
         f"theta {study.theta:g}",
-        "  updates until the greedy path is shortest (mean over runs [least, most]):",
     ]
-    for scale in study.scales:
-        shown = []
-        for method in study.methods:
-            updates = [r.updates for r in outcome.runs[(method, scale)]]
-            missed = sum(not r.reached for r in outcome.runs[(method, scale)])
-            note = f", {missed} not reached" if missed else ""
-            shown.append(
-                f"{METHOD_LABELS[method]} {np.mean(updates):,.0f} [{min(updates):,}, "
-                f"{max(updates):,}{note}]"
-            )
-        ratio = ""
-        if "prioritized_sweeping" in study.methods and "dyna_q" in study.methods:
-            sweeping = np.mean([r.updates for r in outcome.runs[("prioritized_sweeping", scale)]])
-            dyna = np.mean([r.updates for r in outcome.runs[("dyna_q", scale)]])
-            ratio = f"; Dyna-Q / prioritized sweeping {dyna / sweeping:.1f}"
+    both = "prioritized_sweeping" in study.methods and "dyna_q" in study.methods
+    for within in study.optimal_within:
         lines.append(
-            f"  k = {scale} ({maze_states(scale):,} states, shortest path {14 * scale} steps): "
-            + "; ".join(shown)
-            + ratio
+            f"  updates until the greedy path is {'a ' if within == 1.0 else ''}"
+            f"{_criterion_text(within)} (mean over runs [least, most]):"
         )
+        for block in study.scales:
+            shown = []
+            for method in study.methods:
+                found = outcome.runs[(method, within, block)]
+                updates = [r.updates for r in found]
+                missed = sum(not r.reached for r in found)
+                note = f", {missed} not reached: at least" if missed else ""
+                shown.append(
+                    f"{METHOD_LABELS[method]} {np.mean(updates):,.0f} [{min(updates):,}, "
+                    f"{max(updates):,}{note}]"
+                )
+            ratio = ""
+            if both:
+                sweeping = np.mean(
+                    [r.updates for r in outcome.runs[("prioritized_sweeping", within, block)]]
+                )
+                dyna = np.mean([r.updates for r in outcome.runs[("dyna_q", within, block)]])
+                ratio = f"; Dyna-Q / prioritized sweeping {dyna / sweeping:.1f} (book: 5-10)"
+            rows, columns = block
+            lines.append(
+                f"    {rows} x {columns} blocks ({maze_states(block):,} states, shortest path "
+                f"{shortest_path(block)} steps): " + "; ".join(shown) + ratio
+            )
     return lines
 
 
@@ -624,9 +705,15 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
             study.title,
         )
     if study.kind == "until_optimal":
+        styles = [  # curves in criterion-then-method order: a colour per method
+            (index, within != 1.0)
+            for within in study.optimal_within
+            for index, _ in enumerate(study.methods)
+        ]
         return figures.until_optimal_figure(
-            [(c.label, c.x, c.mean, c.low, c.high) for c in outcome.curves[0]], study.title
-        )
+            [(c.label, c.x, c.mean, c.low, c.high) for c in outcome.curves[0]], study.title,
+            styles,
+        )  # fmt: skip
     panels = []
     for panel, curves in zip(study.panels, outcome.curves, strict=True):
         drawn = [
@@ -682,8 +769,9 @@ class UpdatesKind(RunsKind):
             parts = f"{_count(len(spec.branching), 'branching factor')}, {seeds} of problems each"
         elif spec.kind == "until_optimal":
             parts = (
-                f"{_count(len(spec.scales), 'maze size')} x {_count(len(spec.methods), 'method')} "
-                f"x {seeds}"
+                f"{_count(len(spec.scales), 'maze size')} x "
+                f"{_count(len(spec.optimal_within), 'criterion', 'criteria')} x "
+                f"{_count(len(spec.methods), 'method')} x {seeds}"
             )
         else:
             parts = f"{_count(len(spec.panels), 'panel')}' branching factors x {seeds}"
@@ -721,6 +809,6 @@ UPDATES = register_kind(UpdatesKind())
 """the planning-updates kind (registered)"""
 
 
-def _count(n: int, noun: str) -> str:
-    """``1 seed``, ``2,000 seeds``."""
-    return f"{n:,} {noun}{'' if n == 1 else 's'}"
+def _count(n: int, noun: str, plural: str = "") -> str:
+    """``1 seed``, ``2,000 seeds`` (``plural``: when it is not the noun and an s)."""
+    return f"{n:,} {noun if n == 1 else plural or noun + 's'}"

@@ -92,24 +92,35 @@ def trajectory_sampling_figure(
 def until_optimal_figure(
     curves: Sequence[tuple[str, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None]],
     title: str,
+    line_styles: Sequence[tuple[int, bool]] | None = None,
 ) -> DataFigure:
     """Example 8.4's figure: updates until the greedy path is optimal against maze size.
 
-    ``curves`` are ``(label, states, mean, least, most)``; log y axis (as the book's), each
-    point drawn with the range of its runs.
+    ``curves`` are ``(label, states, mean, least, most)``; log axes (as the book's), the
+    sizes ticked, each point drawn with the range of its runs. ``line_styles`` gives each
+    curve ``(colour index, dashed)`` (a colour per method, another criterion dashed); by
+    default each curve has its own colour, solid.
     """
     figure = DataFigure(figsize=(8.0, 5.0), dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
-    for (label, x, mean, low, high), colour in zip(curves, colour_cycle(len(curves)), strict=True):
-        xs = x.tolist()
-        axes.plot(xs, mean, color=colour, marker="o", linewidth=1.4, label=label)
+    styles = line_styles or [(index, False) for index in range(len(curves))]
+    palette = colour_cycle(max(index for index, _ in styles) + 1 if styles else 0)
+    for (label, x, mean, low, high), (index, dashed) in zip(curves, styles, strict=True):
+        colour, xs = palette[index], x.tolist()
+        axes.plot(xs, mean, color=colour, marker="o", linewidth=1.4, label=label,
+                  linestyle="--" if dashed else "-")  # fmt: skip
         if low is not None and high is not None:
             axes.fill_between(xs, low, high, color=colour, alpha=0.15, linewidth=0)
             record.line(label, xs, mean.tolist(), low.tolist(), high.tolist())
         else:
             record.line(label, xs, mean.tolist())
     axes.set_yscale("log")
+    # a log size axis, ticked at the sizes drawn (the book's doubling 47 ... 6,016)
+    sizes = sorted({float(value) for _, x, _, _, _ in curves for value in x})
+    axes.set_xscale("log", base=2)
+    axes.set_xticks(sizes, [f"{size:,.0f}" for size in sizes])
+    axes.minorticks_off()
     axes.set_xlabel("Gridworld size (#states)")
     axes.set_ylabel("Updates until optimal solution")
     axes.legend(loc="upper left", fontsize="small")

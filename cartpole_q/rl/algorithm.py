@@ -201,6 +201,10 @@ class Algorithm:
     """the memory arrays (by index) whose first axis grows with ``train.episodes`` (a batch
     of every transition seen): a run extended past its episodes resumes from a checkpoint
     whose arrays are shorter, copied into the start of the longer ones"""
+    older_memory: Callable[[tuple[np.ndarray, ...]], tuple[np.ndarray, ...]] | None = None
+    """rebuild a memory an earlier version wrote with fewer arrays (a checkpoint from before
+    the algorithm kept more), so that ``train --resume`` continues it; ``None``: a memory of
+    another layout is refused. Raises ``ValueError`` for a memory it cannot rebuild"""
     key: str = field(default="", compare=False)
     """the name and a digest of the module's source: compiled code is cached under it, so
     an edited algorithm is compiled again (set when registered)"""

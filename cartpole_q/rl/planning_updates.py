@@ -182,6 +182,23 @@ def greedy_value(
             return float(values[0])
 
 
+TRAJECTORY_CARRY = 2
+NEXT_UPDATE, STATE = range(TRAJECTORY_CARRY)
+"""a run's state between chunks of :func:`trajectory_run` (int64 ``[TRAJECTORY_CARRY]``): the
+number of the next update (0: not started, the start state not valued yet), and the state
+of the on-policy simulation"""
+
+
+def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
+    """A run's tables, kept across its chunks: ``Q`` (zeros), the values, their next sweep, the policy."""
+    return (
+        np.zeros((states, actions)),
+        np.zeros(states),
+        np.zeros(states),
+        np.zeros(states, np.int64),
+    )
+
+
 @compilable
 def trajectory_run(
     next_states: np.ndarray,
@@ -193,7 +210,10 @@ def trajectory_run(
     tolerance: float,
     rng: Rng,
     out: np.ndarray,
-) -> None:
+    tables: tuple[np.ndarray, ...],
+    carry: np.ndarray,
+    budget: int,
+) -> bool:
     """One task's curve: ``out[i]`` is the start state's greedy value after ``i * every`` updates.
 
     ``Q`` starts at 0. Update ``k = 1, 2, ...``: uniform: the pair ``(k - 1) mod (S * A)``
@@ -202,17 +222,23 @@ def trajectory_run(
     exploring, else the lowest greedy action), then, after the update, ``rng.random() <
     termination`` ends the episode (the next starts at state 0), else ``s =
     next_states[s, a, rng.integers(0, b)]``.
+
+    A call goes on from ``carry`` (zeros: the start) with ``tables``
+    (:func:`trajectory_tables`) for about ``budget`` units of work (an update counts ``b``,
+    a valuation ``S * b``, one sweep's worth; ``budget >= 1``) and returns whether the
+    curve is complete: the run in chunks is the run in one call, draw for draw.
     """
-    states, actions, _ = next_states.shape
-    q = np.zeros((states, actions))
-    values = np.zeros(states)
-    fresh = np.zeros(states)
-    policy = np.zeros(states, np.int64)
+    q, values, fresh, policy = tables
+    states, actions, branching = next_states.shape
     continuing = 1.0 - termination
-    out[0] = greedy_value(q, next_states, rewards, continuing, tolerance, values, fresh, policy)
-    branching = next_states.shape[2]
-    state = 0
-    for update in range(1, (out.shape[0] - 1) * every + 1):
+    if carry[NEXT_UPDATE] == 0:
+        out[0] = greedy_value(q, next_states, rewards, continuing, tolerance, values, fresh, policy)
+        carry[NEXT_UPDATE] = 1
+    state = carry[STATE]
+    last = (out.shape[0] - 1) * every
+    update = carry[NEXT_UPDATE]
+    work = 0
+    while update <= last and work < budget:
         if on_policy:
             if epsilon >= 1.0 or (epsilon > 0.0 and rng.random() < epsilon):
                 action = int(rng.integers(0, actions))
@@ -226,7 +252,12 @@ def trajectory_run(
         else:
             pair = (update - 1) % (states * actions)
             expected_update(q, next_states, rewards, pair // actions, pair % actions, continuing)
+        work += branching
         if update % every == 0:
             out[update // every] = greedy_value(
                 q, next_states, rewards, continuing, tolerance, values, fresh, policy
             )
+            work += states * branching
+        update += 1
+    carry[NEXT_UPDATE], carry[STATE] = update, state
+    return bool(update > last)

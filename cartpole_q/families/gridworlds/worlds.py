@@ -218,18 +218,59 @@ class StochasticWindyGridworldEnv(GridWorld):
         )  # fmt: skip
 
 
-def scaled_cells(cells: Iterable[Cell], scale: int) -> frozenset[Cell]:
-    """Every cell of the ``scale`` x ``scale`` blocks that replace ``cells``.
+Block = tuple[int, int]
+"""``(rows, columns)``: the cells that replace one cell of a scaled maze"""
+
+
+def scaled_cells(cells: Iterable[Cell], scale: int | Block) -> frozenset[Cell]:
+    """Every cell of the blocks that replace ``cells``: ``scale`` x ``scale``, or ``(rows, columns)``.
 
     >>> sorted(scaled_cells({(0, 1)}, 2))
     [(0, 2), (0, 3), (1, 2), (1, 3)]
+    >>> sorted(scaled_cells({(0, 1)}, (2, 1)))
+    [(0, 1), (1, 1)]
     """
+    down_by, across_by = (scale, scale) if isinstance(scale, int) else scale
     return frozenset(
-        (row * scale + down, column * scale + across)
+        (row * down_by + down, column * across_by + across)
         for row, column in cells
-        for down in range(scale)
-        for across in range(scale)
+        for down in range(down_by)
+        for across in range(across_by)
     )
+
+
+def maze_block(scale: Any) -> Block:
+    """A maze scale as ``(rows, columns)``: a whole number ``k >= 1`` is ``(k, k)``, a pair is itself.
+
+    Raises:
+        ValueError: ``scale`` is neither.
+    """
+
+    def whole(value: Any) -> bool:
+        return isinstance(value, int) and not isinstance(value, bool) and value >= 1
+
+    if whole(scale):
+        return scale, scale
+    if isinstance(scale, list | tuple) and len(scale) == 2 and all(whole(v) for v in scale):
+        return scale[0], scale[1]
+    raise ValueError(
+        f"`scale` must be a whole number >= 1 or a pair of them [rows, columns], got {scale!r}"
+    )
+
+
+def doubled_block(doublings: int) -> Block:
+    """The block of the Dyna maze with ``47 * 2**doublings`` open cells, the book's sizes.
+
+    Each doubling doubles the block's rows, then its columns, in turn (the rows first: the
+    6 x 9 maze stays closest to its shape), so the sizes are Example 8.4's axis: 47, 94,
+    188 (the book: 186), 376, 752, 1,504, 3,008, 6,016.
+
+    >>> [doubled_block(j) for j in range(5)]
+    [(1, 1), (2, 1), (2, 2), (4, 2), (4, 4)]
+    """
+    if isinstance(doublings, bool) or not isinstance(doublings, int) or doublings < 0:
+        raise ValueError(f"`doublings` must be a whole number >= 0, got {doublings!r}")
+    return 2 ** ((doublings + 1) // 2), 2 ** (doublings // 2)
 
 
 class DynaMazeEnv(GridWorld):
@@ -243,18 +284,20 @@ class DynaMazeEnv(GridWorld):
             of cells (a ``6 scale`` x ``9 scale`` grid, each obstacle a block of walls, so
             ``47 scale²`` open cells); the start and the goal are the top-left cells of
             their blocks, ``(2 scale, 0)`` and ``(0, 8 scale)`` (as Shangtong Zhang's
-            ``extend_maze``). 1: the maze of Example 8.1.
+            ``extend_maze``). 1: the maze of Example 8.1. A pair ``[rows, columns]`` makes
+            blocks of that many rows and columns (``47 rows columns`` open cells; the
+            doubling sizes of the book's axis: :func:`doubled_block`).
     """
 
-    def __init__(self, scale: int = 1) -> None:
-        if isinstance(scale, bool) or not isinstance(scale, int) or scale < 1:
-            raise ValueError(f"`scale` must be a whole number >= 1, got {scale!r}")
+    def __init__(self, scale: int | Block = 1) -> None:
         self.scale = scale
+        self.block = maze_block(scale)
+        down_by, across_by = self.block
         start, goal = DYNA_MAZE_START, MAZE_GOAL
         super().__init__(
-            MAZE_ROWS * scale, MAZE_COLUMNS * scale, (start[0] * scale, start[1] * scale),
-            (goal[0] * scale, goal[1] * scale), COMPASS_MOVES, step_reward=0.0,
-            goal_reward=1.0, walls=scaled_cells(DYNA_MAZE_WALLS, scale),
+            MAZE_ROWS * down_by, MAZE_COLUMNS * across_by, (start[0] * down_by, start[1] * across_by),
+            (goal[0] * down_by, goal[1] * across_by), COMPASS_MOVES, step_reward=0.0,
+            goal_reward=1.0, walls=scaled_cells(DYNA_MAZE_WALLS, self.block),
         )  # fmt: skip
 
     def open_cells(self) -> int:
