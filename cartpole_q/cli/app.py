@@ -16,7 +16,7 @@ __all__ = ["app", "main"]
 
 COMMAND_MODULES = tuple(
     importlib.import_module(f"cartpole_q.cli.{name}")
-    for name in ("train", "runs", "studies", "bandits", "planning", "updates")
+    for name in ("train", "runs", "studies", "schema", "bandits", "planning", "updates")
 )
 """the modules whose commands are registered on :data:`app`, in the order ``--help`` lists
 them: training and its runs first, then the studies, then the studies' older aliases"""
