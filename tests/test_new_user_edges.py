@@ -266,3 +266,20 @@ def test_example_6_2s_values_figure_names_the_states_a_to_e(tmp_path: Path) -> N
     assert state_labels(walk) == {1: "A", 2: "B", 3: "C", 4: "D", 5: "E"}
     nineteen = load_config({"env": {"id": "cartpole_q/RandomWalk-v0"}}).env
     assert state_labels(nineteen) == {}
+
+
+def test_help_says_what_is_there() -> None:
+    """Issue 47 item 11: help that omitted a metric, a figure kind, or named a missing option."""
+    import re
+
+    def text(*args: str) -> str:
+        result = invoke(*args, "--help")
+        assert result.exit_code == 0
+        return re.sub(r"[\s│]+", " ", result.output)  # Typer's box, folded
+
+    assert "rms_error" in text("plot")
+    updates = text("updates")
+    assert "until_optimal" in updates and "trajectory_sampling" in updates
+    assert "--backend" not in text("compile")
+    commands = re.findall(r"^│ (\w+) ", invoke("--help").output, re.MULTILINE)
+    assert commands[0] == "train" and commands.index("study") < commands.index("bandit")

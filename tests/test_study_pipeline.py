@@ -246,3 +246,48 @@ def test_studies_of_every_kind_run_on_a_local_ray_cluster_to_the_same_bytes(
             assert _files(directory) == _files(local[name]), name
     finally:
         ray.shutdown()
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_inside_a_long_maze_run_ends_the_study_within_two_seconds(
+    tmp_path: Path, signum: int
+) -> None:
+    """Issue 47 item 1: Ctrl-C and SIGTERM did nothing during a run of Example 8.4.
+
+    One prioritized-sweeping run on the 6,016-state maze lasts seconds inside compiled
+    code; the signal comes while it runs, and the study ends within two seconds (exit 130),
+    saying how to go on; resumed, it ends as a study run in one go.
+    """
+    from cartpole_q.engines.until_optimal import Settings, maze_arrays, until_optimal
+    from cartpole_q.families.gridworlds.worlds import DynaMazeEnv
+
+    tiny = maze_arrays(DynaMazeEnv(1))  # the loop compiled (or loaded) here: the run starts at once
+    until_optimal(
+        tiny, Settings("prioritized_sweeping", 0.5, 0.95, 0.1, 5, 1e-5, "random", 10**9, 10**6), 0
+    )
+    path = write_yaml(tmp_path / "big.yaml", {
+        "kind": "updates", "name": "big", "seeds": "0", "scales": [[16, 8]], "theta": 0.00001,
+        "methods": ["prioritized_sweeping"], "figure": {"kind": "until_optimal"},
+    })  # fmt: skip
+    out = tmp_path / "out"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "cartpole_q", "study", str(path), "--out", str(out),
+         "--workers", "1", "-q"],
+        env={**os.environ, "PYTHONPATH": str(REPO)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    deadline = time.monotonic() + 60
+    while not (out / studydir.STUDY_FILE).is_file():
+        assert process.poll() is None and time.monotonic() < deadline
+        time.sleep(0.02)
+    time.sleep(1.0)  # inside the run (about 3 s on this machine)
+    process.send_signal(signum)
+    sent = time.monotonic()
+    _, stderr = process.communicate(timeout=30)
+    assert process.returncode == 130, stderr
+    assert time.monotonic() - sent < 2.0, time.monotonic() - sent
+    assert f"finish it with `cartpole-q study --resume {out}`".encode() in stderr
+    assert b"Traceback" not in stderr
+    assert invoke("study", "--resume", out, "-q").exit_code == 0
+    assert invoke("study", path, "--out", tmp_path / "whole", "-q").exit_code == 0
+    assert _files(out) == _files(tmp_path / "whole")
