@@ -283,3 +283,22 @@ def test_help_says_what_is_there() -> None:
     assert "--backend" not in text("compile")
     commands = re.findall(r"^│ (\w+) ", invoke("--help").output, re.MULTILINE)
     assert commands[0] == "train" and commands.index("study") < commands.index("bandit")
+
+
+def test_optimum_solves_a_continuing_world_dp_solves(tmp_path: Path) -> None:
+    """Issue 47 item 9: optimum refused cartpole_q/CarRental-v0 although dp solves it."""
+    import json
+
+    result = invoke("optimum", "cartpole_q/CarRental-v0")
+    assert_refused(result, "a continuing task", "give --gamma below 1")
+    result = invoke("optimum", "cartpole_q/CarRental-v0", "--gamma", "0.9", "--json")
+    assert result.exit_code == 0, result.output
+    found = json.loads(result.stdout)
+    # policy iteration (Figure 4.2's study) ends at the optimal policy: the same values
+    assert (
+        invoke("study", BOOK / "fig4_2_car_rental.yaml", "--out", tmp_path / "s", "-q").exit_code
+        == 0
+    )
+    values = np.load(tmp_path / "s" / "runs" / "0000.npz")["values"][-1]
+    assert found["optimum"]["return"] == pytest.approx(float(np.mean(values)), abs=1e-6)
+    assert len(found["policy"]) == 441

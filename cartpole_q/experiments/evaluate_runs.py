@@ -338,11 +338,44 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
     env_facts(config)  # an unknown id or argument: a config error naming it
     exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
     if isinstance(exact, str):
-        raise UserError(
-            f"{env_id}: no exact optimum: {exact}. It needs a transition table "
-            "(env.unwrapped.P: FrozenLake, Taxi, CliffWalking) or Blackjack's rules."
-        )
+        continuing = _continuing_optimum(config, gamma)
+        if continuing is None:
+            raise UserError(
+                f"{env_id}: no exact optimum: {exact}. It needs a transition table "
+                "(env.unwrapped.P: FrozenLake, Taxi, CliffWalking), a dense model (Jack's car "
+                "rental) or Blackjack's rules."
+            )
+        exact = continuing
     return Optimum(env_id, dict(config.env.kwargs), exact, grid_layout(config.env))
+
+
+def _continuing_optimum(config: Any, gamma: float | None) -> ExactReport | None:
+    """A world with a dense model and no end (Jack's car rental): its discounted optimum.
+
+    Value iteration on the model (:func:`~cartpole_q.rl.dynamic_programming.value_iteration_sweeps`,
+    to 1e-10), the optimum the mean of ``v*`` over the states, an episode's start being
+    drawn uniformly; ``None`` for a world without a dense model.
+
+    Raises:
+        UserError: no ``gamma`` (a continuing task's undiscounted return is not finite).
+    """
+    from cartpole_q.envs.models import planning_model
+    from cartpole_q.rl import dynamic_programming as dp
+
+    world = planning_model(config.env)
+    if isinstance(world, str) or not world.source.endswith("dense_model()"):
+        return None
+    if gamma is None:
+        raise UserError(
+            f"{config.env.id}: a continuing task (no end, no time limit): its undiscounted "
+            "return is not finite; give --gamma below 1, such as --gamma 0.9 (the book's)."
+        )
+    found = dp.value_iteration_sweeps(world.model, gamma)
+    values = found.values[-1]
+    greedy = dp.greedy(world.model.q_values(values, gamma), world.model.allowed, 1e-9)
+    start = float(np.mean(values))
+    note = f"expected discounted return (gamma {gamma:g}), a continuing task from a uniformly drawn state"
+    return ExactReport(note, 0, gamma, start, None, None, None, tuple(int(a) for a in greedy))
 
 
 @dataclass(frozen=True)
