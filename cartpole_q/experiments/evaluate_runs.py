@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from cartpole_q.config import COMMAND_LINE, load_config
+from cartpole_q.config import COMMAND_LINE, Config, load_config
 from cartpole_q.envs.models import GridLayout, grid_layout
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import (
@@ -349,7 +349,7 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
     return Optimum(env_id, dict(config.env.kwargs), exact, grid_layout(config.env))
 
 
-def _continuing_optimum(config: Any, gamma: float | None) -> ExactReport | None:
+def _continuing_optimum(config: Config, gamma: float | None) -> ExactReport | None:
     """A world with a dense model and no end (Jack's car rental): its discounted optimum.
 
     Value iteration on the model (:func:`~cartpole_q.rl.dynamic_programming.value_iteration_sweeps`,
