@@ -573,7 +573,7 @@ def test_a_runs_epsilon_greedy_policy_plays_its_probabilities(tmp_path: Path) ->
     [
         (["agent.policy=greedy"], "agent.policy_run: agent.policy greedy evaluates a control run"),
         (["agent.policy=greedy", "agent.policy_run=PREDICTION"], "is a prediction run"),
-        (["agent.policy=greedy", "agent.policy_run=NOWHERE"], "has no q_table.npy"),
+        (["agent.policy=greedy", "agent.policy_run=NOWHERE"], "does not exist (moved or removed?)"),
         (["agent.policy_run=CONTROL"], "is read only with agent.policy greedy or epsilon_greedy"),
         (
             ["agent.policy=greedy", "agent.policy_run=CONTROL", "env.kwargs.map_name=8x8"],
@@ -674,7 +674,7 @@ def test_a_runs_policy_is_read_from_an_absolute_path_and_only_when_training(
     assert config.agent.params["policy_run"] == str(tmp_path / "gone")
     again = load_config(overrides=config.to_dict())
     assert again.agent.params["policy_run"] == str(tmp_path / "gone")
-    with pytest.raises(ConfigError, match=r"has no q_table\.npy"):
+    with pytest.raises(ConfigError, match=r"does not exist \(moved or removed\?\)"):
         prepare(config, "test")
 
 

@@ -24,7 +24,7 @@ from cartpole_q.rl.algorithms import prioritized_sweeping as ps
 from cartpole_q.rl.algorithms.prioritized_sweeping import (
     ABSENT,
     HEAP,
-    HEAP_AT,
+    HEAP_PLACES,
     HEAP_SIZE,
     LEADING_FIRST,
     LEADING_NEXT,
@@ -190,7 +190,7 @@ def test_a_memory_saved_before_the_heap_is_rebuilt_and_goes_on_as_the_whole_one(
     played(rebuilt, again, 1, 60)
     assert again.tobytes() == q.tobytes()
     assert rebuilt[QUEUE].tobytes() == memory[QUEUE].tobytes()
-    assert (rebuilt[HEAP_AT] >= 0).sum() == (memory[HEAP_AT] >= 0).sum()
+    assert (rebuilt[HEAP_PLACES] >= 0).sum() == (memory[HEAP_PLACES] >= 0).sum()
 
 
 def test_a_memory_of_another_shape_is_not_taken_for_an_older_one() -> None:

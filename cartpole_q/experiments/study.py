@@ -418,8 +418,8 @@ class RunHandle:
     """told the items (of the kind's units) the run has done so far"""
 
 
-_READ: dict[str, Any] = {}
-"""the studies this process has read, by their ``study.yaml`` digest"""
+_READ: dict[tuple[str, str], Any] = {}
+"""the studies this process has read, by their ``study.yaml`` digest and file"""
 
 
 def run_task(
@@ -435,9 +435,9 @@ def run_task(
     asks to stop (the run in flight returns ``None``).
     """
     digest, raw, where, stem = started
-    if digest not in _READ:
-        _READ[digest] = kind.read(study_of(raw, where, stem, Path(where).parent))
-    spec = _READ[digest]
+    if (digest, where) not in _READ:  # (the file too: its messages name it)
+        _READ[digest, where] = kind.read(study_of(raw, where, stem, Path(where).parent))
+    spec = _READ[digest, where]
     reporter = handle.reporter()
     for index, key in items:
         if handle.should_stop():

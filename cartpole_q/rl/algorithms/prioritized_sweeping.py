@@ -69,7 +69,7 @@ NEXT_STATES, REWARDS, TERMINALS = 0, 1, 2
 """the model's arrays this module reads (:mod:`cartpole_q.rl.model`)"""
 QUEUE, UPDATES = 7, 8
 """the memory's queue (priorities per pair) and its count of updates made"""
-HEAP, HEAP_AT, HEAP_SIZE = 9, 10, 11
+HEAP, HEAP_PLACES, HEAP_SIZE = 9, 10, 11
 """the queue's heap: the queued pairs in heap order, each pair's place in it (-1: not
 queued), and how many are queued"""
 LEADING_FIRST, LEADING_NEXT, LEADING_PREVIOUS = 12, 13, 14
@@ -169,7 +169,7 @@ def take_first(
 @compilable
 def queue_of(memory: Memory) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The queue's arrays in a memory, as :func:`queue` and :func:`take_first` take them."""
-    return memory[QUEUE], memory[HEAP], memory[HEAP_AT], memory[HEAP_SIZE]
+    return memory[QUEUE], memory[HEAP], memory[HEAP_PLACES], memory[HEAP_SIZE]
 
 
 @compilable
@@ -300,7 +300,7 @@ def memory_from_older(saved: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     queued = np.flatnonzero(priorities != ABSENT)
     in_order = queued[np.lexsort((queued, -priorities[queued]))]
     memory[HEAP][: len(in_order)] = in_order
-    memory[HEAP_AT][in_order] = np.arange(len(in_order))
+    memory[HEAP_PLACES][in_order] = np.arange(len(in_order))
     memory[HEAP_SIZE][0] = len(in_order)
     next_states = memory[NEXT_STATES]
     tried = np.flatnonzero(next_states >= 0)
