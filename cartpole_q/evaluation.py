@@ -347,7 +347,7 @@ def exact_report(
     Returns:
         The report, or a sentence saying why the environment has no exact model.
     """
-    from cartpole_q.rl.value_iteration import policy_horizon_values, policy_values
+    from cartpole_q.rl.solvers import policy_horizon_values, policy_values
 
     gamma = config.agent.gamma if gamma is None else gamma
     found = _model(config.env.id, _frozen(config.env.kwargs))
@@ -396,7 +396,7 @@ def _model(env_id: str, kwargs_json: str) -> tuple[Any, str] | str:
 def _optimum(
     env_id: str, kwargs_json: str, gamma: float
 ) -> tuple[float, float | None, tuple[int, ...]]:
-    from cartpole_q.rl.value_iteration import finite_horizon, value_iteration
+    from cartpole_q.rl.solvers import finite_horizon, value_iteration
 
     found = _model(env_id, kwargs_json)
     assert not isinstance(found, str)

@@ -26,7 +26,7 @@ from cartpole_q.envs.models import EnvModel, env_model
 from cartpole_q.envs.registry import twin_settings
 from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.families.tables import twin as transition_table
-from cartpole_q.rl.value_iteration import on_policy_distribution, reachable_states
+from cartpole_q.rl.solvers import on_policy_distribution, reachable_states
 from cartpole_q.store import rundir
 from cartpole_q.training import train
 from tests.conftest import invoke, write_yaml

@@ -23,7 +23,8 @@ from cartpole_q.config import load_config
 from cartpole_q.envs.models import PlanningModel, planning_model
 from cartpole_q.families.planning import WORLDS as PLANNING_WORLDS
 from cartpole_q.figures import book_round
-from cartpole_q.rl import dynamic_programming as dp
+from cartpole_q.rl import solvers as dp
+from cartpole_q.rl.mdp import FiniteMDP
 from tests.conftest import REPO, invoke, write_yaml
 
 BOOK = REPO / "examples" / "book"
@@ -36,19 +37,19 @@ def _world(env_id: str, **kwargs: Any) -> PlanningModel:
 
 
 @pytest.fixture(scope="module")
-def small_grid() -> dp.DenseModel:
+def small_grid() -> FiniteMDP:
     return _world("cartpole_q/SmallGridworld-v0").model
 
 
 @pytest.fixture(scope="module")
-def grid() -> dp.DenseModel:
+def grid() -> FiniteMDP:
     return _world("cartpole_q/Gridworld-v0").model
 
 
 # -- Figure 4.1: the 4x4 gridworld ----------------------------------------------------------
 
 
-def test_fig_4_1_first_sweeps_are_the_books_synchronous_ones(small_grid: dp.DenseModel) -> None:
+def test_fig_4_1_first_sweeps_are_the_books_synchronous_ones(small_grid: FiniteMDP) -> None:
     sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0)
     values = sweeps.values.reshape(-1, 4, 4)
     assert values[0].tolist() == np.zeros((4, 4)).tolist()
@@ -70,28 +71,28 @@ def test_fig_4_1_first_sweeps_are_the_books_synchronous_ones(small_grid: dp.Dens
     ]  # fmt: skip
 
 
-def test_in_place_sweeps_are_not_the_books_figure_4_1(small_grid: dp.DenseModel) -> None:
+def test_in_place_sweeps_are_not_the_books_figure_4_1(small_grid: FiniteMDP) -> None:
     sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0, order="in_place")
     assert sweeps.values[1][:4].tolist() == [0.0, -1.0, -1.25, -1.3125]
     assert sweeps.values[2][1] == -1.9375  # the book's synchronous -1.75 (printed -1.7)
     np.testing.assert_allclose(sweeps.values[-1][[1, 5, 2, 3]], [-14, -18, -20, -22], atol=1e-8)
 
 
-def test_fig_4_1_k_infinity_is_the_books_exact_values(small_grid: dp.DenseModel) -> None:
+def test_fig_4_1_k_infinity_is_the_books_exact_values(small_grid: FiniteMDP) -> None:
     sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0, tolerance=1e-12)
     book = [[0, -14, -20, -22], [-14, -18, -20, -20], [-20, -20, -18, -14], [-22, -20, -14, 0]]
     np.testing.assert_allclose(sweeps.values[-1].reshape(4, 4), book, atol=1e-9)
     assert sweeps.changes[-1] < 1e-12 <= sweeps.changes[-2]
 
 
-def test_fig_4_1_greedy_policy_at_k_1_and_the_tie_rule(small_grid: dp.DenseModel) -> None:
+def test_fig_4_1_greedy_policy_at_k_1_and_the_tie_rule(small_grid: FiniteMDP) -> None:
     sweeps = dp.evaluate_sweeps(small_grid, dp.uniform_policy(small_grid), 1.0)
-    tied = dp.tied_best(small_grid.q_values(sweeps.values[1], 1.0), small_grid.allowed, 1e-9)
+    tied = dp.tied_best(small_grid.backup(sweeps.values[1], 1.0), small_grid.allowed, 1e-9)
     up, down, left, right = range(4)
     assert np.flatnonzero(tied[1]).tolist() == [left]  # next to the top-left corner
     assert np.flatnonzero(tied[14]).tolist() == [right]
     assert tied[5].all()  # all four tie in the middle
-    assert dp.greedy(small_grid.q_values(sweeps.values[1], 1.0), small_grid.allowed)[5] == up
+    assert dp.greedy(small_grid.backup(sweeps.values[1], 1.0), small_grid.allowed)[5] == up
     assert np.flatnonzero(tied[11]).tolist() == [down]
 
 
@@ -104,9 +105,9 @@ def test_book_round_rounds_halves_upwards_as_the_book_prints() -> None:
 # -- Figures 3.2 and 3.5: the 5x5 gridworld -------------------------------------------------
 
 
-def test_fig_3_2_random_policy_values(grid: dp.DenseModel) -> None:
+def test_fig_3_2_random_policy_values(grid: FiniteMDP) -> None:
     values = dp.evaluate_sweeps(grid, dp.uniform_policy(grid), 0.9, tolerance=1e-12).values[-1]
-    exact = dp.policy_values_stochastic(grid, dp.uniform_policy(grid), 0.9)
+    exact = dp.evaluate_policy(grid, dp.uniform_policy(grid), 0.9)
     np.testing.assert_allclose(values, exact, atol=1e-10)
     printed = [book_round(float(v), 1) for v in values]
     assert printed[1] == 8.8 and printed[3] == 5.3  # A and B
@@ -114,7 +115,7 @@ def test_fig_3_2_random_policy_values(grid: dp.DenseModel) -> None:
     assert printed[20:] == [-1.9, -1.3, -1.2, -1.4, -2.0]
 
 
-def test_fig_3_5_optimal_values_and_policy(grid: dp.DenseModel) -> None:
+def test_fig_3_5_optimal_values_and_policy(grid: FiniteMDP) -> None:
     sweeps = dp.value_iteration_sweeps(grid, 0.9, tolerance=1e-12)
     values = sweeps.values[-1]
     assert book_round(float(values[1]), 1) == 24.4  # v*(A)
@@ -122,7 +123,7 @@ def test_fig_3_5_optimal_values_and_policy(grid: dp.DenseModel) -> None:
     assert [book_round(float(v), 1) for v in values[20:]] == [14.4, 16.0, 14.4, 13.0, 11.7]
     # v*(A) exactly: 10 + 0.9^5 v*(A) (A -> A' then four steps up back to A).
     assert values[1] == pytest.approx(10 / (1 - 0.9**5), abs=1e-9)
-    tied = dp.tied_best(grid.q_values(values, 0.9), grid.allowed, 1e-9)
+    tied = dp.tied_best(grid.backup(values, 0.9), grid.allowed, 1e-9)
     up, _down, left, right = range(4)
     assert np.flatnonzero(tied[0]).tolist() == [right]
     assert np.flatnonzero(tied[24]).tolist() == [up, left]
@@ -133,7 +134,7 @@ def test_fig_3_5_optimal_values_and_policy(grid: dp.DenseModel) -> None:
 
 
 @st.composite
-def small_mdps(draw: Any) -> dp.DenseModel:
+def small_mdps(draw: Any) -> FiniteMDP:
     states = draw(st.integers(1, 5))
     actions = draw(st.integers(1, 3))
     seed = draw(st.integers(0, 2**32 - 1))
@@ -142,31 +143,31 @@ def small_mdps(draw: Any) -> dp.DenseModel:
     reward = rng.normal(size=(states, actions)).round(3)
     allowed = rng.random((states, actions)) < 0.7
     allowed[np.arange(states), rng.integers(actions, size=states)] = True
-    return dp.DenseModel(transition, reward, allowed)
+    return FiniteMDP.from_dense(transition, reward, allowed)
 
 
 @given(small_mdps(), st.floats(0.0, 0.95))
-def test_policy_evaluation_equals_the_linear_solve(model: dp.DenseModel, gamma: float) -> None:
+def test_policy_evaluation_equals_the_linear_solve(model: FiniteMDP, gamma: float) -> None:
     pi = dp.uniform_policy(model)
     for order in dp.SWEEP_ORDERS:
         swept = dp.evaluate_sweeps(model, pi, gamma, tolerance=1e-12, order=order).values[-1]
-        exact = dp.policy_values_stochastic(model, pi, gamma)
+        exact = dp.evaluate_policy(model, pi, gamma)
         np.testing.assert_allclose(swept, exact, atol=1e-9)
 
 
 @given(small_mdps(), st.floats(0.0, 0.95))
 def test_value_iteration_satisfies_the_bellman_optimality_equation(
-    model: dp.DenseModel, gamma: float
+    model: FiniteMDP, gamma: float
 ) -> None:
     for order in dp.SWEEP_ORDERS:
         values = dp.value_iteration_sweeps(model, gamma, tolerance=1e-13, order=order).values[-1]
-        q = np.where(model.allowed, model.q_values(values, gamma), -np.inf)
+        q = np.where(model.allowed, model.backup(values, gamma), -np.inf)
         np.testing.assert_allclose(values, q.max(axis=1), atol=1e-9)
         # Its greedy policy's exact values are the optimum: policy iteration agrees.
-        greedy = dp.greedy(model.q_values(values, gamma), model.allowed)
+        greedy = dp.greedy(model.backup(values, gamma), model.allowed)
         assert model.allowed[np.arange(model.n_states), greedy].all()
         # (a tie within 1e-9 may cost up to 1e-9 / (1 - gamma) of value)
-        np.testing.assert_allclose(dp.policy_values(model, greedy, gamma), values, atol=1e-7)
+        np.testing.assert_allclose(dp.policy_values(model, greedy, gamma).values, values, atol=1e-7)
     start = np.argmax(model.allowed, axis=1)
     found = dp.policy_iteration(model, gamma, start)
     np.testing.assert_allclose(found.values[-1], values, atol=1e-7)
@@ -176,12 +177,12 @@ def test_policy_iteration_stops_when_the_old_action_is_still_among_the_best() ->
     # Two actions of equal value everywhere: the start policy (action 1) is kept.
     transition = np.zeros((2, 2, 2))
     transition[:, :, 0] = 0.5
-    model = dp.DenseModel(transition, np.ones((2, 2)))
+    model = FiniteMDP.from_dense(transition, np.ones((2, 2)))
     found = dp.policy_iteration(model, 0.5, np.array([1, 1]))
     assert found.improvements == 0 and found.policies.tolist() == [[1, 1]]
 
 
-def test_bad_arguments_are_refused(small_grid: dp.DenseModel) -> None:
+def test_bad_arguments_are_refused(small_grid: FiniteMDP) -> None:
     pi = dp.uniform_policy(small_grid)
     with pytest.raises(ValueError, match="gamma"):
         dp.evaluate_sweeps(small_grid, pi, 1.5)
@@ -204,8 +205,10 @@ def test_each_planning_world_is_registered_and_passes_check_env(world: Any) -> N
         check_env(env.unwrapped)
     assert env.spec is not None and env.spec.max_episode_steps == world.max_episode_steps
     found = _world(world.id)
-    # Every row of the model sums to at most 1 (the rest ends the episode).
-    assert np.all(found.model.transition.sum(axis=2) <= 1.0 + 1e-12)
+    # Every (state, action)'s outcomes sum to 1 (what ends the episode included).
+    model = found.model
+    totals = np.bincount(model.state * model.n_actions + model.action, weights=model.probability)
+    np.testing.assert_allclose(totals, 1.0, atol=1e-12)
 
 
 def test_the_small_gridworld_plays_its_table() -> None:
@@ -335,14 +338,14 @@ def test_fig_4_3_gambler_v_star_50_and_the_books_policy_shape() -> None:
         0.64, abs=1e-12
     )
     assert values[0] == values[100] == 0.0  # the ends; +1 is the reward of reaching 100
-    stakes = dp.greedy(model.q_values(values, 1.0), model.allowed, 1e-9)
+    stakes = dp.greedy(model.backup(values, 1.0), model.allowed, 1e-9)
     # The book's figure (and Zhang's rounded argmax): spikes at 25, 50, 75; between them
     # triangles rising by one a capital from 1 to 12 and falling back to 1.
     triangle = [*range(1, 13), *range(12, 0, -1)]
     assert stakes[1:100].tolist() == [*triangle, 25, *triangle, 50, *triangle, 25, *triangle]
     # Zhang's rule, state for state.
     for capital in range(1, 100):
-        returns = model.q_values(values, 1.0)[capital, : min(capital, 100 - capital) + 1]
+        returns = model.backup(values, 1.0)[capital, : min(capital, 100 - capital) + 1]
         assert stakes[capital] == np.argmax(np.round(returns[1:], 5)) + 1
 
 
@@ -370,13 +373,16 @@ def test_the_car_rental_model_is_exact_and_sums_to_one() -> None:
     assert rented[0] == 0.0 and rented[1] == pytest.approx(1 - np.exp(-3.0))
     assert rented[20] == pytest.approx(3.0, abs=1e-6)  # 20 cars: nearly every request met
     model = _world("cartpole_q/CarRental-v0").model
-    np.testing.assert_allclose(model.transition.sum(axis=2), 1.0, atol=1e-12)
+    assert not model.terminated.any()  # the days go on: every row sums to 1, none ends
+    totals = np.bincount(model.state * model.n_actions + model.action, weights=model.probability)
+    np.testing.assert_allclose(totals, 1.0, atol=1e-12)
     # No car, no move: nothing rented. From (20, 0), moving 5 costs $10 and leaves 15 cars
     # at the first location (3 requests a day) and 5 at the second (4 a day).
-    assert model.reward[0, 5] == 0.0
+    expected_reward = model.backup(np.zeros(model.n_states), 0.0)  # sum p * r: r's expectation
+    assert expected_reward[0, 5] == 0.0
     _, rented_second = day_at_location(4.0, 2.0, 20)
     expected = 10 * (rented[15] + rented_second[5]) - 10.0
-    assert model.reward[20 * 21 + 0, 10] == pytest.approx(expected, abs=1e-12)
+    assert expected_reward[20 * 21 + 0, 10] == pytest.approx(expected, abs=1e-9)
 
 
 def test_fig_4_2_policy_iteration_stops_at_pi_4() -> None:
@@ -393,7 +399,7 @@ def test_fig_4_2_policy_iteration_stops_at_pi_4() -> None:
     # Each improvement improves: v_pi(i+1) >= v_pi(i) everywhere.
     assert np.all(np.diff(found.values, axis=0) >= -1e-9)
     # The last policy is greedy with respect to its own values (policy iteration's stop).
-    tied = dp.tied_best(model.q_values(values, 0.9), model.allowed, 1e-9)
+    tied = dp.tied_best(model.backup(values, 0.9), model.allowed, 1e-9)
     assert tied[np.arange(441), found.policies[-1]].all()
 
 

@@ -526,7 +526,7 @@ def _control_run(path: Path, q_table: np.ndarray, env_id: str = "FrozenLake-v1")
 def test_the_greedy_policy_of_q_star_has_the_optimal_values(tmp_path: Path) -> None:
     """Evaluating the greedy policy of Q* gives v* (the two solvers agree to rounding)."""
     from cartpole_q.envs.models import EnvModel, env_model
-    from cartpole_q.rl.value_iteration import value_iteration
+    from cartpole_q.rl.solvers import value_iteration
 
     config = load_config(overrides={**LAKE, "agent.algorithm": "td"})
     model = env_model(config.env)
@@ -695,7 +695,7 @@ def test_the_true_values_on_tiles_follow_the_discretization() -> None:
 
 def test_optimum_evaluates_a_runs_greedy_policy(tmp_path: Path) -> None:
     from cartpole_q.envs.models import EnvModel, env_model
-    from cartpole_q.rl.value_iteration import value_iteration
+    from cartpole_q.rl.solvers import value_iteration
 
     model = env_model(load_config(overrides={**LAKE, "agent.algorithm": "td"}).env)
     assert isinstance(model, EnvModel)

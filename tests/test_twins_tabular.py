@@ -34,7 +34,8 @@ from cartpole_q.envs.registry import TwinSettings, twin_settings
 from cartpole_q.families.blackjack import twin as blackjack
 from cartpole_q.families.tables import twin as transition_table
 from cartpole_q.families.toy_text import taxi_twin as taxi
-from cartpole_q.rl.value_iteration import TabularModel, value_iteration
+from cartpole_q.rl.mdp import FiniteMDP
+from cartpole_q.rl.solvers import value_iteration
 from cartpole_q.store.rundir import metrics_csv
 
 CUSTOM_LAKE = ["SFFS", "FHFH", "FFFH", "HFSG"]
@@ -125,7 +126,7 @@ def _purposeful_policy(env_id: str, kwargs: dict[str, Any]) -> Any:
     if "Blackjack" in env_id:
         return lambda observation: int(observation[0] < 17)
     n_actions = int(env.action_space.n)  # type: ignore[attr-defined]
-    model = TabularModel.from_transitions(env.P, env.initial_state_distrib, n_actions)  # type: ignore[attr-defined]
+    model = FiniteMDP.from_transitions(env.P, env.initial_state_distrib, n_actions)  # type: ignore[attr-defined]
     policy = value_iteration(model, 0.95, tolerance=1e-9).policy
     return lambda observation: int(policy[observation])
 

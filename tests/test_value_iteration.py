@@ -9,8 +9,8 @@ import pytest
 from cartpole_q.config import load_config
 from cartpole_q.envs.models import env_model
 from cartpole_q.families.blackjack.model import blackjack_model
-from cartpole_q.rl.value_iteration import (
-    TabularModel,
+from cartpole_q.rl.mdp import FiniteMDP
+from cartpole_q.rl.solvers import (
     finite_horizon,
     policy_horizon_values,
     policy_values,
@@ -19,7 +19,7 @@ from cartpole_q.rl.value_iteration import (
 from tests.conftest import invoke
 
 
-def _three_states() -> TabularModel:
+def _three_states() -> FiniteMDP:
     """State 0: 'safe' pays 1 and ends; 'risky' reaches state 1 with 0.8 (else state 2).
 
     State 1 pays 10 and ends; state 2 pays -5 and ends. With discount g the risky value is
@@ -30,7 +30,7 @@ def _three_states() -> TabularModel:
         1: {0: [(1.0, 1, 10.0, True)], 1: [(1.0, 1, 10.0, True)]},
         2: {0: [(1.0, 2, -5.0, True)], 1: [(1.0, 2, -5.0, True)]},
     }
-    return TabularModel.from_transitions(P, initial=[1.0, 0.0, 0.0])
+    return FiniteMDP.from_transitions(P, initial=[1.0, 0.0, 0.0])
 
 
 @pytest.mark.parametrize("gamma", [0.0, 0.1, 0.5, 0.9, 1.0])
@@ -83,7 +83,7 @@ def test_frozenlake_optimum_equals_policy_iteration(gamma: float) -> None:
     env = gymnasium.make("FrozenLake-v1")
     P = env.unwrapped.P
     expected = _policy_iteration(P, 16, 4, gamma)
-    model = TabularModel.from_transitions(P, env.unwrapped.initial_state_distrib)
+    model = FiniteMDP.from_transitions(P, env.unwrapped.initial_state_distrib)
     solution = value_iteration(model, gamma, tolerance=1e-13)
     assert np.allclose(solution.values, expected, atol=1e-6)
     # the optimal policy evaluated exactly gives the optimal values back
@@ -91,9 +91,7 @@ def test_frozenlake_optimum_equals_policy_iteration(gamma: float) -> None:
 
 
 def test_frozenlake_known_optimum() -> None:
-    model = TabularModel.from_transitions(
-        gymnasium.make("FrozenLake-v1").unwrapped.P, np.eye(16)[0]
-    )
+    model = FiniteMDP.from_transitions(gymnasium.make("FrozenLake-v1").unwrapped.P, np.eye(16)[0])
     # Without a time limit the best policy reaches the goal from the start with
     # probability 14/17 (0.8235); within FrozenLake-v1's 100 steps, 0.7442 (Gymnasium's
     # registration notes "optimum = 0.74").

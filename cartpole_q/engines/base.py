@@ -27,7 +27,7 @@ from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.prediction import policy_table
 from cartpole_q.rl.schedules import SAMPLE_AVERAGE, SCHEDULE_KINDS, schedule_value
-from cartpole_q.rl.value_iteration import (
+from cartpole_q.rl.solvers import (
     evaluate_policy,
     on_policy_distribution,
     reachable_states,
@@ -377,7 +377,7 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     """The evaluated policy's exact values on the world's non-terminal states.
 
     From the world's transition table, by
-    :func:`~cartpole_q.rl.value_iteration.evaluate_policy` with the config's
+    :func:`~cartpole_q.rl.solvers.evaluate_policy` with the config's
     ``agent.gamma``; each model state is measured on the table row it is observed as
     (several on one row only where the world aggregates states by design: where two share a
     row by accident, as Blackjack's natural 21 and a 21 with a usable ace, nothing is
@@ -579,7 +579,7 @@ def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
 
     The fraction of an episode's time steps spent in each state of :func:`prediction_truth`'s
     ``states``, in their order (Sutton & Barto eq. 9.3, from the world's model by
-    :func:`~cartpole_q.rl.value_iteration.on_policy_distribution`, renormalised over the
+    :func:`~cartpole_q.rl.solvers.on_policy_distribution`, renormalised over the
     measured states): what Figure 9.1 shades.
 
     Raises:

@@ -22,8 +22,7 @@ import numpy as np
 from cartpole_q.config import EnvConfig
 from cartpole_q.families import profile_for
 from cartpole_q.families.blackjack.model import MODEL_KWARGS, blackjack_model
-from cartpole_q.rl.dynamic_programming import DenseModel
-from cartpole_q.rl.value_iteration import TabularModel
+from cartpole_q.rl.mdp import FiniteMDP
 
 GREEDY_STEP_CAP = 10_000
 """where a greedy episode stops in an environment without a time limit (CliffWalking,
@@ -34,7 +33,7 @@ Blackjack): a deterministic policy can walk in circles forever there"""
 class EnvModel:
     """An environment's exact model and how Q-table rows map onto its states."""
 
-    model: TabularModel
+    model: FiniteMDP
     row_of_state: np.ndarray
     """int64, one per model state: the Q-table row whose greedy action is played there"""
     horizon: int
@@ -104,7 +103,7 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
                 return f"{env.id!r}: its observation_of_state does not map its states onto its observations"
         elif getattr(space, "n", None) != len(transitions) or getattr(space, "start", 0) != 0:
             return f"{env.id!r}: its observations are not the states of its transition table"
-        model = TabularModel.from_transitions(transitions, initial, int(made.action_space.n))
+        model = FiniteMDP.from_transitions(transitions, initial, int(made.action_space.n))
         success = _pays_only_success(model)
         if observed is not None:
             where = "env.unwrapped.P, observed in groups of states (observation_of_state)"
@@ -118,7 +117,7 @@ def env_model(env: EnvConfig, spec_max_steps: int | None = None) -> EnvModel | s
         made.close()
 
 
-def point_model(env: EnvConfig) -> tuple[TabularModel, np.ndarray] | None:
+def point_model(env: EnvConfig) -> tuple[FiniteMDP, np.ndarray] | None:
     """The model of a world observed as points, and each state's point, or ``None``.
 
     A world with a transition table that observes its states as points of a Box (its
@@ -136,13 +135,13 @@ def point_model(env: EnvConfig) -> tuple[TabularModel, np.ndarray] | None:
         initial = getattr(unwrapped, "initial_state_distrib", None)
         if points is None or not isinstance(transitions, Mapping) or initial is None:
             return None
-        model = TabularModel.from_transitions(transitions, initial, int(made.action_space.n))
+        model = FiniteMDP.from_transitions(transitions, initial, int(made.action_space.n))
         return model, np.asarray(points, dtype=np.float32)
     finally:
         made.close()
 
 
-def _pays_only_success(model: TabularModel) -> bool:
+def _pays_only_success(model: FiniteMDP) -> bool:
     """Whether the only rewards are 1 on a terminating step and 0 otherwise."""
     paid = model.reward != 0
     return bool(np.all(model.reward[paid] == 1.0) and np.all(model.terminated[paid]))
@@ -220,7 +219,7 @@ def grid_layout(env: EnvConfig) -> GridLayout | None:
 class PlanningModel:
     """A world's exact model as dynamic programming takes it, and what figures need of it."""
 
-    model: DenseModel
+    model: FiniteMDP
     action_values: tuple[float, ...]
     """what each action means as a number (a stake, cars moved), else its index"""
     source: str
@@ -255,15 +254,13 @@ def planning_model(env: EnvConfig, source: str = "config") -> PlanningModel | st
         dense = getattr(unwrapped, "dense_model", None)
         if dense is not None:
             transition, reward = dense()
-            model = DenseModel(
-                transition, reward, np.zeros((0, 0), bool) if allowed is None else allowed
-            )
+            model = FiniteMDP.from_dense(transition, reward, allowed)
             where = f"{type(unwrapped).__name__}.dense_model()"
         else:
             found = env_model(env)
             if isinstance(found, str):
                 return found
-            model = DenseModel.from_tabular(found.model, allowed)
+            model = found.model if allowed is None else replace(found.model, allowed=allowed)
             where = found.source
         values = getattr(unwrapped, "action_values", None)
         action_values = (

@@ -360,7 +360,7 @@ def _continuing_optimum(config: Config, gamma: float | None) -> ExactReport | No
         UserError: no ``gamma`` (a continuing task's undiscounted return is not finite).
     """
     from cartpole_q.envs.models import planning_model
-    from cartpole_q.rl import dynamic_programming as dp
+    from cartpole_q.rl import solvers as dp
 
     world = planning_model(config.env)
     if isinstance(world, str) or not world.source.endswith("dense_model()"):
@@ -372,7 +372,7 @@ def _continuing_optimum(config: Config, gamma: float | None) -> ExactReport | No
         )
     found = dp.value_iteration_sweeps(world.model, gamma)
     values = found.values[-1]
-    greedy = dp.greedy(world.model.q_values(values, gamma), world.model.allowed, 1e-9)
+    greedy = dp.greedy(world.model.backup(values, gamma), world.model.allowed, 1e-9)
     start = float(np.mean(values))
     note = f"expected discounted return (gamma {gamma:g}), a continuing task from a uniformly drawn state"
     return ExactReport(note, 0, gamma, start, None, None, None, tuple(int(a) for a in greedy))

@@ -3,7 +3,7 @@
 A study file names a world with an exact model, an algorithm of chapter 4 (policy
 evaluation, value iteration, policy iteration) and its settings, the figure to draw, and
 the book's numbers to print beside ours. :func:`run_study` runs it (pure NumPy, see
-:mod:`cartpole_q.rl.dynamic_programming`); :func:`write_study` writes the figure with its
+:mod:`cartpole_q.rl.solvers`); :func:`write_study` writes the figure with its
 data (``<figure>.csv``) and every recorded sweep and policy (``<figure>_sweeps.csv``).
 """
 
@@ -29,7 +29,7 @@ from cartpole_q.experiments.sweep_spec import (
     checked_study,
 )
 from cartpole_q.progress import Units
-from cartpole_q.rl import dynamic_programming as dp
+from cartpole_q.rl import solvers as dp
 from cartpole_q.store.studydir import Cell, RunRecord
 
 STUDY_KEYS = (
@@ -358,14 +358,14 @@ def run_study(study: Study) -> Outcome:
                     model, pi, study.gamma, study.tolerance, study.max_sweeps, study.order
                 )
             values, steps = sweeps.values, sweeps.sweeps
-            policies = np.array([dp.greedy(model.q_values(v, study.gamma), model.allowed,
+            policies = np.array([dp.greedy(model.backup(v, study.gamma), model.allowed,
                                            study.tie_tolerance) for v in values])  # fmt: skip
     except ValueError as error:
         hint = "; raise max_sweeps, or the tolerance" if "converge" in str(error) else ""
         raise ConfigError(f"{study.where}: {error}{hint}.") from None
     tied = np.array(
         [
-            dp.tied_best(model.q_values(v, study.gamma), model.allowed, study.tie_tolerance)
+            dp.tied_best(model.backup(v, study.gamma), model.allowed, study.tie_tolerance)
             for v in values
         ]
     )
@@ -474,8 +474,7 @@ def study_figure(study: Study, outcome: Outcome) -> Any:
     last = outcome.steps
     if spec.kind == "grid":
         assert world.shape is not None  # checked by run_study
-        ends = world.model.transition.sum(axis=(1, 2)) == 0
-        ends &= np.abs(world.model.reward).sum(axis=1) == 0
+        ends = world.model.terminal_states()
         steps = [k for k in spec.show if k < last] + [last]
         symbol = "pi" if study.algorithm == "policy_evaluation" else "*"
         names = [_move_name(move) for move in world.moves]

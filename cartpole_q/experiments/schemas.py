@@ -47,7 +47,7 @@ from cartpole_q.learning_curves import (
     METRICS,
     X_AXES,
 )
-from cartpole_q.rl.dynamic_programming import SWEEP_ORDERS
+from cartpole_q.rl.solvers import SWEEP_ORDERS
 
 CONFIG_REF = "#/$defs/config"
 """where a study schema holds the config schema (a sweep's and a tune file's ``base``)"""

@@ -584,7 +584,7 @@ def blackjack_optimum(config: Config) -> tuple[np.ndarray, np.ndarray, np.ndarra
     """
     from cartpole_q.envs.models import env_model
     from cartpole_q.families.blackjack.model import BLACKJACK_SHAPE
-    from cartpole_q.rl.value_iteration import finite_horizon
+    from cartpole_q.rl.solvers import finite_horizon
 
     exact = env_model(config.env)
     if isinstance(exact, str):

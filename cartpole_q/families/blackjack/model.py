@@ -13,7 +13,7 @@ from functools import cache
 
 import numpy as np
 
-from cartpole_q.rl.value_iteration import TabularModel
+from cartpole_q.rl.mdp import FiniteMDP
 
 MODEL_KWARGS = (
     "sab", "natural", "render_mode", "max_episode_steps", "player_sum", "usable_ace", "dealer",
@@ -59,7 +59,7 @@ def _compare(player: int, dealer: int) -> float:
     return float(player > dealer) - float(player < dealer)
 
 
-def blackjack_model(sab: bool, natural: bool) -> tuple[TabularModel, np.ndarray]:
+def blackjack_model(sab: bool, natural: bool) -> tuple[FiniteMDP, np.ndarray]:
     """Blackjack-v1's exact model under its ``sab`` and ``natural`` rules.
 
     Returns:
@@ -91,7 +91,7 @@ def blackjack_model(sab: bool, natural: bool) -> tuple[TabularModel, np.ndarray]
     rows = np.concatenate(
         [np.arange(n_rows), [blackjack_row(21, card, 1) for card in range(1, 11)]]
     )
-    model = TabularModel.from_transitions(transitions, initial / initial.sum(), n_actions=2)
+    model = FiniteMDP.from_transitions(transitions, initial / initial.sum(), n_actions=2)
     return model, rows.astype(np.int64)
 
 
