@@ -404,10 +404,18 @@ def test_malformed_set_assignments_are_config_errors(text: str) -> None:
           "discretization.high": [1] * 6, "env.kwargs.max_episode_steps": 1000}, -100.0),
     ],
 )  # fmt: skip
-def test_cartpole_threshold_scales_with_the_time_limit(overrides: dict, threshold: float) -> None:
-    from cartpole_q.envs.gym import inspect_env
+def test_cartpole_threshold_scales_with_the_time_limit(
+    overrides: dict, threshold: float, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import gymnasium
 
-    assert inspect_env(load_config(overrides=overrides)).reward_threshold == threshold
+    from cartpole_q.envs.gym import config_threshold, inspect_env
+
+    config = load_config(overrides=overrides)
+    assert inspect_env(config).reward_threshold == threshold
+    # a run directory's reader asks the registry alone: it makes no environment
+    monkeypatch.setattr(gymnasium, "make", lambda *a, **k: pytest.fail("an environment was made"))
+    assert config_threshold(config) == threshold
 
 
 @pytest.mark.parametrize(

@@ -467,9 +467,7 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
             f"{memory_text(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
         )
     max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
-    threshold = config.train.reward_threshold
-    if threshold is None and spec is not None and spec.reward_threshold is not None:
-        threshold = _default_threshold(env_id, float(spec.reward_threshold), max_steps)
+    threshold = _threshold_of(config, spec)
     return EnvInfo(
         id=env_id,
         observation_dim=observation_dim,
@@ -511,6 +509,32 @@ def _index_starts(space: Any) -> tuple[int, ...] | None:
     ):
         return tuple(int(getattr(component, "start", 0)) for component in space.spaces)
     return None
+
+
+def config_threshold(config: Config) -> float | None:
+    """The reward threshold a config's runs are judged by (``None`` without one).
+
+    From the config and Gymnasium's registry (the id's registered threshold and time limit):
+    a registered world is not made, so a run directory's reader can ask cheaply. A plug-in
+    world not yet registered is made once, which imports the module that registers it.
+    """
+    import gymnasium
+
+    if config.train.reward_threshold is not None:
+        return config.train.reward_threshold
+    spec = gymnasium.registry.get(config.env.id.rpartition(":")[2])
+    if spec is None:
+        return inspect_env(config).reward_threshold
+    return _threshold_of(config, spec)
+
+
+def _threshold_of(config: Config, spec: Any) -> float | None:
+    """:func:`config_threshold` given the environment's spec (``None``: it has none)."""
+    threshold = config.train.reward_threshold
+    if threshold is None and spec is not None and spec.reward_threshold is not None:
+        max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps)
+        threshold = _default_threshold(config.env.id, float(spec.reward_threshold), max_steps)
+    return threshold
 
 
 def _default_threshold(env_id: str, registered_threshold: float, max_steps: Any) -> float:

@@ -502,10 +502,13 @@ def _with_threshold(result: SeedResult, config: Config) -> SeedResult:
 
 
 def config_threshold(config: Config) -> float | None:
-    """The reward threshold a config's runs are judged by (``None`` without one)."""
-    from cartpole_q.engines.plan import env_facts
+    """The reward threshold a config's runs are judged by (``None`` without one).
 
-    return env_facts(config).reward_threshold
+    From the config and Gymnasium's registry: reading a run directory makes no environment.
+    """
+    from cartpole_q.envs.gym import config_threshold as threshold
+
+    return threshold(config)
 
 
 def load_array(path: Path, dtype: type, check: ShapeCheck | None = None) -> np.ndarray:
