@@ -91,8 +91,7 @@ def evaluate_run(
         ConfigError: ``physics`` or ``max_steps`` do not fit the environment, or the
             environment has no twin under them (``numba``).
     """
-    from cartpole_q.engines.plan import env_facts
-    from cartpole_q.envs.gym import display_problem
+    from cartpole_q.envs.gym import config_threshold, display_problem
 
     if engine != "gymnasium" and (render or video is not None):
         raise UserError(
@@ -102,7 +101,7 @@ def evaluate_run(
     threshold = run.result.reward_threshold
     if physics or max_steps is not None:
         run = dataclasses.replace(run, config=under_conditions(run.config, physics, max_steps))
-        threshold = env_facts(run.config).reward_threshold
+        threshold = config_threshold(run.config)
     if render and video is not None:
         raise UserError("--render and --video cannot be combined: choose one.")
     if render and (problem := display_problem()) is not None:
@@ -208,7 +207,7 @@ def evaluate_seeds(
         ``notes`` (what was left out or is unfinished) and ``note`` (them as one line, or
         None), ``played_in`` (``gymnasium`` or ``twin``).
     """
-    from cartpole_q.engines.plan import env_facts
+    from cartpole_q.envs.gym import config_threshold
 
     runs = run_set.runs
     if engine == "gymnasium":
@@ -223,7 +222,7 @@ def evaluate_seeds(
     reward_threshold = run_set.reward_threshold
     if physics or max_steps is not None:  # the horizon may scale CartPole's threshold
         conditions = under_conditions(run_set.config, physics, max_steps)
-        reward_threshold = env_facts(conditions).reward_threshold
+        reward_threshold = config_threshold(conditions)
     means = [result["mean"] for result in results]
     exact = exact_summary(results)
     return {

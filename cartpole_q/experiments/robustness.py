@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from cartpole_q.engines import make_engine
-from cartpole_q.engines.plan import env_facts
+from cartpole_q.envs.gym import config_threshold
 from cartpole_q.envs.registry import twin_for
 from cartpole_q.errors import UserError
 from cartpole_q.evaluation import under_conditions
@@ -132,7 +132,7 @@ def measure(
     finally:
         progress.close()
     trained = [float(config.env.physics.get(axis.key, spec.defaults[axis.key])) for axis in axes]
-    threshold = env_facts(under_conditions(config, None, max_steps)).reward_threshold
+    threshold = config_threshold(under_conditions(config, None, max_steps))
     return means.reshape(shape), trained, threshold
 
 

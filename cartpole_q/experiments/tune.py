@@ -554,9 +554,9 @@ def _run_trials(
         if len(rows) < len(spec.seeds):  # stopped by a signal: not a result
             the_study.tell(trial, state=optuna.trial.TrialState.FAIL)
             break
-        from cartpole_q.engines.plan import env_facts
+        from cartpole_q.envs.gym import config_threshold
 
-        threshold = env_facts(spec.config_for(values)).reward_threshold
+        threshold = config_threshold(spec.config_for(values))
         figures = trial_figures(spec, rows, threshold)
         for name, value in figures.items():
             trial.set_user_attr(name, value)
