@@ -218,7 +218,7 @@ def test_robustness_refuses_bad_axes(solved_run, tmp_path, args, named: str) -> 
 def test_another_horizon_judges_success_by_the_environment_threshold_for_it(tmp_path) -> None:  # type: ignore[no-untyped-def]
     """--max-steps 10000 counts success at 9,500, also for a run trained with its own threshold.
 
-    A run's ``train.reward_threshold`` (``robust``'s 1995 of 2000 steps) stops its training;
+    A run's ``train.reward_threshold`` (such as 1995 of 2000 steps) stops its training;
     at its own horizon it stays the yardstick, at another one CartPole's scaled default is.
     """
     from cartpole_q.envs.gym import inspect_env
