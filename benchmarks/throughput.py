@@ -20,10 +20,17 @@ Rows:
   prediction        every prediction algorithm on the 19-state random walk (Figure 7.2's),
                     the random policy, its error measured per episode: the numba engine
                     against the gymnasium engine on the same training
+  linear            every sampled linear method (a linear study's curve): on the 1000-state
+                    walk (Fourier order 5; the on-policy ones) and Baird's counterexample
+                    (its declared features; the off-policy ones), the numba engine against
+                    the gymnasium engine on the same run (√VE recorded every 100 episodes or
+                    1,000 steps), env steps per second; the expected methods' sweeps per
+                    second on Baird's
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
 same run, so they hold across machines even when absolute rates do not. --only SECTION runs
-one section (cartpole, algorithms, environments, tabular, prediction, tiles, progress); the algorithms section
+one section (cartpole, algorithms, environments, tabular, prediction, tiles, linear,
+progress); the algorithms section
 then measures its own Q-learning baseline.
 """
 
@@ -195,7 +202,8 @@ TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
 """the tabular worlds' rows: label, shipped config, its episodes (the whole training)"""
 
 SECTIONS = (
-    "cartpole", "algorithms", "environments", "tabular", "prediction", "tiles", "progress",
+    "cartpole", "algorithms", "environments", "tabular", "prediction", "tiles", "linear",
+    "progress",
 )  # fmt: skip
 """what --only can pick; by default every section runs, in this order"""
 
@@ -366,6 +374,105 @@ def prediction_rows(repeats: int, scale: float) -> None:
         )
 
 
+LINEAR_WALK = {
+    "kind": "linear", "world": {"id": "cartpole_q/RandomWalk1000-v0", "kwargs": {"position": True}},
+    "gamma": 1.0,
+}  # fmt: skip
+LINEAR_BAIRD = {
+    "kind": "linear", "world": {"id": "cartpole_q/Baird-v0"}, "gamma": 0.99, "target": [0, 1],
+    "behaviour": ["6/7", "1/7"],
+}  # fmt: skip
+LINEAR_CURVES = (
+    ("gradient_mc", LINEAR_WALK, {"alpha": 5e-5, "features": {"kind": "fourier", "order": 5}}),
+    ("semi_gradient_td", LINEAR_WALK, {"alpha": 5e-5, "features": {"kind": "fourier", "order": 5}}),
+    ("lstd", LINEAR_WALK, {"features": {"kind": "fourier", "order": 5}}),
+    ("off_policy_td", LINEAR_BAIRD, {"alpha": 0.001, "features": {"kind": "declared"}}),
+    ("tdc", LINEAR_BAIRD, {"alpha": 0.005, "beta": 0.05, "features": {"kind": "declared"}}),
+    ("gtd2", LINEAR_BAIRD, {"alpha": 0.005, "beta": 0.05, "features": {"kind": "declared"}}),
+    ("emphatic_td", LINEAR_BAIRD, {"alpha": 0.001, "features": {"kind": "declared"}}),
+    ("semi_gradient_dp", LINEAR_BAIRD, {"alpha": 0.01, "features": {"kind": "declared"}}),
+    (
+        "expected_tdc",
+        LINEAR_BAIRD,
+        {"alpha": 0.005, "beta": 0.05, "features": {"kind": "declared"}},
+    ),
+    ("expected_emphatic_td", LINEAR_BAIRD, {"alpha": 0.03, "features": {"kind": "declared"}}),
+)
+"""the linear section's rows: each method on its world, with its settings"""
+
+
+def linear_rate(raw: dict, engine: str, count: int) -> tuple[int, float]:
+    """One run of a linear study's curve: ``(env steps or sweeps, seconds)``."""
+    from cartpole_q.experiments import linear
+    from cartpole_q.experiments.study import RunHandle, study_of
+
+    unit = "episodes" if raw["world"]["id"].endswith("RandomWalk1000-v0") else "steps"
+    study = linear.read_study(study_of(
+        {**raw, unit: count, "record_every": 100 if unit == "episodes" else 1000, "engine": engine},
+        "benchmark", "b", Path("."),
+    ))  # fmt: skip
+    steps = [0]
+
+    def count_steps(done: int) -> None:
+        steps[0] = done
+
+    linear.curve_setup(study, 0)  # the model's solves and the layer: set-up, not stepping
+    linear.world_table(study)
+    start = time.perf_counter()
+    record = linear.run_one(study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, count_steps))
+    seconds = time.perf_counter() - start
+    assert record is not None
+    if unit == "episodes":  # the walk's env steps: replay the episode lengths' sum from the record
+        steps[0] = walk_steps(count)
+    return steps[0], seconds
+
+
+def walk_steps(episodes: int, seed: int = 0) -> int:
+    """The env steps of ``episodes`` episodes of the random policy on the walk (seed 0's draws)."""
+    env = gym.make("cartpole_q/RandomWalk1000-v0")
+    agent_seq, env_seq = np.random.SeedSequence(seed).spawn(2)
+    rng = np.random.Generator(np.random.PCG64(agent_seq))
+    env.reset(seed=int(env_seq.generate_state(1, dtype=np.uint32)[0]))
+    steps = 0
+    for episode in range(episodes):
+        if episode:
+            env.reset()
+        done = False
+        while not done:
+            _, _, terminated, truncated, _ = env.step(int(rng.integers(0, 2)))
+            steps += 1
+            done = terminated or truncated
+    return steps
+
+
+def linear_rows(repeats: int, scale: float) -> None:
+    """Each linear method: the numba engine against the gymnasium engine, the same run."""
+    print(
+        f"{'linear method, world':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s} "
+        f"{'per run':>9s} {'unit':>10s}"
+    )
+    for algorithm, world, curve in LINEAR_CURVES:
+        raw = {**world, "curves": [{"algorithm": algorithm, **curve}]}
+        expected = algorithm in ("semi_gradient_dp", "expected_tdc", "expected_emphatic_td")
+        on_walk = world is LINEAR_WALK
+        count = max(20, int((200 if algorithm == "lstd" else 2000) * scale)) if on_walk else (
+            max(1000, int(200_000 * scale)) if not expected else max(1000, int(50_000 * scale))
+        )  # fmt: skip
+        linear_rate(raw, "numba", 2 if on_walk else 10)  # compile or load the cache
+        label = f"{algorithm}, {'walk' if on_walk else 'Baird'}"
+        unit = "sweeps" if expected else "env steps"
+        numba_rate = median_rate(lambda r=raw, c=count: linear_rate(r, "numba", c), max(3, repeats))
+        if expected:
+            print(f"{label:40s} {'-':>14s} {numba_rate:13,.0f} {'-':>7s} {count:9,d} {unit:>10s}")
+            continue
+        gym_count = max(10, count // 20)
+        gym_rate = median_rate(lambda r=raw, c=gym_count: linear_rate(r, "gymnasium", c), repeats)
+        print(
+            f"{label:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x "
+            f"{count:9,d} {unit:>10s}"
+        )
+
+
 TILINGS = (1, 2, 4, 8, 16)
 """the tiles section's tiling counts (1: the plain grid, the baseline)"""
 
@@ -447,6 +554,8 @@ def main() -> None:
             prediction_rows(args.repeats, scale)
         elif section == "tiles":
             tile_rows(args.repeats, scale)
+        elif section == "linear":
+            linear_rows(args.repeats, scale)
         else:
             progress_row(args.repeats, python_episodes)
 

@@ -83,6 +83,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/RandomWalk5-v0": (7, 2, 1_000),
         "cartpole_q/RandomWalk-v0": (21, 2, 1_000),
         "cartpole_q/RandomWalk1000-v0": (1002, 2, 10_000),
+        "cartpole_q/Baird-v0": (7, 2, None),  # continuing: no time limit, nothing ends
     }
     assert set(expected) == set(IDS)
     for env_id, (states, actions, limit) in expected.items():

@@ -44,7 +44,9 @@ def test_check_refuses_a_bad_file_naming_the_key(tmp_path: Path) -> None:
     path = write_yaml(tmp_path / "s.yaml", {**study, "steps": 0})
     assert_refused(invoke("study", path, "--check"), f"{path}: steps: must be a whole number")
     path = write_yaml(tmp_path / "k.yaml", {**study, "kind": "bandits"})
-    assert_refused(invoke("study", path, "--check"), "kind: must be one of bandit, dp, sweep")
+    assert_refused(
+        invoke("study", path, "--check"), "kind: must be one of bandit, dp, linear, sweep"
+    )
 
 
 def small(tmp_path: Path, name: str, **change: object) -> Path:
@@ -105,6 +107,7 @@ RESUMED = {
     "expected_vs_sample": lambda tmp: small(
         tmp, "fig8_7_expected_vs_sample", seeds="0-4", branching=[2, 10, 100]
     ),
+    "linear": lambda tmp: small(tmp, "fig9_10_tile_coding", seeds="0-2", episodes=40, book=[]),
 }  # fmt: skip
 
 
@@ -229,7 +232,7 @@ def test_studies_of_every_kind_run_on_a_local_ray_cluster_to_the_same_bytes(
     from cartpole_q.experiments import study as studies
     from cartpole_q.experiments.study_kinds import registered
 
-    files = {name: RESUMED[name](tmp_path) for name in ("bandit", "dp", "until_optimal")}
+    files = {name: RESUMED[name](tmp_path) for name in ("bandit", "dp", "until_optimal", "linear")}
     local = {}
     for name, path in files.items():
         local[name] = tmp_path / f"local-{name}"

@@ -58,9 +58,10 @@ class CompileJob:
         return f"{self.algorithm} on {self.label} ({self.engine} engine)"
 
 
-STUDY_LOOPS = {
+STUDY_LOOPS: dict[str, tuple[str, Callable[[], None]]] = {
     "bandit_numba": ("the bandit testbed", lambda: _bandit("numba")),
     "bandit_gymnasium": ("the bandit testbed", lambda: _bandit("gymnasium")),
+    "linear": ("the linear methods (both engines)", lambda: _linear()),
 }
 """the compiled loops the studies run outside training (by a name, with what they play
 and how to compile them): ``compile --all`` fills the cache with them too"""
@@ -70,6 +71,12 @@ def _bandit(engine: str) -> None:
     from cartpole_q.engines.bandit import warm_up
 
     warm_up(engine)
+
+
+def _linear() -> None:
+    from cartpole_q.engines.linear import warm_up
+
+    warm_up()
 
 
 def jobs_for(config: Config | None, every: bool) -> list[CompileJob]:

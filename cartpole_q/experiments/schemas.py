@@ -38,7 +38,15 @@ from cartpole_q.config.json_schema import (
     with_null,
 )
 from cartpole_q.config.overrides import TUNE_FILE_KEYS
-from cartpole_q.experiments import bandits, planning, study_kinds, sweep_spec, tune_spec, updates
+from cartpole_q.experiments import (
+    bandits,
+    linear,
+    planning,
+    study_kinds,
+    sweep_spec,
+    tune_spec,
+    updates,
+)
 from cartpole_q.experiments.study import KIND_KEY
 from cartpole_q.learning_curves import (
     AGGREGATES,
@@ -84,9 +92,9 @@ def study_schema() -> Schema:
 
     >>> schema = study_schema()
     >>> sorted(name for name in schema["$defs"] if "." not in name)
-    ['bandit', 'config', 'dp', 'sweep', 'tune', 'updates']
+    ['bandit', 'config', 'dp', 'linear', 'sweep', 'tune', 'updates']
     >>> schema["properties"]["kind"]["enum"]
-    ['bandit', 'dp', 'sweep', 'updates']
+    ['bandit', 'dp', 'linear', 'sweep', 'updates']
     """
     schemas = kind_schemas()
     kinds = sorted(schemas)
@@ -150,7 +158,10 @@ def kind_schemas() -> dict[str, Schema]:
     Raises:
         ValueError: a registered kind has no schema here (a new kind needs one).
     """
-    built = {"sweep": _sweep(), "bandit": _bandit(), "dp": _dp(), "updates": _updates()}
+    built = {
+        "sweep": _sweep(), "bandit": _bandit(), "dp": _dp(), "updates": _updates(),
+        "linear": _linear(),
+    }  # fmt: skip
     missing = sorted(set(study_kinds.registered()) - set(built))
     if missing:
         raise ValueError(f"no JSON Schema for the study kinds {', '.join(missing)}")
@@ -614,6 +625,109 @@ def _dimension_defs() -> dict[str, Schema]:
         },
     ]  # fmt: skip
     return {f"{TUNE_DEFS}choices": choices, f"{TUNE_DEFS}range": span}
+
+
+# -- linear ---------------------------------------------------------------------------------
+
+
+def _linear() -> Schema:
+    number = _bandit_number()
+    probabilities = {"type": "array", "minItems": 1, "items": _bandit_number(0.0, 1.0)}
+    policy: Schema = {"anyOf": [{"const": "random"}, probabilities]}
+    world = _object(
+        {"id": {"type": "string", "minLength": 1}, "kwargs": {"type": "object"}}, ["id"]
+    )
+    _check_keys(world, linear.WORLD_KEYS)
+    errors = {"type": "array", "minItems": 1, "uniqueItems": True,
+              "items": {"enum": list(linear.MEASURES)}}  # fmt: skip
+    count = {"type": "integer", "minimum": 1, "maximum": MAX_COUNT}
+    own = {
+        "y_min": number, "y_max": number, "log_y": BOOLEAN, "fixed_points": BOOLEAN,
+        "show_errors": BOOLEAN,
+    }  # fmt: skip
+    properties: dict[str, Schema] = {
+        "name": NAME,
+        "world": world,
+        "gamma": number_schema(0.0, 1.0),
+        "seeds": seeds_schema(),
+        "episodes": count,
+        "steps": count,
+        "record_every": count,
+        "engine": {"enum": list(linear.ENGINES)},
+        "target": policy,
+        "behaviour": policy,
+        "errors": errors,
+        "curves": {"type": "array", "minItems": 1, "items": _linear_curve()},
+        "figure": _study_figure(linear.FIGURE_KEYS, linear.FIGURE_KINDS, own),
+        "book": {"type": "array", "items": _linear_book()},
+    }
+    schema = _kind("linear", linear.STUDY_KEYS, properties, "Linear files")
+    schema["required"] = ["world", "curves"]
+    schema["not"] = {"required": ["episodes", "steps"]}  # the world says which (the reader)
+    return schema
+
+
+def _linear_curve() -> Schema:
+    """One curve: an algorithm on a feature layer, its step sizes and starting weights."""
+    from cartpole_q.rl import features
+    from cartpole_q.rl import linear as methods
+
+    order = {"type": "integer", "minimum": 1, "maximum": features.MAX_ORDER}
+    whole = {"type": "integer", "minimum": 1}
+    numbers = {"type": "array", "minItems": 1, "items": _bandit_number()}
+    layer_properties: dict[str, Schema] = {
+        "kind": {"enum": list(features.KINDS)}, "order": order, "tilings": whole,
+        "bins": {"type": "array", "minItems": 1, "items": whole}, "low": numbers, "high": numbers,
+    }  # fmt: skip
+    layer = _object(layer_properties, ["kind"])
+    layer["allOf"] = [
+        {
+            "if": {"properties": {"kind": {"const": kind}}},
+            "then": {
+                "properties": dict.fromkeys(
+                    [key for key in layer_properties if key not in keys], False
+                ),
+                "required": [key for key in keys if key in ("order", "bins", "low", "high")],
+            },
+        }
+        for kind, keys in linear.FEATURE_KEYS.items()
+    ]
+    positive = _bandit_number(0.0, low_open=True)
+    curve = _object({
+        "label": TEXT,
+        "algorithm": {"enum": list(methods.ALGORITHMS)},
+        "features": layer,
+        "alpha": positive,
+        "beta": positive,
+        "epsilon": positive,
+        "w0": {"anyOf": [_bandit_number(), numbers]},
+    }, ["algorithm", "features"])  # fmt: skip
+    _check_keys(curve, linear.CURVE_KEYS)
+    curve["allOf"] = [
+        {"if": {"properties": {"algorithm": {"enum": list(methods.WITH_BETA)}}},
+         "then": {"required": ["alpha", "beta"]},
+         "else": {"properties": {"beta": False}}},
+        {"if": {"properties": {"algorithm": {"const": "lstd"}}},
+         "then": {"properties": {"alpha": False}},
+         "else": {"required": ["alpha"], "properties": {"epsilon": False}}},
+    ]  # fmt: skip
+    return curve
+
+
+def _linear_book() -> Schema:
+    """A number the book shows at one point of a curve, or its claim that one lies below another."""
+    index = {"type": "integer", "minimum": 0}
+    book = _object({
+        "label": TEXT,
+        "curve": index,
+        "at": {"type": "integer", "minimum": 0},
+        "of": {"type": "string", "pattern": r"^(?:ve|pbe|w[1-9][0-9]*)$"},
+        "value": {"type": ["number", "null"]},
+        "below": with_null(index),
+        "text": TEXT,
+    }, ["label", "curve"])  # fmt: skip
+    _check_keys(book, linear.BOOK_KEYS)
+    return book
 
 
 # -- what the kinds share --------------------------------------------------------------------

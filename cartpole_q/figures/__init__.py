@@ -10,8 +10,8 @@ One module per kind of figure: :mod:`~cartpole_q.figures.base` (the data, sizes,
 formats), :mod:`~cartpole_q.figures.curves`, :mod:`~cartpole_q.figures.maps`,
 :mod:`~cartpole_q.figures.robustness`, :mod:`~cartpole_q.figures.sweeps`,
 :mod:`~cartpole_q.figures.tune`, :mod:`~cartpole_q.figures.dp`,
-:mod:`~cartpole_q.figures.bandits` and :mod:`~cartpole_q.figures.planning`; every public
-name is here too.
+:mod:`~cartpole_q.figures.bandits`, :mod:`~cartpole_q.figures.planning` and
+:mod:`~cartpole_q.figures.linear`; every public name is here too.
 """
 
 from __future__ import annotations
@@ -61,6 +61,7 @@ from cartpole_q.figures.dp import (
     dp_grid_figure,
     gambler_figure,
 )
+from cartpole_q.figures.linear import ErrorCurve, WeightsPanel, error_curves_figure, weights_figure
 from cartpole_q.figures.maps import (
     GridMap,
     action_names,
@@ -114,6 +115,7 @@ __all__ = [
     "Cell",
     "Curve",
     "DataFigure",
+    "ErrorCurve",
     "FigureData",
     "GridMap",
     "GridPanel",
@@ -123,6 +125,7 @@ __all__ = [
     "SeedBand",
     "SweepAxis",
     "TrajectoryCurve",
+    "WeightsPanel",
     "action_names",
     "blackjack_optimal_figure",
     "blackjack_policy_figure",
@@ -141,6 +144,7 @@ __all__ = [
     "draw_reward_curves",
     "drawable",
     "drawn_points",
+    "error_curves_figure",
     "expected_vs_sample_figure",
     "figure_bytes",
     "figure_png",
@@ -164,4 +168,5 @@ __all__ = [
     "trajectory_sampling_figure",
     "tune_history_figure",
     "until_optimal_figure",
+    "weights_figure",
 ]

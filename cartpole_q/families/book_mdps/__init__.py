@@ -1,7 +1,9 @@
-"""The book's small MDPs: the one-state MDP (Example 5.5) and the maximization bias (6.7).
+"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1).
 
-Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state` and
-:mod:`~cartpole_q.families.book_mdps.bias`.
+Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state`,
+:mod:`~cartpole_q.families.book_mdps.bias` and :mod:`~cartpole_q.families.book_mdps.baird`
+(a continuing world: nothing ends, and it has no time limit; its linear features are its
+own, ``features_of_state``, for the ``linear`` studies).
 
 Both have a transition table, so ``cartpole-q optimum`` and ``eval`` compute the best return
 exactly. The one-state MDP plays on the compiled twin of any table world; the
@@ -16,6 +18,7 @@ from types import MappingProxyType
 from cartpole_q.families.base import NAMESPACE, EnvProfile, World
 from cartpole_q.families.tables import load_twin as load_table_twin
 
+_BAIRD = "cartpole_q.families.book_mdps.baird"
 _BIAS = "cartpole_q.families.book_mdps.bias"
 _ONE_STATE = "cartpole_q.families.book_mdps.one_state"
 ONE_STATE_TIME_LIMIT = 1_000
@@ -54,10 +57,22 @@ ONE_STATE = EnvProfile(
     policies=MappingProxyType({"left": always_left}),
 )
 
-PROFILES = (MAXIMIZATION_BIAS, ONE_STATE)
+BAIRD = EnvProfile(
+    name="Baird",
+    description="Baird's counterexample: seven states, dashed to an upper state, solid to the "
+    "lower one, reward 0, no end; eight linear features (Sutton & Barto's Example 11.1)",
+    ids=("cartpole_q/Baird-v0",),
+    entry_points=(f"{_BAIRD}:BairdEnv",),
+    action_names=("dashed", "solid"),
+    model="transition_table",
+    twin=load_table_twin,
+)
+
+PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD)
 """the family's profiles"""
 WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
     World(f"{NAMESPACE}/OneState-v0", f"{_ONE_STATE}:OneStateEnv", ONE_STATE_TIME_LIMIT),
+    World(f"{NAMESPACE}/Baird-v0", f"{_BAIRD}:BairdEnv", None),
 )
 """the worlds it registers"""

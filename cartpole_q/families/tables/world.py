@@ -47,6 +47,11 @@ class TableWorld(gymnasium.Env[Any, Any]):
     gives each state's observation here (``None``: it observes integers); tile coding then
     measures the true values on each state's tiles"""
 
+    features_of_state: np.ndarray | None = None
+    """float64 ``(n_states, d)``: linear features the world declares for its states (Baird's
+    counterexample), which a ``linear`` study's ``features: {kind: declared}`` takes
+    (``None``: none)"""
+
     def __init__(self, n_states: int, n_actions: int, start: int) -> None:
         self.observation_space = spaces.Discrete(n_states)
         self.action_space = spaces.Discrete(n_actions)
