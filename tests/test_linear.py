@@ -347,3 +347,19 @@ def test_the_shipped_linear_studies_are_the_books_figures() -> None:
     ):  # fmt: skip
         text = (REPO / "examples" / "book" / f"{name}.yaml").read_text(encoding="utf-8")
         assert f"Sutton & Barto {figure})" in text and "kind: linear" in text
+
+
+def test_a_long_stretch_between_records_still_returns_to_python_and_stops() -> None:
+    study = read({**BAIRD_STUDY, "steps": 250_000, "record_every": 250_000, "curves": [
+        {"algorithm": "tdc", "alpha": 0.005, "beta": 0.05, "features": {"kind": "declared"}}]})  # fmt: skip
+    reported: list[int] = []
+    record = study_kind.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, reported.append)
+    )
+    assert reported == [100_000, 200_000, 250_000]
+    assert record is not None and record.arrays["at"].tolist() == [0, 250_000]
+    seen: list[int] = []
+    stopped = study_kind.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: bool(seen), seen.append)
+    )
+    assert stopped is None and seen == [100_000]  # asked after every compiled call

@@ -9,9 +9,10 @@ and the same draws, so their weights and errors agree byte for byte
 - ``gymnasium``: a Python loop over ``gymnasium.make(world)``, the behaviour's draws and the
   updates compiled, one call per step.
 
-A run goes in chunks of ``record_every`` episodes (or steps, or sweeps): after each, the
-errors are measured and the run's ``should_stop`` is asked, so a stop is seen within a
-chunk. An expected algorithm sweeps the model and never steps the world (one engine).
+A run goes in chunks of ``record_every`` episodes (or steps, or sweeps), after each of
+which the errors are measured; a compiled call runs at most :data:`EPISODES_PER_CALL`
+episodes (:data:`STEPS_PER_CALL` steps, :data:`SWEEPS_PER_CALL` sweeps), and between calls
+the run's ``should_stop`` is asked, so a stop is seen within a fraction of a second. An expected algorithm sweeps the model and never steps the world (one engine).
 
 **Seeds** (docs/algorithms.md, "Linear function approximation"): run ``seed``:
 ``agent_seq, env_seq = np.random.SeedSequence(seed).spawn(2)``; the behaviour draws from
@@ -47,6 +48,10 @@ from cartpole_q.rl.tabular import compilable
 ENGINES = ("numba", "gymnasium")
 EPISODE_CAP = 10_000
 """an episodic world without a time limit is cut (truncated) at this many steps"""
+EPISODES_PER_CALL = 1_000
+STEPS_PER_CALL = 100_000
+SWEEPS_PER_CALL = 10_000
+"""the most a compiled call runs before it returns (to see a stop, to report progress)"""
 
 
 class Behaviour(NamedTuple):
@@ -246,16 +251,26 @@ def run(
         chunk = _numba_chunk(learner, behaviour, world, seed)
     else:
         chunk = _gymnasium_chunk(learner, behaviour, world, seed)
+    most = _most_per_call(learner, world)
     done = 0
     while done < count:
-        if should_stop():
-            return None
-        size = min(record_every, count - done)
-        chunk(size)
-        done += size
+        target = min(done + record_every, count)
+        while done < target:  # a long stretch between records still returns to Python often
+            if should_stop():
+                return None
+            size = min(most, target - done)
+            chunk(size)
+            done += size
+            report(done)
         record(done)
-        report(done)
     return records
+
+
+def _most_per_call(learner: Learner, world: World) -> int:
+    """Episodes, steps or sweeps per compiled call: a few hundredths of a second each."""
+    if learner.code >= len(SAMPLED):
+        return SWEEPS_PER_CALL
+    return STEPS_PER_CALL if world.continuing else EPISODES_PER_CALL
 
 
 def _sweep_chunk(learner: Learner, model: Model) -> Callable[[int], None]:

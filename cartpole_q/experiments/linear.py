@@ -1048,8 +1048,12 @@ class LinearKind(RunsKind):
     """``kind: linear``: linear methods on feature layers (Figures 9.5, 9.10, 11.2, 11.5, 11.6)."""
 
     name = "linear"
-    units = Units("linear", "runs", "runs")
+    units = Units("linear", "episodes or steps", "runs")
     runs_per_task = 4
+
+    def run_size(self, spec: Study, key: Mapping[str, Cell]) -> int:
+        """A run's episodes, steps or sweeps (what the progress counts)."""
+        return spec.count
 
     def read(self, study: StudyFile) -> Study:
         """Check the file (:func:`read_study`)."""
