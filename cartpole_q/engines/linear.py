@@ -98,9 +98,13 @@ def choose(behaviour: Any, rng: Any) -> int:
 
 def _play_episodes(
     learner: Any, behaviour: Any, params: Any, agent_rng: Any, env_rng: Any, episodes: int,
-    cap: int, states: Any, rewards: Any, returns: Any,
+    cap: int, buffers: Any,
 ) -> None:  # fmt: skip
-    """``episodes`` episodes on the table (compiled): reset, step to the end, learn."""
+    """``episodes`` episodes on the table (compiled): reset, step to the end, learn.
+
+    ``buffers`` is ``(states, rewards, returns)``, room for an episode of ``cap`` steps.
+    """
+    states, rewards, returns = buffers
     for _ in range(episodes):
         state = initial_state(params, env_rng)
         states[0] = state
@@ -221,16 +225,29 @@ class Records:
         return arrays
 
 
+class Schedule(NamedTuple):
+    """How long a run lasts, what it records and where it plays."""
+
+    seed: int
+    length: int
+    """episodes, steps or sweeps"""
+    record_every: int
+    measures: tuple[str, ...]
+    """the errors recorded: ``ve``, ``pbe``"""
+    engine: str
+
+
 def run(
     learner: Learner, behaviour: Behaviour, world: World, model: Model, errors: Errors,
-    *, seed: int, count: int, record_every: int, measures: tuple[str, ...], engine: str,
-    should_stop: Callable[[], bool] = lambda: False, report: Callable[[int], None] = lambda n: None,
+    schedule: Schedule, should_stop: Callable[[], bool] = lambda: False,
+    report: Callable[[int], None] = lambda n: None,
 ) -> Records | None:  # fmt: skip
-    """Play one run of ``count`` episodes (steps, sweeps), recording every ``record_every``.
+    """Play one run of ``schedule.length`` episodes (steps, sweeps), recording as it says.
 
     Returns:
         The records, or ``None`` when ``should_stop`` ended the run early.
     """
+    seed, count, record_every, measures, engine = schedule
     records = Records([], [], {name: [] for name in measures})
 
     def record(at: int) -> None:
@@ -291,13 +308,11 @@ def _numba_chunk(
         return lambda size: steps(
             learner, behaviour, world.params, agent_rng, env_rng, size, position
         )
-    states = np.zeros(world.cap + 1, dtype=np.int64)
-    rewards, returns = np.zeros(world.cap), np.zeros(world.cap)
+    buffers = (np.zeros(world.cap + 1, dtype=np.int64), np.zeros(world.cap), np.zeros(world.cap))
     episodes = compiled("linear_play_episodes")
     return lambda size: episodes(
-        learner, behaviour, world.params, agent_rng, env_rng, size, world.cap, states, rewards,
-        returns,
-    )  # fmt: skip
+        learner, behaviour, world.params, agent_rng, env_rng, size, world.cap, buffers
+    )
 
 
 def _gymnasium_chunk(
@@ -414,6 +429,6 @@ def warm_up() -> None:
                 )  # fmt: skip
                 run(
                     learner, make_behaviour(uniform, uniform, True), world, model_arrays, errors,
-                    seed=0, count=1, record_every=1, measures=("ve", "pbe"), engine=engine,
+                    Schedule(0, 1, 1, ("ve", "pbe"), engine),
                 )  # fmt: skip
         env.close()

@@ -847,9 +847,8 @@ def run_one(study: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunReco
     )  # fmt: skip
     records = engine.run(
         learner, engine.make_behaviour(target, behaviour, study.uniform_behaviour), world, model,
-        errors, seed=seed, count=study.count, record_every=study.record_every,
-        measures=study.errors, engine=study.engine, should_stop=handle.should_stop,
-        report=handle.report,
+        errors, engine.Schedule(seed, study.count, study.record_every, study.errors, study.engine),
+        handle.should_stop, handle.report,
     )  # fmt: skip
     if records is None:
         return None
