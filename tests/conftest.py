@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 import yaml
 from hypothesis import settings
+from threadpoolctl import threadpool_limits
 from typer.testing import CliRunner, Result
 
 from cartpole_q.cli import app
@@ -22,6 +23,11 @@ CONFIGS = REPO / "configs"
 # function loads (or compiles) it, which can take longer than Hypothesis' 200 ms deadline.
 settings.register_profile("cartpole-q", deadline=None)
 settings.load_profile("cartpole-q")
+
+# LAPACK on one thread in the test process, as the package runs every solve
+# (cartpole_q.rl.solvers.one_thread): the plain re-derivations solve the same systems with
+# numpy.linalg and must get the same bits.
+_ONE_THREAD = threadpool_limits(limits=1, user_api="blas")
 
 # Rendering in tests never opens a window.
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")

@@ -29,6 +29,7 @@ from cartpole_q.experiments.sweep_spec import check_top_keys, checked_figure_sec
 from cartpole_q.progress import Units
 from cartpole_q.rl import features as layers
 from cartpole_q.rl import linear as methods
+from cartpole_q.rl.solvers import one_thread
 from cartpole_q.store.studydir import Cell, RunRecord
 
 STUDY_KEYS = (
@@ -719,7 +720,8 @@ def episodic_distribution(
     _, matrix = model.stochastic_policy_matrix(behaviour)
     system = np.eye(len(reach)) - matrix[np.ix_(reach, reach)]
     try:
-        visits = np.linalg.solve(system.T, model.initial[reach])
+        with one_thread():
+            visits = np.linalg.solve(system.T, model.initial[reach])
     except np.linalg.LinAlgError:
         raise ConfigError("behaviour: may never end an episode of this world") from None
     kept = visits[np.searchsorted(reach, measured)]
@@ -734,7 +736,8 @@ def stationary_distribution(model: Any, behaviour: np.ndarray) -> np.ndarray:
     system[-1, :] = 1.0
     unit = np.zeros(model.n_states)
     unit[-1] = 1.0
-    mu: np.ndarray = np.linalg.solve(system, unit)
+    with one_thread():
+        mu: np.ndarray = np.linalg.solve(system, unit)
     return mu
 
 
@@ -766,7 +769,8 @@ def curve_setup(study: Study, index: int) -> CurveSetup:
     dense = rows.dense(found.measured)
     pseudo = np.zeros((0, 0))
     if "pbe" in study.errors:
-        pseudo = np.linalg.pinv(_covariance(rows, found))
+        with one_thread():
+            pseudo = np.linalg.pinv(_covariance(rows, found))
     fixed: np.ndarray | None = None
     if curve.algorithm == "gradient_mc":
         fixed = methods.least_ve_weights(dense, found.mu, found.truth)

@@ -53,6 +53,8 @@ so ``0.5 / 0.55``, and the first ``v0 = 0.45 v1 + 0.45 v0``, so ``0.45 * 0.5 / 0
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -64,6 +66,23 @@ MAX_DENSE_STATES = 4096
 """above this many states, :func:`policy_values` iterates instead of solving densely"""
 SWEEP_ORDERS = ("synchronous", "in_place")
 """how a sweep updates the states: from the previous sweep's values, or one by one in place"""
+
+
+@contextlib.contextmanager
+def one_thread() -> Iterator[None]:
+    """LAPACK (``numpy.linalg``) on one thread inside: the same bits whatever the threads.
+
+    A multi-threaded LU or SVD of a large matrix (the 1000-state walk's) orders its sums by
+    the thread count, so its last bits follow ``OMP_NUM_THREADS`` (Ray's workers set it to
+    1): an exact value solved on a Ray worker differed from the same solve on this
+    machine's two threads. Inside this scope the BLAS that NumPy loaded runs on one thread
+    (``threadpoolctl``), so every solve of the package gives one answer on a given
+    installation, whichever backend or worker runs it.
+    """
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):
+        yield
 
 
 def reachable_states(model: FiniteMDP, pi: np.ndarray) -> np.ndarray:
@@ -129,7 +148,8 @@ def evaluate_policy(
         if stuck is not None:
             raise ValueError(f"from state {stuck} the policy may never end an episode")
     system = np.eye(len(chosen)) - gamma * matrix[np.ix_(chosen, chosen)]
-    values: np.ndarray = np.linalg.solve(system, expected[chosen])
+    with one_thread():
+        values: np.ndarray = np.linalg.solve(system, expected[chosen])
     return values
 
 
@@ -162,7 +182,8 @@ def on_policy_distribution(model: FiniteMDP, pi: np.ndarray, states: np.ndarray)
         raise ValueError(f"from state {stuck} the policy may never end an episode")
     _, matrix = model.stochastic_policy_matrix(np.asarray(pi, dtype=np.float64))
     system = np.eye(len(chosen)) - matrix[np.ix_(chosen, chosen)]
-    visits: np.ndarray = np.linalg.solve(system.T, model.initial[chosen])
+    with one_thread():
+        visits: np.ndarray = np.linalg.solve(system.T, model.initial[chosen])
     distribution: np.ndarray = visits / visits.sum()
     return distribution
 
@@ -273,7 +294,8 @@ def policy_values(
     if model.n_states <= MAX_DENSE_STATES:
         expected, matrix = model.policy_matrix(policy)
         try:
-            values = np.linalg.solve(np.eye(model.n_states) - gamma * matrix, expected)
+            with one_thread():
+                values = np.linalg.solve(np.eye(model.n_states) - gamma * matrix, expected)
         except np.linalg.LinAlgError:
             raise ValueError(
                 "the policy's values are not finite: with gamma 1 it never ends the episode "
