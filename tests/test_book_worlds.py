@@ -40,7 +40,7 @@ IDS = [world.id for world in WORLDS]
 DETERMINISTIC = [
     "cartpole_q/WindyGridworld-v0", "cartpole_q/KingsWindyGridworld-v0", "cartpole_q/DynaMaze-v0",
     "cartpole_q/BlockingMaze-v0", "cartpole_q/ShortcutMaze-v0", "cartpole_q/RandomWalk-v0",
-    "cartpole_q/RandomWalk5-v0",
+    "cartpole_q/RandomWalk5-v0", "cartpole_q/ShortCorridor-v0",
 ]  # fmt: skip
 
 
@@ -84,6 +84,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/RandomWalk-v0": (21, 2, 1_000),
         "cartpole_q/RandomWalk1000-v0": (1002, 2, 10_000),
         "cartpole_q/Baird-v0": (7, 2, None),  # continuing: no time limit, nothing ends
+        "cartpole_q/ShortCorridor-v0": (4, 2, None),  # the engines cut at 10,000 steps
     }
     assert set(expected) == set(IDS)
     for env_id, (states, actions, limit) in expected.items():

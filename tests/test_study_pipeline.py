@@ -45,7 +45,8 @@ def test_check_refuses_a_bad_file_naming_the_key(tmp_path: Path) -> None:
     assert_refused(invoke("study", path, "--check"), f"{path}: steps: must be a whole number")
     path = write_yaml(tmp_path / "k.yaml", {**study, "kind": "bandits"})
     assert_refused(
-        invoke("study", path, "--check"), "kind: must be one of bandit, dp, linear, sweep"
+        invoke("study", path, "--check"),
+        "kind: must be one of bandit, dp, linear, policy_gradient, sweep",
     )
 
 
@@ -108,6 +109,7 @@ RESUMED = {
         tmp, "fig8_7_expected_vs_sample", seeds="0-4", branching=[2, 10, 100]
     ),
     "linear": lambda tmp: small(tmp, "fig9_10_tile_coding", seeds="0-2", episodes=40, book=[]),
+    "policy_gradient": lambda tmp: small(tmp, "fig13_2_reinforce_baseline", seeds="0-2", episodes=60),
 }  # fmt: skip
 
 

@@ -62,6 +62,7 @@ STUDY_LOOPS: dict[str, tuple[str, Callable[[], None]]] = {
     "bandit_numba": ("the bandit testbed", lambda: _bandit("numba")),
     "bandit_gymnasium": ("the bandit testbed", lambda: _bandit("gymnasium")),
     "linear": ("the linear methods (both engines)", lambda: _linear()),
+    "policy_gradient": ("the policy-gradient methods (both engines)", lambda: _policy_gradient()),
 }
 """the compiled loops the studies run outside training (by a name, with what they play
 and how to compile them): ``compile --all`` fills the cache with them too"""
@@ -75,6 +76,12 @@ def _bandit(engine: str) -> None:
 
 def _linear() -> None:
     from cartpole_q.engines.linear import warm_up
+
+    warm_up()
+
+
+def _policy_gradient() -> None:
+    from cartpole_q.engines.policy_gradient import warm_up
 
     warm_up()
 

@@ -161,9 +161,9 @@ def read_study(study: StudyFile) -> Study:
     raw, where, name = checked_study(
         study, STUDY_KEYS, "a `world`, `curves` and `episodes` or `steps`", EXAMPLE
     )
-    world_id, world_kwargs = _world_key(raw.get("world"), where)
+    world_id, world_kwargs = world_key(raw.get("world"), where)
     facts = world_facts(world_id, world_kwargs, where)
-    gamma = _number(raw, "gamma", 1.0, where)
+    gamma = number_of(raw, "gamma", 1.0, where)
     if not 0.0 <= gamma <= 1.0:
         raise ConfigError(f"{where}: gamma: must be in [0, 1], got {gamma:g}.")
     if facts.continuing and gamma >= 1.0:
@@ -172,8 +172,8 @@ def read_study(study: StudyFile) -> Study:
             f"gamma < 1, got {gamma:g}."
         )
     count = _count_of(raw, facts.continuing, world_id, where)
-    seeds = _seeds(raw, where)
-    record_every = _whole(raw, "record_every", 1, where, 1)
+    seeds = seeds_of(raw, where)
+    record_every = whole_of(raw, "record_every", 1, where, 1)
     check_count(where, "record_every", record_every)
     engine = raw.get("engine", "numba")
     if engine not in ENGINES:
@@ -217,10 +217,13 @@ def read_study(study: StudyFile) -> Study:
         raw.get("figure", {"kind": "errors"}), name, where, FIGURE_KEYS, FIGURE_KINDS
     )
     figure = raw.get("figure", {})
-    y_limits = (_optional_number(figure, "y_min", where), _optional_number(figure, "y_max", where))
-    log_y = _flag(figure, "log_y", False, where)
-    fixed_points = _flag(figure, "fixed_points", kind == "errors", where)
-    show_errors = _flag(figure, "show_errors", True, where)
+    y_limits = (
+        optional_number_of(figure, "y_min", where),
+        optional_number_of(figure, "y_max", where),
+    )
+    log_y = flag_of(figure, "log_y", False, where)
+    fixed_points = flag_of(figure, "fixed_points", kind == "errors", where)
+    show_errors = flag_of(figure, "show_errors", True, where)
     book_raw = raw.get("book", [])
     if not isinstance(book_raw, list):
         raise ConfigError(f"{where}: book: must be a list, got {shown_value(book_raw)}.")
@@ -235,7 +238,8 @@ def read_study(study: StudyFile) -> Study:
     )  # fmt: skip
 
 
-def _world_key(raw: Any, where: str) -> tuple[str, tuple[tuple[str, Any], ...]]:
+def world_key(raw: Any, where: str) -> tuple[str, tuple[tuple[str, Any], ...]]:
+    """The ``world`` mapping's id and its kwargs (sorted pairs), checked."""
     if not isinstance(raw, Mapping) or not isinstance(raw.get("id"), str):
         raise ConfigError(
             f"{where}: world: must be a mapping with the world's id, such as {{id: "
@@ -257,12 +261,13 @@ def _count_of(raw: Mapping[str, Any], continuing: bool, world_id: str, where: st
         raise ConfigError(f"{where}: {other}: {world_id} is {nature}; give `{given}` instead.")
     if given not in raw:
         raise ConfigError(f"{where}: {given}: is missing; how many {given} each run lasts.")
-    count = _whole(raw, given, None, where, 1)
+    count = whole_of(raw, given, None, where, 1)
     check_count(where, given, count)
     return count
 
 
-def _seeds(raw: Mapping[str, Any], where: str) -> tuple[int, ...]:
+def seeds_of(raw: Mapping[str, Any], where: str) -> tuple[int, ...]:
+    """The ``seeds`` key as run seeds (``0-29``, a list, a number)."""
     try:
         return parse_seeds(raw.get("seeds", 0))
     except ValueError as error:
@@ -275,7 +280,7 @@ def _policy(raw: Any, key: str, n: int, where: str) -> tuple[tuple[float, ...], 
         return tuple(1.0 / n for _ in range(n)), True
     values: list[float] = []
     for item in raw if isinstance(raw, list) else []:
-        number = _fraction(item)
+        number = fraction_of(item)
         if number is None or number < 0.0:
             values = []
             break
@@ -288,7 +293,7 @@ def _policy(raw: Any, key: str, n: int, where: str) -> tuple[tuple[float, ...], 
     return tuple(values), False
 
 
-def _fraction(item: Any) -> float | None:
+def fraction_of(item: Any) -> float | None:
     """A number, or text ``a/b`` read as ``a / b`` (float64), else ``None``."""
     if isinstance(item, bool):
         return None
@@ -350,10 +355,10 @@ def _curve(raw: Any, index: int, facts: WorldFacts, on_policy: bool, where: str)
         raise ConfigError(
             f"{here}.alpha: lstd has no step size (its weights solve M c); remove it."
         )
-    alpha = _number(raw, "alpha", 0.0 if algorithm == "lstd" else None, here, dotted=True)
+    alpha = number_of(raw, "alpha", 0.0 if algorithm == "lstd" else None, here, dotted=True)
     if algorithm != "lstd" and not alpha > 0.0:
         raise ConfigError(f"{here}.alpha: must be positive, got {alpha:g}.")
-    beta = _number(
+    beta = number_of(
         raw, "beta", 0.0 if algorithm not in methods.WITH_BETA else None, here, dotted=True
     )
     if algorithm in methods.WITH_BETA and not beta > 0.0:
@@ -362,13 +367,13 @@ def _curve(raw: Any, index: int, facts: WorldFacts, on_policy: bool, where: str)
         raise ConfigError(
             f"{here}.beta: {algorithm} has no second step size (tdc, gtd2 and expected_tdc have)."
         )
-    epsilon = _number(raw, "epsilon", 1.0, here, dotted=True)
+    epsilon = number_of(raw, "epsilon", 1.0, here, dotted=True)
     if "epsilon" in raw and algorithm != "lstd":
         raise ConfigError(f"{here}.epsilon: only lstd takes it (its M starts at I / epsilon).")
     if not epsilon > 0.0:
         raise ConfigError(f"{here}.epsilon: must be positive, got {epsilon:g}.")
     _, _, weights = _layer_size(features, facts)
-    w0 = _w0(raw.get("w0", 0.0), weights, f"{here}.w0")
+    w0 = weights_of(raw.get("w0", 0.0), weights, f"{here}.w0")
     return CurveSpec(label, str(algorithm), features, alpha, beta, epsilon, w0)
 
 
@@ -435,7 +440,7 @@ def _tiles(raw: Mapping[str, Any], dimensions: int, here: str) -> FeatureSpec:
     bounds = []
     for key in ("low", "high"):
         value = raw.get(key)
-        numbers = [_fraction(item) for item in value] if isinstance(value, list) else []
+        numbers = [fraction_of(item) for item in value] if isinstance(value, list) else []
         if len(numbers) != dimensions or any(v is None for v in numbers):
             raise ConfigError(
                 f"{here}.{key}: must be a list of {dimensions} numbers, got {shown_value(value)}."
@@ -451,13 +456,14 @@ def _tiles(raw: Mapping[str, Any], dimensions: int, here: str) -> FeatureSpec:
     return FeatureSpec("tiles", bins=tuple(bins), low=bounds[0], high=bounds[1], tilings=tilings)
 
 
-def _w0(raw: Any, weights: int, here: str) -> tuple[float, ...]:
+def weights_of(raw: Any, weights: int, here: str) -> tuple[float, ...]:
+    """Starting weights: one number for every weight, or a list of ``weights``."""
     if isinstance(raw, list):
-        numbers = [_fraction(item) for item in raw]
+        numbers = [fraction_of(item) for item in raw]
         if len(numbers) == weights and all(v is not None for v in numbers):
             return tuple(float(v) for v in numbers if v is not None)
     else:
-        number = _fraction(raw)
+        number = fraction_of(raw)
         if number is not None and not isinstance(raw, str):
             return (number,)
     raise ConfigError(
@@ -514,9 +520,10 @@ def _book(
     )
 
 
-def _number(
+def number_of(
     raw: Mapping[str, Any], key: str, default: float | None, where: str, dotted: bool = False
 ) -> float:
+    """A finite number at ``key`` (text such as ``1e-3`` read as a number)."""
     value = raw.get(key, default)
     if isinstance(value, str):
         with contextlib.suppress(ValueError):
@@ -529,13 +536,15 @@ def _number(
     return float(value)
 
 
-def _optional_number(raw: Any, key: str, where: str) -> float | None:
+def optional_number_of(raw: Any, key: str, where: str) -> float | None:
+    """``figure.<key>`` as a number, or ``None`` when absent."""
     if not isinstance(raw, Mapping) or raw.get(key) is None:
         return None
-    return _number(raw, key, None, f"{where}: figure", dotted=True)
+    return number_of(raw, key, None, f"{where}: figure", dotted=True)
 
 
-def _flag(raw: Any, key: str, default: bool, where: str) -> bool:
+def flag_of(raw: Any, key: str, default: bool, where: str) -> bool:
+    """``figure.<key>`` as true or false."""
     value = raw.get(key, default) if isinstance(raw, Mapping) else default
     if not isinstance(value, bool):
         raise ConfigError(
@@ -544,7 +553,8 @@ def _flag(raw: Any, key: str, default: bool, where: str) -> bool:
     return value
 
 
-def _whole(raw: Mapping[str, Any], key: str, default: int | None, where: str, least: int) -> int:
+def whole_of(raw: Mapping[str, Any], key: str, default: int | None, where: str, least: int) -> int:
+    """A whole number at ``key``, at least ``least``."""
     value = raw.get(key, default)
     if isinstance(value, bool) or not isinstance(value, int) or value < least:
         raise ConfigError(
@@ -575,6 +585,8 @@ class WorldFacts:
     declared: np.ndarray | None
     transitions: Mapping[int, Mapping[int, Sequence[tuple[float, int, float, bool]]]]
     initial: np.ndarray
+    declared_actions: np.ndarray | None = None
+    """float64 ``(N, n, d)`` (``features_of_action``: a policy's features), or ``None``"""
 
 
 @functools.lru_cache(maxsize=8)
@@ -626,6 +638,7 @@ def world_facts(world_id: str, kwargs: tuple[tuple[str, Any], ...], where: str) 
         None if points is None else np.asarray(points), low, high,
         None if groups is None else np.asarray(groups, dtype=np.int64), observations,
         getattr(world, "features_of_state", None), transitions, np.asarray(initial, dtype=np.float64),
+        getattr(world, "features_of_action", None),
     )  # fmt: skip
 
 
@@ -845,9 +858,9 @@ def run_one(study: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunReco
         np.zeros(facts.n_states),
     )  # fmt: skip
     world = engine.World(
-        world_table(study), study.continuing,
+        world_table(study.world_id, study.world_kwargs, study.where), study.continuing,
         facts.time_limit if facts.time_limit else engine.EPISODE_CAP,
-        functools.partial(_make, study.world_id, study.world_kwargs),
+        functools.partial(make_world, study.world_id, study.world_kwargs),
     )  # fmt: skip
     records = engine.run(
         learner, engine.make_behaviour(target, behaviour, study.uniform_behaviour), world, model,
@@ -862,19 +875,22 @@ def run_one(study: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunReco
 
 
 @functools.lru_cache(maxsize=8)
-def world_table(study: Study) -> tuple[np.ndarray, ...]:
+def world_table(
+    world_id: str, world_kwargs: tuple[tuple[str, Any], ...], where: str
+) -> tuple[np.ndarray, ...]:
     """The world's table as the compiled loops step it (once per process)."""
     from cartpole_q.families.tables.twin import table_params
 
-    env = _make(study.world_id, study.world_kwargs)
+    env = make_world(world_id, world_kwargs)
     params = table_params(env.unwrapped, aggregated=True)
     env.close()
     if isinstance(params, str):  # (world_facts has read the same table)
-        raise ConfigError(f"{study.where}: world: {study.world_id}: {params}.")
+        raise ConfigError(f"{where}: world: {world_id}: {params}.")
     return params
 
 
-def _make(world_id: str, kwargs: tuple[tuple[str, Any], ...]) -> Any:
+def make_world(world_id: str, kwargs: tuple[tuple[str, Any], ...]) -> Any:
+    """``gymnasium.make`` of the world with its kwargs."""
     import gymnasium
 
     return gymnasium.make(world_id, **dict(kwargs))

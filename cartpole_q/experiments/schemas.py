@@ -42,6 +42,7 @@ from cartpole_q.experiments import (
     bandits,
     linear,
     planning,
+    policy_gradient,
     study_kinds,
     sweep_spec,
     tune_spec,
@@ -92,9 +93,9 @@ def study_schema() -> Schema:
 
     >>> schema = study_schema()
     >>> sorted(name for name in schema["$defs"] if "." not in name)
-    ['bandit', 'config', 'dp', 'linear', 'sweep', 'tune', 'updates']
+    ['bandit', 'config', 'dp', 'linear', 'policy_gradient', 'sweep', 'tune', 'updates']
     >>> schema["properties"]["kind"]["enum"]
-    ['bandit', 'dp', 'linear', 'sweep', 'updates']
+    ['bandit', 'dp', 'linear', 'policy_gradient', 'sweep', 'updates']
     """
     schemas = kind_schemas()
     kinds = sorted(schemas)
@@ -160,7 +161,7 @@ def kind_schemas() -> dict[str, Schema]:
     """
     built = {
         "sweep": _sweep(), "bandit": _bandit(), "dp": _dp(), "updates": _updates(),
-        "linear": _linear(),
+        "linear": _linear(), "policy_gradient": _policy_gradient(),
     }  # fmt: skip
     missing = sorted(set(study_kinds.registered()) - set(built))
     if missing:
@@ -728,6 +729,54 @@ def _linear_book() -> Schema:
     }, ["label", "curve"])  # fmt: skip
     _check_keys(book, linear.BOOK_KEYS)
     return book
+
+
+# -- policy gradient ------------------------------------------------------------------------
+
+
+def _policy_gradient() -> Schema:
+    from cartpole_q.rl import policy_gradient as methods
+
+    number = _bandit_number()
+    world = _object(
+        {"id": {"type": "string", "minLength": 1}, "kwargs": {"type": "object"}}, ["id"]
+    )
+    count = {"type": "integer", "minimum": 1, "maximum": MAX_COUNT}
+    positive = _bandit_number(0.0, low_open=True)
+    numbers = {"type": "array", "minItems": 1, "items": number}
+    curve = _object({
+        "label": TEXT,
+        "algorithm": {"enum": list(methods.ALGORITHMS)},
+        "alpha": positive,
+        "alpha_w": positive,
+        "policy_features": {"enum": list(methods.POLICY_LAYERS)},
+        "value_features": {"enum": list(methods.VALUE_LAYERS)},
+        "theta0": {"anyOf": [number, numbers]},
+        "w0": {"anyOf": [number, numbers]},
+        "min_probability": _bandit_number(0.0, 0.5),
+    }, ["algorithm", "alpha"])  # fmt: skip
+    _check_keys(curve, policy_gradient.CURVE_KEYS)
+    curve["allOf"] = [
+        {"if": {"properties": {"algorithm": {"enum": list(methods.WITH_VALUE)}}},
+         "then": {"required": ["alpha_w"]},
+         "else": {"properties": {"alpha_w": False, "value_features": False, "w0": False}}},
+    ]  # fmt: skip
+    own = {"y_min": number, "y_max": number, "optimum": BOOLEAN}
+    properties: dict[str, Schema] = {
+        "name": NAME,
+        "world": world,
+        "gamma": number_schema(0.0, 1.0),
+        "seeds": seeds_schema(),
+        "episodes": count,
+        "engine": {"enum": list(policy_gradient.ENGINES)},
+        "curves": {"type": "array", "minItems": 1, "items": curve},
+        "figure": _study_figure(policy_gradient.FIGURE_KEYS, policy_gradient.FIGURE_KINDS, own),
+    }
+    schema = _kind(
+        "policy_gradient", policy_gradient.STUDY_KEYS, properties, "Policy-gradient files"
+    )
+    schema["required"] = ["world", "episodes", "curves"]
+    return schema
 
 
 # -- what the kinds share --------------------------------------------------------------------

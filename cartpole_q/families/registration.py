@@ -12,6 +12,7 @@ id                                         world
 ``cartpole_q/MaximizationBias-v0``         Example 6.7, Figure 6.5 (:mod:`~cartpole_q.families.book_mdps`)
 ``cartpole_q/OneState-v0``                 Example 5.5, Figure 5.4 (:mod:`~cartpole_q.families.book_mdps`)
 ``cartpole_q/Baird-v0``                    Example 11.1, Figures 11.2, 11.5, 11.6: Baird's counterexample (continuing)
+``cartpole_q/ShortCorridor-v0``            Example 13.1, Figures 13.1, 13.2: the short corridor with switched actions
 ``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.families.walks`)
 ``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
 ``cartpole_q/RandomWalk1000-v0``           Example 9.1, Figures 9.1, 9.2: 1000 states, jumps of up to 100 (``groups``: state aggregation)

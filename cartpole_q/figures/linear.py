@@ -24,8 +24,13 @@ class ErrorCurve:
 def error_curves_figure(
     curves: Sequence[ErrorCurve], title: str, x_label: str, y_label: str,
     y_limits: tuple[float | None, float | None] = (None, None), log_y: bool = False,
+    levels: Sequence[tuple[str, float]] = (),
 ) -> DataFigure:  # fmt: skip
-    """Figures 9.5, 9.10: each curve's error against the episodes, its fixed point dashed."""
+    """Figures 9.5, 9.10, 13.1, 13.2: each curve against the episodes, its fixed point dashed.
+
+    ``levels`` are further ``(name, value)`` levels, drawn dashed in black (the best start
+    value of Figures 13.1 and 13.2).
+    """
     figure = DataFigure(figsize=CURVE_SIZE, dpi=DPI, layout="constrained")
     axes = figure.add_subplot()
     record = figure.data.panel("")
@@ -37,6 +42,9 @@ def error_curves_figure(
             name = f"{curve.label}: its fixed point"
             axes.axhline(curve.fixed, color=colour, linewidth=0.8, linestyle="--", label=name)
             record.level(name, curve.fixed)
+    for name, value in levels:
+        axes.axhline(value, color="black", linewidth=1.0, linestyle="--", label=name)
+        record.level(name, value)
     if log_y:
         axes.set_yscale("log")
     axes.set_ylim(*y_limits)

@@ -1,4 +1,4 @@
-"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1).
+"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1), the short corridor (13.1).
 
 Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state`,
 :mod:`~cartpole_q.families.book_mdps.bias` and :mod:`~cartpole_q.families.book_mdps.baird`
@@ -21,6 +21,7 @@ from cartpole_q.families.tables import load_twin as load_table_twin
 _BAIRD = "cartpole_q.families.book_mdps.baird"
 _BIAS = "cartpole_q.families.book_mdps.bias"
 _ONE_STATE = "cartpole_q.families.book_mdps.one_state"
+_CORRIDOR = "cartpole_q.families.book_mdps.short_corridor"
 ONE_STATE_TIME_LIMIT = 1_000
 """steps before an episode of the one-state MDP is truncated (left comes back with
 probability 0.9: ten steps on average)"""
@@ -68,11 +69,23 @@ BAIRD = EnvProfile(
     twin=load_table_twin,
 )
 
-PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD)
+SHORT_CORRIDOR = EnvProfile(
+    name="ShortCorridor",
+    description="the short corridor with switched actions: three states that look alike, "
+    "the middle one switching left and right, -1 per step (Sutton & Barto's Example 13.1)",
+    ids=("cartpole_q/ShortCorridor-v0",),
+    entry_points=(f"{_CORRIDOR}:ShortCorridorEnv",),
+    action_names=("left", "right"),
+    model="transition_table",
+    twin=load_table_twin,
+)
+
+PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR)
 """the family's profiles"""
 WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
     World(f"{NAMESPACE}/OneState-v0", f"{_ONE_STATE}:OneStateEnv", ONE_STATE_TIME_LIMIT),
     World(f"{NAMESPACE}/Baird-v0", f"{_BAIRD}:BairdEnv", None),
+    World(f"{NAMESPACE}/ShortCorridor-v0", f"{_CORRIDOR}:ShortCorridorEnv", None),
 )
 """the worlds it registers"""

@@ -52,6 +52,11 @@ class TableWorld(gymnasium.Env[Any, Any]):
     counterexample), which a ``linear`` study's ``features: {kind: declared}`` takes
     (``None``: none)"""
 
+    features_of_action: np.ndarray | None = None
+    """float64 ``(n_states, n_actions, d)``: the features of each state-action pair the world
+    declares for a policy's preferences (the short corridor), which a ``policy_gradient``
+    study's ``policy_features: declared`` takes (``None``: none)"""
+
     def __init__(self, n_states: int, n_actions: int, start: int) -> None:
         self.observation_space = spaces.Discrete(n_states)
         self.action_space = spaces.Discrete(n_actions)

@@ -1,0 +1,180 @@
+"""Policy-gradient methods: a softmax policy on linear preferences, and its updates (13.1-13.5).
+
+The policy in state ``s`` is the softmax of ``h(s, a, θ) = θᵀx(s, a)`` over the actions
+(Sutton & Barto eq. 13.2), ``x(s, a)`` a row of the policy's feature layer (pairs of a
+weight index and a value, one row per state-action pair ``s * n + a``). REINFORCE (13.3),
+REINFORCE with a baseline (13.4) and one-step actor-critic (13.5) move ``θ`` along the
+eligibility vector ``∇ ln π(a | s, θ)``; the last two also learn ``v̂(s, w) = wᵀx(s)`` on a
+second layer. Every function here is compiled by the engines
+(:mod:`cartpole_q.engines.policy_gradient`); the arithmetic and its order are the contract
+of docs/algorithms.md ("Policy gradient"), which ``tests/reference_policy_gradient.py``
+re-derives.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from cartpole_q.rl.linear import add_along, estimate
+from cartpole_q.rl.tabular import compilable
+
+ALGORITHMS = ("reinforce", "reinforce_baseline", "actor_critic")
+CODES = {name: code for code, name in enumerate(ALGORITHMS)}
+REINFORCE, REINFORCE_BASELINE, ACTOR_CRITIC = range(len(ALGORITHMS))
+WITH_VALUE = ("reinforce_baseline", "actor_critic")
+"""the algorithms that learn ``v̂`` too (and take ``alpha_w``)"""
+POLICY_LAYERS = ("declared", "table")
+VALUE_LAYERS = ("constant", "table")
+
+
+class Agent(NamedTuple):
+    """One curve's learner: its algorithm, step sizes, both layers, and room to work in."""
+
+    code: int
+    """the algorithm (:data:`CODES`)"""
+    alpha: float
+    """the policy's step size (the book's alpha, or alpha^theta)"""
+    alpha_w: float
+    gamma: float
+    floor: float
+    """two actions: the least probability either may have (0.0: none; Zhang's script: 0.05)"""
+    n_actions: int
+    policy_index: np.ndarray
+    """int64 ``(N * n, K)``: the policy layer's rows, row ``s * n + a``"""
+    policy_value: np.ndarray
+    theta: np.ndarray
+    """float64 ``(d,)``"""
+    value_index: np.ndarray
+    """int64 ``(N, K_w)``: the value layer's rows"""
+    value_value: np.ndarray
+    w: np.ndarray
+    """float64 ``(d_w,)``"""
+    probabilities: np.ndarray
+    """float64 ``(n,)``: room for ``π(· | s)``"""
+    gradient: np.ndarray
+    """float64 ``(d,)``: room for ``∇ ln π``"""
+
+
+def new_agent(
+    algorithm: str, alpha: float, alpha_w: float, gamma: float, floor: float, n_actions: int,
+    policy_rows: tuple[np.ndarray, np.ndarray], theta0: np.ndarray,
+    value_rows: tuple[np.ndarray, np.ndarray], w0: np.ndarray,
+) -> Agent:  # fmt: skip
+    """An agent at its start: ``θ = theta0``, ``w = w0`` (copied)."""
+    return Agent(
+        CODES[algorithm], float(alpha), float(alpha_w), float(gamma), float(floor), int(n_actions),
+        policy_rows[0], policy_rows[1], theta0.astype(np.float64, copy=True),
+        value_rows[0], value_rows[1], w0.astype(np.float64, copy=True),
+        np.zeros(n_actions), np.zeros(theta0.shape[0]),
+    )  # fmt: skip
+
+
+@compilable
+def policy(agent: Any, state: int) -> None:
+    """``agent.probabilities = π(· | state)``: the softmax of the preferences, from the largest.
+
+    With a floor (two actions), the smaller probability is raised to it.
+    """
+    n = agent.n_actions
+    out = agent.probabilities
+    for a in range(n):
+        out[a] = estimate(agent.policy_index, agent.policy_value, agent.theta, state * n + a)
+    largest = out[0]
+    for a in range(1, n):
+        if out[a] > largest:
+            largest = out[a]
+    for a in range(n):
+        out[a] = math.exp(out[a] - largest)
+    total = 0.0
+    for a in range(n):
+        total = total + out[a]
+    for a in range(n):
+        out[a] = out[a] / total
+    if agent.floor > 0.0:  # two actions: the smaller (action 0 on a tie) raised to the floor
+        low = 0 if out[0] <= out[1] else 1
+        if out[low] < agent.floor:
+            out[low] = agent.floor
+            out[1 - low] = 1.0 - agent.floor
+
+
+@compilable
+def draw(probabilities: Any, rng: Any) -> int:
+    """One ``rng.random()`` against the running sums; the last possible action if none is above."""
+    u = rng.random()
+    running = 0.0
+    for a in range(probabilities.shape[0]):
+        running = running + probabilities[a]
+        if u < running:
+            return a
+    last: int = probabilities.shape[0] - 1
+    while last > 0 and not probabilities[last] > 0.0:
+        last -= 1
+    return last
+
+
+@compilable
+def choose(agent: Any, state: int, rng: Any) -> int:
+    """The action drawn from ``π(· | state)`` with the current ``θ``."""
+    policy(agent, state)
+    return draw(agent.probabilities, rng)
+
+
+@compilable
+def move_policy(agent: Any, state: int, action: int, amount: float) -> None:
+    """``θ = θ + amount * ∇ ln π(action | state, θ)``, the gradient from the current ``θ``."""
+    policy(agent, state)
+    n = agent.n_actions
+    index, value, g = agent.policy_index, agent.policy_value, agent.gradient
+    for i in range(g.shape[0]):
+        g[i] = 0.0
+    row = state * n + action
+    for j in range(index.shape[1]):
+        g[index[row, j]] = g[index[row, j]] + value[row, j]
+    for b in range(n):
+        row = state * n + b
+        for j in range(index.shape[1]):
+            g[index[row, j]] = g[index[row, j]] - agent.probabilities[b] * value[row, j]
+    theta = agent.theta
+    for i in range(theta.shape[0]):
+        theta[i] = theta[i] + amount * g[i]
+
+
+@compilable
+def learn_episode(
+    agent: Any, states: Any, actions: Any, rewards: Any, length: int, returns: Any
+) -> None:
+    """REINFORCE (with or without a baseline) after an episode of ``length`` steps.
+
+    ``states[t]`` is ``S_t``, ``actions[t]`` is ``A_t``, ``rewards[t]`` is ``R_{t+1}``.
+    """
+    g = 0.0
+    for t in range(length - 1, -1, -1):
+        g = rewards[t] + agent.gamma * g
+        returns[t] = g
+    k = 1.0
+    for t in range(length):
+        state = states[t]
+        if agent.code == REINFORCE_BASELINE:
+            delta = returns[t] - estimate(agent.value_index, agent.value_value, agent.w, state)
+            add_along(agent.value_index, agent.value_value, agent.w, state, agent.alpha_w * delta)
+            move_policy(agent, state, actions[t], (agent.alpha * k) * delta)
+        else:
+            move_policy(agent, state, actions[t], (agent.alpha * k) * returns[t])
+        k = k * agent.gamma
+
+
+@compilable
+def learn_step(
+    agent: Any, state: int, action: int, reward: float, following: int, terminated: bool,
+    discount: Any,
+) -> None:  # fmt: skip
+    """One-step actor-critic after a step; ``discount[0]`` is the episode's ``I``."""
+    index, value, w = agent.value_index, agent.value_value, agent.w
+    after = 0.0 if terminated else estimate(index, value, w, following)
+    delta = reward + agent.gamma * after - estimate(index, value, w, state)
+    add_along(index, value, w, state, agent.alpha_w * delta)
+    move_policy(agent, state, action, (agent.alpha * discount[0]) * delta)
+    discount[0] = agent.gamma * discount[0]
