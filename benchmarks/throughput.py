@@ -26,11 +26,14 @@ Rows:
                     the gymnasium engine on the same run (√VE recorded every 100 episodes or
                     1,000 steps), env steps per second; the expected methods' sweeps per
                     second on Baird's
+  policy_gradient   REINFORCE, REINFORCE with baseline and one-step actor-critic on the short
+                    corridor (Figure 13.2's settings, 1,000 episodes): the numba engine
+                    against the gymnasium engine on the same run, env steps per second
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
 same run, so they hold across machines even when absolute rates do not. --only SECTION runs
 one section (cartpole, algorithms, environments, tabular, prediction, tiles, linear,
-progress); the algorithms section
+policy_gradient, progress); the algorithms section
 then measures its own Q-learning baseline.
 """
 
@@ -203,7 +206,7 @@ TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
 
 SECTIONS = (
     "cartpole", "algorithms", "environments", "tabular", "prediction", "tiles", "linear",
-    "progress",
+    "policy_gradient", "progress",
 )  # fmt: skip
 """what --only can pick; by default every section runs, in this order"""
 
@@ -417,7 +420,7 @@ def linear_rate(raw: dict, engine: str, count: int) -> tuple[int, float]:
         steps[0] = done
 
     linear.curve_setup(study, 0)  # the model's solves and the layer: set-up, not stepping
-    linear.world_table(study)
+    linear.world_table(study.world_id, study.world_kwargs, study.where)
     start = time.perf_counter()
     record = linear.run_one(study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, count_steps))
     seconds = time.perf_counter() - start
@@ -470,6 +473,57 @@ def linear_rows(repeats: int, scale: float) -> None:
         print(
             f"{label:40s} {gym_rate:14,.0f} {numba_rate:13,.0f} {numba_rate / gym_rate:6,.0f}x "
             f"{count:9,d} {unit:>10s}"
+        )
+
+
+POLICY_GRADIENT_CURVES = (
+    {"algorithm": "reinforce", "alpha": 2**-13, "theta0": [-1.47, 1.47], "min_probability": 0.05},
+    {"algorithm": "reinforce_baseline", "alpha": 2**-9, "alpha_w": 2**-6,
+     "theta0": [-1.47, 1.47], "min_probability": 0.05},
+    {"algorithm": "actor_critic", "alpha": 2**-9, "alpha_w": 2**-6, "theta0": [-1.47, 1.47],
+     "min_probability": 0.05},
+)  # fmt: skip
+"""the policy-gradient section's rows: each method on the short corridor"""
+
+
+def policy_gradient_rate(curve: dict, engine: str, episodes: int) -> tuple[int, float]:
+    """One run of a policy-gradient curve on the short corridor: ``(env steps, seconds)``."""
+    from cartpole_q.experiments import linear, policy_gradient
+    from cartpole_q.experiments.study import RunHandle, study_of
+
+    study = policy_gradient.read_study(study_of(
+        {"kind": "policy_gradient", "world": {"id": "cartpole_q/ShortCorridor-v0"},
+         "episodes": episodes, "engine": engine, "curves": [curve]},
+        "benchmark", "b", Path("."),
+    ))  # fmt: skip
+    linear.world_table(study.world_id, study.world_kwargs, study.where)
+    start = time.perf_counter()
+    record = policy_gradient.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, lambda n: None)
+    )
+    seconds = time.perf_counter() - start
+    assert record is not None
+    return int(np.sum(record.arrays["lengths"])), seconds
+
+
+def policy_gradient_rows(repeats: int, scale: float) -> None:
+    """Each policy-gradient method: the numba engine against the gymnasium engine, the same run."""
+    print(
+        f"{'policy-gradient method':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s} "
+        f"{'episodes':>9s}"
+    )
+    episodes = max(50, int(1000 * scale))
+    for curve in POLICY_GRADIENT_CURVES:
+        policy_gradient_rate(curve, "numba", 2)  # compile or load the cache
+        numba_rate = median_rate(
+            lambda c=curve: policy_gradient_rate(c, "numba", episodes), max(3, repeats)
+        )
+        gym_rate = median_rate(
+            lambda c=curve: policy_gradient_rate(c, "gymnasium", max(20, episodes // 10)), repeats
+        )
+        print(
+            f"{curve['algorithm'] + ', short corridor':40s} {gym_rate:14,.0f} {numba_rate:13,.0f} "
+            f"{numba_rate / gym_rate:6,.0f}x {episodes:9,d}"
         )
 
 
@@ -556,6 +610,8 @@ def main() -> None:
             tile_rows(args.repeats, scale)
         elif section == "linear":
             linear_rows(args.repeats, scale)
+        elif section == "policy_gradient":
+            policy_gradient_rows(args.repeats, scale)
         else:
             progress_row(args.repeats, python_episodes)
 
