@@ -611,9 +611,16 @@ class TraceAgent(Agent):
                 z = 1.0
             elif kind == "dutch":
                 z = (1.0 - alpha) * z + 1.0
+            elif kind == "clearing":
+                z = 1.0
             else:
                 raise ValueError(f"unknown trace {kind!r}")
             self.traces[flat] = z
+            if kind == "clearing":  # the row's other actions that have a trace: 0.0, kept
+                for b in range(self.n):
+                    other = row * self.n + b
+                    if b != a and other in self.traces:
+                        self.traces[other] = 0.0
 
     def decay(self) -> None:
         """``z = (gamma * lambda) * z`` for every trace; traces now exactly 0.0 are dropped."""

@@ -108,6 +108,8 @@ EDGE_VARIANTS: dict[str, tuple[str, dict[str, Any]]] = {
     "n_step_sarsa-n150": ("n_step_sarsa", {"n": 150}),
     "n_step_tree_backup-n150": ("n_step_tree_backup", {"n": 150}),
     "sarsa_lambda-dutch-lambda0": ("sarsa_lambda", {"lambda": 0.0, "trace": "dutch"}),
+    # replacing with clearing (Figure 12.11): FrozenLake's four actions and tiles
+    "sarsa_lambda-clearing": ("sarsa_lambda", {"lambda": 0.8, "trace": "clearing"}),
     "sarsa_lambda-accumulating-lambda0.1": (
         "sarsa_lambda",
         {"lambda": 0.1, "trace": "accumulating"},

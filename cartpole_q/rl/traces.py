@@ -41,14 +41,16 @@ from cartpole_q.rl.tabular import (
     tiles_variant,
 )
 
-TRACE_KINDS = ("accumulating", "replacing", "dutch")
+TRACE_KINDS = ("accumulating", "replacing", "dutch", "clearing")
 """``agent.trace`` values, in the order of their codes"""
-ACCUMULATING, REPLACING, DUTCH = 0, 1, 2
+ACCUMULATING, REPLACING, DUTCH, CLEARING = 0, 1, 2, 3
 
 LAMBDA = Param("lambda", 0.9, "the trace decay lambda (0: one-step)", low=0.0, high=1.0)
 """``agent.lambda`` of the trace methods"""
 TRACE = Param(
-    "trace", "replacing", "how a visit sets its pair's trace: z + 1, 1, or (1 - alpha) z + 1",
+    "trace", "replacing",
+    "how a visit sets its pair's trace: z + 1, 1, (1 - alpha) z + 1, or 1 with the traces of "
+    "the state's other actions set to 0 (replacing with clearing)",
     kind="choice", choices=TRACE_KINDS,
 )  # fmt: skip
 """``agent.trace`` of SARSA(lambda) and Watkins's Q(lambda)"""
@@ -107,7 +109,7 @@ def set_trace(values: np.ndarray, where: int, kind: int, alpha: float) -> None:
     """The trace at ``where`` after a visit: ``z + 1``, ``1`` or ``(1 - alpha) z + 1``."""
     if kind == ACCUMULATING:
         values[where] = values[where] + 1.0
-    elif kind == REPLACING:
+    elif kind in (REPLACING, CLEARING):
         values[where] = 1.0
     else:
         values[where] = (1.0 - alpha) * values[where] + 1.0
@@ -125,6 +127,23 @@ def give_trace(
     """
     where = trace_slot(values, states, actions, slots, count, state, action, n_actions)
     set_trace(values, where, kind, visit_step(alpha, state, action))
+    if kind == CLEARING:
+        clear_other_actions(values, slots, state, action, n_actions)
+
+
+@compilable
+def clear_other_actions(
+    values: np.ndarray, slots: np.ndarray, row: int, action: int, n_actions: int
+) -> None:
+    """Replacing with clearing: every other action's trace of ``row`` that exists becomes 0.0.
+
+    A cleared trace stays in the list (its slot) until a decay drops it, as any trace of 0.0.
+    """
+    for other in range(n_actions):
+        if other != action:
+            where = slots[row * n_actions + other]
+            if where >= 0:
+                values[where] = 0.0
 
 
 @tiles_variant(give_trace)
@@ -134,7 +153,8 @@ def give_tile_traces(
 ) -> None:  # fmt: skip
     """Give each of the state's tiles its trace, the dutch one over all of them at once.
 
-    Accumulating and replacing set each tile's trace alone. Dutch is Sutton & Barto's
+    Accumulating, replacing and clearing set each tile's trace alone (clearing also zeroes
+    that tile's traces of the other actions). Dutch is Sutton & Barto's
     (eq. 12.11) for the binary features of the ``T`` tiles, whose decayed traces sum to
     ``S``: every tile ``z = z + (1.0 - (alpha / T) * S)`` (one-hot features, ``T = 1``, give
     ``(1 - alpha) z + 1``).
@@ -149,6 +169,8 @@ def give_tile_traces(
         row = features[state, t]
         where = trace_slot(values, states, actions, slots, count, row, action, n_actions)
         set_trace(values, where, kind, alpha)
+        if kind == CLEARING:
+            clear_other_actions(values, slots, row, action, n_actions)
 
 
 @compilable
