@@ -28,7 +28,8 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-ALGORITHMS = ("reinforce", "reinforce_baseline", "actor_critic")
+ALGORITHMS = ("reinforce", "reinforce_baseline", "actor_critic", "actor_critic_lambda")
+PER_STEP = ("actor_critic", "actor_critic_lambda")
 CUT = 10_000  # an episode of a world without a time limit is cut after this many steps
 
 
@@ -234,6 +235,8 @@ def run_policy_gradient(
     seed: int,
     episodes: int,
     min_probability: float = 0.0,
+    lambda_theta: float = 0.0,
+    lambda_w: float = 0.0,
 ) -> dict[str, np.ndarray]:
     """One run of a curve, as the contract states it.
 
@@ -248,7 +251,8 @@ def run_policy_gradient(
     world = make_world(env_id, kwargs)
     try:
         return _run(world, gamma, algorithm, alpha, alpha_w, policy_features, value_features,
-                    theta0, w0, seed, int(episodes), float(min_probability))  # fmt: skip
+                    theta0, w0, seed, int(episodes), float(min_probability),
+                    (float(lambda_theta), float(lambda_w)))  # fmt: skip
     finally:
         world.env.close()
 
@@ -256,7 +260,8 @@ def run_policy_gradient(
 def _run(world: World, gamma: float, algorithm: str, alpha: float, alpha_w: float,
          policy_features: str | None, value_features: str | None,
          theta0: float | Sequence[float], w0: float | Sequence[float], seed: int,
-         episodes: int, floor: float) -> dict[str, np.ndarray]:  # fmt: skip
+         episodes: int, floor: float,
+         lambdas: tuple[float, float]) -> dict[str, np.ndarray]:  # fmt: skip
     rows, d = policy_layer(world, policy_features)
     value_rows, d_w = value_layer(world, value_features)
     theta = _start_weights(theta0, d, "theta0")
@@ -276,6 +281,8 @@ def _run(world: World, gamma: float, algorithm: str, alpha: float, alpha_w: floa
         actions: list[int] = []
         step_rewards: list[float] = []
         big_i = 1.0
+        z_theta = [0.0] * d
+        z_w = [0.0] * d_w
         while True:
             a = draw(rng, policy(rows[s], theta, floor))
             _, reward, terminated, truncated, _ = env.step(a)
@@ -294,11 +301,25 @@ def _run(world: World, gamma: float, algorithm: str, alpha: float, alpha_w: floa
                 g = eligibility(rows[s], a, theta, d, floor)
                 move(theta, (alpha * big_i) * delta, g)
                 big_i = gamma * big_i
+            elif algorithm == "actor_critic_lambda":
+                following = 0.0 if terminated else v_hat(value_rows[s2], w)
+                delta = r + gamma * following - v_hat(value_rows[s], w)
+                for i in range(d_w):
+                    z_w[i] = (gamma * lambdas[1]) * z_w[i]
+                add_along(value_rows[s], z_w, 1.0)
+                g = eligibility(rows[s], a, theta, d, floor)
+                for i in range(d):
+                    z_theta[i] = (gamma * lambdas[0]) * z_theta[i] + big_i * g[i]
+                for i in range(d_w):
+                    w[i] = w[i] + (alpha_w * delta) * z_w[i]
+                for i in range(d):
+                    theta[i] = theta[i] + (alpha * delta) * z_theta[i]
+                big_i = gamma * big_i
             s = s2
             if ended:
                 break
         steps = len(states)
-        if algorithm != "actor_critic":
+        if algorithm not in PER_STEP:
             returns = [0.0] * steps
             big_g = 0.0
             for t in range(steps - 1, -1, -1):

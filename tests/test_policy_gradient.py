@@ -59,6 +59,12 @@ CASES = [
       "theta0": 0.3, "w0": 0.5}),
     (WALK, {"max_episode_steps": 6}, 1.0,
      {"algorithm": "actor_critic", "alpha": 0.2, "alpha_w": 0.1, "min_probability": 0.1}),
+    (CORRIDOR, {}, 0.95,
+     {"algorithm": "actor_critic_lambda", "alpha": 0.02, "alpha_w": 0.05, "lambda_theta": 0.9,
+      "lambda_w": 0.7, "theta0": THETA0}),
+    (WALK, {}, 0.9,
+     {"algorithm": "actor_critic_lambda", "alpha": 0.1, "alpha_w": 0.1, "lambda_theta": 0.5,
+      "lambda_w": 0.8, "value_features": "table", "min_probability": 0.05}),
 ]  # fmt: skip
 
 
@@ -77,6 +83,7 @@ def test_every_algorithm_and_layer_equals_the_re_derivation_byte_for_byte(
         world, kwargs, gamma, curve["algorithm"], curve["alpha"], curve.get("alpha_w", 0.0),
         curve.get("policy_features"), curve.get("value_features"), curve.get("theta0", 0.0),
         curve.get("w0", 0.0), 4, 40, curve.get("min_probability", 0.0),
+        curve.get("lambda_theta", 0.0), curve.get("lambda_w", 0.0),
     )  # fmt: skip
     assert ours["rewards"].tobytes() == theirs["rewards"].tobytes()
     assert ours["lengths"].tobytes() == theirs["lengths"].tobytes()
@@ -194,6 +201,12 @@ BAD = [
     ({"world": {"id": WALK}, "figure": {"kind": "rewards", "optimum": True},
       "curves": [{"algorithm": "reinforce", "alpha": 0.1}]}, "figure.optimum: the best start value"),
     ({"episodes": 0}, "episodes: must be a whole number >= 1"),
+    ({"curves": [{"algorithm": "actor_critic_lambda", "alpha": 0.1, "alpha_w": 0.1,
+                  "lambda_theta": 0.9}]}, "curves[0].lambda_w: is missing"),
+    ({"curves": [{"algorithm": "actor_critic", "alpha": 0.1, "alpha_w": 0.1, "lambda_w": 0.5}]},
+     "curves[0].lambda_w: actor_critic keeps no traces"),
+    ({"curves": [{"algorithm": "actor_critic_lambda", "alpha": 0.1, "alpha_w": 0.1,
+                  "lambda_theta": 1.5, "lambda_w": 0.5}]}, "curves[0].lambda_theta: a trace decay in [0, 1]"),
     ({"episodes": 10**13}, "episodes"),
 ]  # fmt: skip
 

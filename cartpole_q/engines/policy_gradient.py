@@ -26,6 +26,7 @@ from cartpole_q.rl.policy_gradient import (
     ACTOR_CRITIC,
     Agent,
     choose,
+    clear_traces,
     learn_episode,
     learn_step,
 )
@@ -63,6 +64,7 @@ def _play_episodes(
         state = initial_state(params, env_rng)
         states[0] = state
         discount[0] = 1.0
+        clear_traces(agent)
         length = 0
         total = 0.0
         while True:
@@ -73,12 +75,12 @@ def _play_episodes(
             total = total + reward
             length += 1
             states[length] = following
-            if agent.code == ACTOR_CRITIC:
+            if agent.code >= ACTOR_CRITIC:
                 learn_step(agent, state, action, reward, following, terminated, discount)
             state = following
             if terminated or length >= cap:
                 break
-        if agent.code != ACTOR_CRITIC:
+        if agent.code < ACTOR_CRITIC:
             learn_episode(agent, states, actions, rewards, length, returns)
         totals[episode] = total
         lengths[episode] = length
@@ -88,11 +90,11 @@ _compiled: dict[str, Any] = {}
 
 LOOP_NAMES = (
     "policy_gradient_play_episodes", "policy_gradient_choose", "policy_gradient_learn_step",
-    "policy_gradient_learn_episode",
+    "policy_gradient_learn_episode", "policy_gradient_clear_traces",
 )  # fmt: skip
 """the compiled functions, by their cache names"""
 _TEMPLATES: dict[str, Callable[..., Any]] = dict(
-    zip(LOOP_NAMES, (_play_episodes, choose, learn_step, learn_episode), strict=True)
+    zip(LOOP_NAMES, (_play_episodes, choose, learn_step, learn_episode, clear_traces), strict=True)
 )
 
 
@@ -163,6 +165,7 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
     choose_action = compiled("policy_gradient_choose")
     step_update = compiled("policy_gradient_learn_step")
     episode_update = compiled("policy_gradient_learn_episode")
+    new_episode = compiled("policy_gradient_clear_traces")
     buffers = new_buffers(world.cap)
     seeds = [env_seed]
 
@@ -172,6 +175,7 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
             state = int(env.unwrapped.s)
             buffers.states[0] = state
             buffers.discount[0] = 1.0
+            new_episode(agent)
             length, total = 0, 0.0
             while True:
                 action = int(choose_action(agent, state, agent_rng))
@@ -182,7 +186,7 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
                 total = total + float(reward)
                 length += 1
                 buffers.states[length] = following
-                if agent.code == ACTOR_CRITIC:
+                if agent.code >= ACTOR_CRITIC:
                     step_update(
                         agent, state, action, float(reward), following, bool(terminated),
                         buffers.discount,
@@ -190,7 +194,7 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
                 state = following
                 if terminated or cut or length >= world.cap:
                     break
-            if agent.code != ACTOR_CRITIC:
+            if agent.code < ACTOR_CRITIC:
                 episode_update(
                     agent, buffers.states, buffers.actions, buffers.rewards, length,
                     buffers.returns,
@@ -230,7 +234,7 @@ def warm_up() -> None:
         for engine in ENGINES:
             agent = new_agent(
                 algorithm, 0.01, 0.01, 1.0, 0.05, n_actions, policy_rows,
-                np.zeros(n_states * n_actions), value_rows, np.zeros(1),
+                np.zeros(n_states * n_actions), value_rows, np.zeros(1), (0.5, 0.5),
             )  # fmt: skip
             run(agent, world, 0, 1, engine)
     env.close()

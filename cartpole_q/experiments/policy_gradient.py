@@ -43,7 +43,7 @@ STUDY_KEYS = ("name", "world", "gamma", "seeds", "episodes", "engine", "curves",
 """the keys a policy-gradient study file may have"""
 CURVE_KEYS = (
     "label", "algorithm", "alpha", "alpha_w", "policy_features", "value_features", "theta0",
-    "w0", "min_probability",
+    "w0", "min_probability", "lambda_theta", "lambda_w",
 )  # fmt: skip
 FIGURE_KINDS = ("rewards",)
 FIGURE_KEYS = ("kind", "file", "title", "y_min", "y_max", "optimum")
@@ -69,6 +69,8 @@ class CurveSpec:
     w0: tuple[float, ...]
     floor: float = 0.0
     """``min_probability`` (two actions): the least probability either action may have"""
+    lambdas: tuple[float, float] = (0.0, 0.0)
+    """``(lambda_theta, lambda_w)``: actor-critic with traces"""
 
 
 @dataclass(frozen=True)
@@ -204,19 +206,36 @@ def _curve(raw: Any, index: int, facts: WorldFacts, where: str) -> CurveSpec:
             f"0.5), on a world of two actions ({facts.world_id} has {facts.n_actions}), got "
             f"{floor:g}."
         )
+    lambdas = (0.0, 0.0)
+    if algorithm in methods.WITH_TRACES:
+        lambdas = (_decay(raw, "lambda_theta", here), _decay(raw, "lambda_w", here))
+    else:
+        for key in ("lambda_theta", "lambda_w"):
+            if key in raw:
+                raise ConfigError(
+                    f"{here}.{key}: {algorithm} keeps no traces; only "
+                    f"{', '.join(methods.WITH_TRACES)} takes it."
+                )
     spec = CurveSpec(label, str(algorithm), alpha, alpha_w, str(policy_features),
                      str(value_features), (), ())  # fmt: skip
     d, d_w = _weights(spec, facts)
     theta0 = weights_of(raw.get("theta0", 0.0), d, f"{here}.theta0")
     w0 = weights_of(raw.get("w0", 0.0), d_w, f"{here}.w0")
     return CurveSpec(label, str(algorithm), alpha, alpha_w, str(policy_features),
-                     str(value_features), theta0, w0, floor)  # fmt: skip
+                     str(value_features), theta0, w0, floor, lambdas)  # fmt: skip
 
 
 def _step_size(raw: Mapping[str, Any], key: str, here: str) -> float:
     value = number_of(raw, key, None, here, dotted=True)
     if value <= 0.0:
         raise ConfigError(f"{here}.{key}: a step size must be above 0, got {value:g}.")
+    return value
+
+
+def _decay(raw: Mapping[str, Any], key: str, here: str) -> float:
+    value = number_of(raw, key, None, here, dotted=True)
+    if not 0.0 <= value <= 1.0:
+        raise ConfigError(f"{here}.{key}: a trace decay in [0, 1], got {value:g}.")
     return value
 
 
@@ -299,7 +318,7 @@ def new_agent(study: Study, curve: CurveSpec) -> methods.Agent:
     w0 = np.full(d_w, curve.w0[0]) if len(curve.w0) == 1 else np.asarray(curve.w0)
     return methods.new_agent(
         curve.algorithm, curve.alpha, curve.alpha_w, study.gamma, curve.floor, facts.n_actions,
-        policy_rows(curve, facts), theta0, value_rows(curve, facts), w0,
+        policy_rows(curve, facts), theta0, value_rows(curve, facts), w0, curve.lambdas,
     )  # fmt: skip
 
 

@@ -754,12 +754,17 @@ def _policy_gradient() -> Schema:
         "theta0": {"anyOf": [number, numbers]},
         "w0": {"anyOf": [number, numbers]},
         "min_probability": _bandit_number(0.0, 0.5),
+        "lambda_theta": _bandit_number(0.0, 1.0),
+        "lambda_w": _bandit_number(0.0, 1.0),
     }, ["algorithm", "alpha"])  # fmt: skip
     _check_keys(curve, policy_gradient.CURVE_KEYS)
     curve["allOf"] = [
         {"if": {"properties": {"algorithm": {"enum": list(methods.WITH_VALUE)}}},
          "then": {"required": ["alpha_w"]},
          "else": {"properties": {"alpha_w": False, "value_features": False, "w0": False}}},
+        {"if": {"properties": {"algorithm": {"enum": list(methods.WITH_TRACES)}}},
+         "then": {"required": ["lambda_theta", "lambda_w"]},
+         "else": {"properties": {"lambda_theta": False, "lambda_w": False}}},
     ]  # fmt: skip
     own = {"y_min": number, "y_max": number, "optimum": BOOLEAN}
     properties: dict[str, Schema] = {

@@ -21,11 +21,15 @@ import numpy as np
 from cartpole_q.rl.linear import add_along, estimate
 from cartpole_q.rl.tabular import compilable
 
-ALGORITHMS = ("reinforce", "reinforce_baseline", "actor_critic")
+ALGORITHMS = ("reinforce", "reinforce_baseline", "actor_critic", "actor_critic_lambda")
 CODES = {name: code for code, name in enumerate(ALGORITHMS)}
-REINFORCE, REINFORCE_BASELINE, ACTOR_CRITIC = range(len(ALGORITHMS))
-WITH_VALUE = ("reinforce_baseline", "actor_critic")
+REINFORCE, REINFORCE_BASELINE, ACTOR_CRITIC, ACTOR_CRITIC_LAMBDA = range(len(ALGORITHMS))
+WITH_VALUE = ("reinforce_baseline", "actor_critic", "actor_critic_lambda")
 """the algorithms that learn ``v̂`` too (and take ``alpha_w``)"""
+PER_STEP = ("actor_critic", "actor_critic_lambda")
+"""the algorithms that learn after every step (the others after the episode)"""
+WITH_TRACES = ("actor_critic_lambda",)
+"""the algorithms that take ``lambda_theta`` and ``lambda_w``"""
 POLICY_LAYERS = ("declared", "table")
 VALUE_LAYERS = ("constant", "table")
 
@@ -41,6 +45,9 @@ class Agent(NamedTuple):
     gamma: float
     floor: float
     """two actions: the least probability either may have (0.0: none; Zhang's script: 0.05)"""
+    lambda_theta: float
+    lambda_w: float
+    """the traces' decays (actor-critic with traces)"""
     n_actions: int
     policy_index: np.ndarray
     """int64 ``(N * n, K)``: the policy layer's rows, row ``s * n + a``"""
@@ -56,19 +63,26 @@ class Agent(NamedTuple):
     """float64 ``(n,)``: room for ``π(· | s)``"""
     gradient: np.ndarray
     """float64 ``(d,)``: room for ``∇ ln π``"""
+    trace_theta: np.ndarray
+    """float64 ``(d,)``: ``z^θ`` (actor-critic with traces)"""
+    trace_w: np.ndarray
+    """float64 ``(d_w,)``: ``z^w``"""
 
 
 def new_agent(
     algorithm: str, alpha: float, alpha_w: float, gamma: float, floor: float, n_actions: int,
     policy_rows: tuple[np.ndarray, np.ndarray], theta0: np.ndarray,
     value_rows: tuple[np.ndarray, np.ndarray], w0: np.ndarray,
+    lambdas: tuple[float, float] = (0.0, 0.0),
 ) -> Agent:  # fmt: skip
-    """An agent at its start: ``θ = theta0``, ``w = w0`` (copied)."""
+    """An agent at its start: ``θ = theta0``, ``w = w0`` (copied); ``lambdas``: ``(λ^θ, λ^w)``."""
     return Agent(
-        CODES[algorithm], float(alpha), float(alpha_w), float(gamma), float(floor), int(n_actions),
+        CODES[algorithm], float(alpha), float(alpha_w), float(gamma), float(floor),
+        float(lambdas[0]), float(lambdas[1]), int(n_actions),
         policy_rows[0], policy_rows[1], theta0.astype(np.float64, copy=True),
         value_rows[0], value_rows[1], w0.astype(np.float64, copy=True),
-        np.zeros(n_actions), np.zeros(theta0.shape[0]),
+        np.zeros(n_actions), np.zeros(theta0.shape[0]), np.zeros(theta0.shape[0]),
+        np.zeros(w0.shape[0]),
     )  # fmt: skip
 
 
@@ -123,8 +137,8 @@ def choose(agent: Any, state: int, rng: Any) -> int:
 
 
 @compilable
-def move_policy(agent: Any, state: int, action: int, amount: float) -> None:
-    """``θ = θ + amount * ∇ ln π(action | state, θ)``, the gradient from the current ``θ``."""
+def eligibility(agent: Any, state: int, action: int) -> None:
+    """``agent.gradient = ∇ ln π(action | state, θ)``, from the current ``θ``."""
     policy(agent, state)
     n = agent.n_actions
     index, value, g = agent.policy_index, agent.policy_value, agent.gradient
@@ -137,7 +151,13 @@ def move_policy(agent: Any, state: int, action: int, amount: float) -> None:
         row = state * n + b
         for j in range(index.shape[1]):
             g[index[row, j]] = g[index[row, j]] - agent.probabilities[b] * value[row, j]
-    theta = agent.theta
+
+
+@compilable
+def move_policy(agent: Any, state: int, action: int, amount: float) -> None:
+    """``θ = θ + amount * ∇ ln π(action | state, θ)``, the gradient from the current ``θ``."""
+    eligibility(agent, state, action)
+    theta, g = agent.theta, agent.gradient
     for i in range(theta.shape[0]):
         theta[i] = theta[i] + amount * g[i]
 
@@ -171,10 +191,45 @@ def learn_step(
     agent: Any, state: int, action: int, reward: float, following: int, terminated: bool,
     discount: Any,
 ) -> None:  # fmt: skip
-    """One-step actor-critic after a step; ``discount[0]`` is the episode's ``I``."""
+    """Actor-critic after a step (one-step, or with traces); ``discount[0]`` is the episode's ``I``."""
     index, value, w = agent.value_index, agent.value_value, agent.w
     after = 0.0 if terminated else estimate(index, value, w, following)
     delta = reward + agent.gamma * after - estimate(index, value, w, state)
-    add_along(index, value, w, state, agent.alpha_w * delta)
-    move_policy(agent, state, action, (agent.alpha * discount[0]) * delta)
+    if agent.code == ACTOR_CRITIC_LAMBDA:
+        _traces_step(agent, state, action, delta, discount[0])
+    else:
+        add_along(index, value, w, state, agent.alpha_w * delta)
+        move_policy(agent, state, action, (agent.alpha * discount[0]) * delta)
     discount[0] = agent.gamma * discount[0]
+
+
+@compilable
+def _traces_step(agent: Any, state: int, action: int, delta: float, discount: float) -> None:
+    """Actor-critic with traces (13.5): both traces decay and grow, then both weights move."""
+    z_w, z_theta = agent.trace_w, agent.trace_theta
+    decay_w = agent.gamma * agent.lambda_w
+    for i in range(z_w.shape[0]):
+        z_w[i] = decay_w * z_w[i]
+    add_along(agent.value_index, agent.value_value, z_w, state, 1.0)
+    eligibility(agent, state, action)
+    g = agent.gradient
+    decay_theta = agent.gamma * agent.lambda_theta
+    for i in range(z_theta.shape[0]):
+        z_theta[i] = decay_theta * z_theta[i] + discount * g[i]
+    step_w = agent.alpha_w * delta
+    w = agent.w
+    for i in range(w.shape[0]):
+        w[i] = w[i] + step_w * z_w[i]
+    step_theta = agent.alpha * delta
+    theta = agent.theta
+    for i in range(theta.shape[0]):
+        theta[i] = theta[i] + step_theta * z_theta[i]
+
+
+@compilable
+def clear_traces(agent: Any) -> None:
+    """``z^θ = z^w = 0`` (an episode's start)."""
+    for i in range(agent.trace_theta.shape[0]):
+        agent.trace_theta[i] = 0.0
+    for i in range(agent.trace_w.shape[0]):
+        agent.trace_w[i] = 0.0
