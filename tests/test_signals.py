@@ -110,8 +110,13 @@ def _assert_ends_cleanly(process: subprocess.Popen[bytes], tmp_path: Path) -> st
         process.wait(timeout=30)
     finally:
         if process.returncode is None:
+            # Still running: every thread's stack to its stderr (cartpole-q's faulthandler
+            # on SIGUSR1), so the failure says where it was, then the end.
+            os.kill(process.pid, signal.SIGUSR1)
+            time.sleep(1.0)
             os.killpg(process.pid, signal.SIGKILL)
             process.wait()
+            print((tmp_path / "stderr").read_text())  # in the test's report
     stderr = (tmp_path / "stderr").read_text()
     left: dict[int, str] = {}
     deadline = time.monotonic() + 5
@@ -199,6 +204,17 @@ def test_multi_seed_eval_ends_on_signals(
     _wait_until(_workers_running(process), "two worker processes starting")
     time.sleep(0.5)  # into their imports or their episodes
     _signal(process, signum, count, group)
+    _assert_ends_cleanly(process, tmp_path)
+
+
+@pytest.mark.slow
+def test_sigusr1_prints_where_a_command_is_and_it_goes_on(reference: Path, tmp_path: Path) -> None:
+    process = _start(tmp_path, "eval", reference, "--episodes", 10**6, "--workers", 2)
+    _wait_until(_workers_running(process), "two worker processes starting")
+    os.kill(process.pid, signal.SIGUSR1)
+    _wait_until(lambda: "in _dispatch" in (tmp_path / "stderr").read_text(), "the stack dump")
+    assert process.poll() is None  # it goes on
+    _signal(process, signal.SIGINT, 1, True)
     _assert_ends_cleanly(process, tmp_path)
 
 

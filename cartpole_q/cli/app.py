@@ -23,5 +23,14 @@ them: training and its runs first, then the studies, then the studies' older ali
 
 
 def main() -> None:
-    """Entry point of the ``cartpole-q`` console script."""
+    """Entry point of the ``cartpole-q`` console script.
+
+    ``kill -USR1 PID`` makes a running command print every thread's Python stack to stderr
+    (Python's ``faulthandler``) and go on: where a command that seems stuck is.
+    """
+    import faulthandler
+    import signal
+
+    if hasattr(signal, "SIGUSR1"):
+        faulthandler.register(signal.SIGUSR1, all_threads=True)
     app()
