@@ -26,8 +26,9 @@ Rows:
                     the gymnasium engine on the same run (√VE recorded every 100 episodes or
                     1,000 steps), env steps per second; the expected methods' sweeps per
                     second on Baird's
-  policy_gradient   REINFORCE, REINFORCE with baseline and one-step actor-critic on the short
-                    corridor (Figure 13.2's settings, 1,000 episodes): the numba engine
+  policy_gradient   REINFORCE, REINFORCE with baseline, one-step actor-critic and actor-critic
+                    with traces on the short corridor (Figure 13.2's settings, 1,000
+                    episodes; the gymnasium engine 100): the numba engine
                     against the gymnasium engine on the same run, env steps per second
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
@@ -482,6 +483,8 @@ POLICY_GRADIENT_CURVES = (
      "theta0": [-1.47, 1.47], "min_probability": 0.05},
     {"algorithm": "actor_critic", "alpha": 2**-9, "alpha_w": 2**-6, "theta0": [-1.47, 1.47],
      "min_probability": 0.05},
+    {"algorithm": "actor_critic_lambda", "alpha": 2**-9, "alpha_w": 2**-6, "lambda_theta": 0.9,
+     "lambda_w": 0.9, "theta0": [-1.47, 1.47], "min_probability": 0.05},
 )  # fmt: skip
 """the policy-gradient section's rows: each method on the short corridor"""
 
