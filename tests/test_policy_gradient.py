@@ -103,6 +103,25 @@ def test_a_policy_that_never_reaches_the_goal_is_cut_at_ten_thousand_steps() -> 
     assert ours["rewards"].tolist() == [-10_000.0, -10_000.0]
 
 
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_long_episodes_return_to_python_every_hundred_thousand_steps(engine: str) -> None:
+    """A policy that never reaches the goal: 10,000-step episodes, 10 per compiled call."""
+    raw = {"kind": "policy_gradient", "world": {"id": CORRIDOR}, "episodes": 12, "engine": engine,
+           "curves": [{"algorithm": "reinforce", "alpha": 1e-9, "theta0": [-30, 30]}]}  # fmt: skip
+    study = read(raw)
+    reports: list[int] = []
+    record = study_kind.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, reports.append)
+    )
+    assert record is not None
+    assert reports == [10, 12]
+    assert np.asarray(record.arrays["lengths"]).tolist() == [10_000] * 12
+    stopped = study_kind.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: len(reports) > 2, reports.append)
+    )
+    assert stopped is None and reports[2:] == [10]  # asked between calls: it stops after one
+
+
 def test_the_short_corridors_best_start_value_is_its_closed_form() -> None:
     # v(s0) = -(4 - 6p + 2p^2) / (p (1 - p))... solved by hand from the three Bellman equations:
     # v0 = v1 - 1/p, v1 = -1 + p v0 + (1 - p) v2, v2 = -1 + (1 - p) v1; best at p = 2 - √2.

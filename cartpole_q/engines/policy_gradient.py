@@ -8,8 +8,11 @@ and the same draws, so their records agree byte for byte (``tests/test_policy_gr
 - ``gymnasium``: a Python loop over ``gymnasium.make(world)``, the draws and the updates
   compiled.
 
-Between calls the run's ``should_stop`` is asked, so a stop is seen within a fraction of a
-second. **Seeds** as a linear run's (:func:`~cartpole_q.engines.linear.run_generators`).
+A call ends after at most :data:`~cartpole_q.engines.linear.EPISODES_PER_CALL` episodes,
+or sooner, after the episode that reaches
+:data:`~cartpole_q.engines.linear.STEPS_PER_CALL` steps (a policy that never reaches the
+goal plays 10,000-step episodes); between calls the run's ``should_stop`` is asked, so a
+stop is seen within a fraction of a second. **Seeds** as a linear run's (:func:`~cartpole_q.engines.linear.run_generators`).
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from cartpole_q.engines.compile import specialise
-from cartpole_q.engines.linear import EPISODES_PER_CALL, World, run_generators
+from cartpole_q.engines.linear import EPISODES_PER_CALL, STEPS_PER_CALL, World, run_generators
 from cartpole_q.families.tables.twin import initial_state, table_step
 from cartpole_q.rl.policy_gradient import (
     ACTOR_CRITIC,
@@ -56,10 +59,15 @@ def new_buffers(cap: int) -> Buffers:
 
 def _play_episodes(
     agent: Any, params: Any, agent_rng: Any, env_rng: Any, cap: int, buffers: Any,
-    totals: Any, lengths: Any,
-) -> None:  # fmt: skip
-    """``len(totals)`` episodes on the table (compiled), each one's total reward and length kept."""
+    totals: Any, lengths: Any, most_steps: int,
+) -> int:  # fmt: skip
+    """Up to ``len(totals)`` episodes on the table (compiled), each one's reward and length kept.
+
+    Returns after the episode that brings the steps to ``most_steps`` (a call stays short
+    when episodes are long): the number of episodes played.
+    """
     states, actions, rewards, returns, discount = buffers
+    steps = 0
     for episode in range(totals.shape[0]):
         state = initial_state(params, env_rng)
         states[0] = state
@@ -84,6 +92,10 @@ def _play_episodes(
             learn_episode(agent, states, actions, rewards, length, returns)
         totals[episode] = total
         lengths[episode] = length
+        steps += length
+        if steps >= most_steps:
+            return episode + 1
+    return int(totals.shape[0])
 
 
 _compiled: dict[str, Any] = {}
@@ -137,14 +149,14 @@ def run(
         if should_stop():
             return None
         size = min(EPISODES_PER_CALL, episodes - done)
-        chunk(totals[done : done + size], lengths[done : done + size])
-        done += size
+        done += chunk(totals[done : done + size], lengths[done : done + size])
         report(done)
     return Records(totals, lengths)
 
 
-Chunk = Callable[[np.ndarray, np.ndarray], None]
-"""plays ``len(totals)`` episodes, filling ``totals`` and ``lengths``"""
+Chunk = Callable[[np.ndarray, np.ndarray], int]
+"""plays up to ``len(totals)`` episodes (fewer once they took :data:`STEPS_PER_CALL`
+steps), filling ``totals`` and ``lengths``; returns how many it played"""
 
 
 def _numba_chunk(agent: Agent, world: World, seed: int) -> Chunk:
@@ -153,8 +165,18 @@ def _numba_chunk(agent: Agent, world: World, seed: int) -> Chunk:
     env_rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence(env_seed)))
     buffers = new_buffers(world.cap)
     episodes = compiled("policy_gradient_play_episodes")
-    return lambda totals, lengths: episodes(
-        agent, world.params, agent_rng, env_rng, world.cap, buffers, totals, lengths
+    return lambda totals, lengths: int(
+        episodes(
+            agent,
+            world.params,
+            agent_rng,
+            env_rng,
+            world.cap,
+            buffers,
+            totals,
+            lengths,
+            STEPS_PER_CALL,
+        )
     )
 
 
@@ -169,7 +191,8 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
     buffers = new_buffers(world.cap)
     seeds = [env_seed]
 
-    def episodes(totals: np.ndarray, lengths: np.ndarray) -> None:
+    def episodes(totals: np.ndarray, lengths: np.ndarray) -> int:
+        steps = 0
         for episode in range(totals.shape[0]):
             env.reset(seed=seeds.pop() if seeds else None)
             state = int(env.unwrapped.s)
@@ -201,6 +224,10 @@ def _gymnasium_chunk(agent: Agent, world: World, seed: int) -> Chunk:
                 )  # fmt: skip
             totals[episode] = total
             lengths[episode] = length
+            steps += length
+            if steps >= STEPS_PER_CALL:
+                return episode + 1
+        return int(totals.shape[0])
 
     return episodes
 
