@@ -34,20 +34,25 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
 
-@pytest.fixture(autouse=True)
-def signals_as_they_were() -> Iterator[None]:
-    """Give SIGINT and SIGTERM back their handlers after each test.
+DEFAULT_HANDLERS = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: signal.SIG_DFL}
+"""Python's own SIGINT and SIGTERM handlers, as a process started from a terminal has them"""
 
-    A command run in-process that ends interrupted leaves both ignored on purpose (its
-    process is on its way out); in the test process that would leak into every later test,
-    and into the subprocesses they start (an ignored signal stays ignored across exec: a
-    command started so never sees Ctrl-C).
+
+@pytest.fixture(autouse=True)
+def default_signal_handlers() -> Iterator[None]:
+    """Every test starts, and leaves, with Python's default SIGINT and SIGTERM handlers.
+
+    The suite may itself run with SIGINT ignored (started as a background job by a script:
+    ``cmd &`` in a non-interactive shell ignores SIGINT for it), and a command run in-process that
+    ends interrupted leaves both ignored on purpose (its process is on its way out). An
+    ignored signal stays ignored across exec, so a command a test starts would never see
+    the test's Ctrl-C: the signal tests hung so when the suite ran as such a job.
     """
-    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    for signum, handler in DEFAULT_HANDLERS.items():
+        signal.signal(signum, handler)
     yield
-    for signum, handler in before.items():
-        if handler is not None and signal.getsignal(signum) is not handler:
-            signal.signal(signum, handler)
+    for signum, handler in DEFAULT_HANDLERS.items():
+        signal.signal(signum, handler)
 
 
 def write_yaml(path: Path, data: object) -> Path:

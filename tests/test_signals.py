@@ -211,8 +211,8 @@ def test_multi_seed_eval_ends_on_signals(
 def test_sigusr1_prints_where_a_command_is_and_it_goes_on(reference: Path, tmp_path: Path) -> None:
     process = _start(tmp_path, "eval", reference, "--episodes", 10**6, "--workers", 2)
     _wait_until(_workers_running(process), "two worker processes starting")
-    os.kill(process.pid, signal.SIGUSR1)
-    _wait_until(lambda: "in _dispatch" in (tmp_path / "stderr").read_text(), "the stack dump")
+    os.kill(process.pid, signal.SIGUSR1)  # wherever it is, it is evaluating the seeds
+    _wait_until(lambda: "in evaluate_seeds" in (tmp_path / "stderr").read_text(), "the dump")
     assert process.poll() is None  # it goes on
     _signal(process, signal.SIGINT, 1, True)
     _assert_ends_cleanly(process, tmp_path)
