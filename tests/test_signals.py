@@ -16,7 +16,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -55,6 +55,22 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return parent
 
 
+_STARTED: list[subprocess.Popen[bytes]] = []
+"""the commands this module's tests started (each in its own session)"""
+
+
+@pytest.fixture(autouse=True)
+def no_command_left_running() -> Iterator[None]:
+    """A test that fails before it ends its command still ends it (and its workers)."""
+    yield
+    while _STARTED:
+        process = _STARTED.pop()
+        if process.poll() is None:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+
+
 def _start(
     tmp_path: Path, *args: object, env: dict[str, str] | None = None
 ) -> subprocess.Popen[bytes]:
@@ -63,11 +79,13 @@ def _start(
     ``env`` replaces the environment (default: this one, so the numba cache stays warm).
     """
     with (tmp_path / "stdout").open("wb") as out, (tmp_path / "stderr").open("wb") as err:
-        return subprocess.Popen(
+        process = subprocess.Popen(
             [sys.executable, "-m", "cartpole_q", *map(str, args)],
             stdout=out, stderr=err, start_new_session=True, cwd=tmp_path,
             env=env if env is not None else {**os.environ},
         )  # fmt: skip
+    _STARTED.append(process)
+    return process
 
 
 def _session(sid: int) -> dict[int, str]:
