@@ -260,3 +260,31 @@ def specialise(
     wrappers: dict[str, Any] = {"no_cfunc_wrapper": True, "no_cpython_wrapper": callee}
     compiled: Dispatcher = njit(nogil=True, cache=True, **wrappers)(function)
     return compiled
+
+
+class LoopSet:
+    """A study engine's compiled loops by their cache names, each compiled once per process.
+
+    Args:
+        templates: cache name -> the plain function compiled under it (no placeholders).
+        notice: what to say before the first run on a machine compiles them.
+    """
+
+    def __init__(self, templates: Mapping[str, Callable[..., Any]], notice: str) -> None:
+        self.templates = dict(templates)
+        self._notice = notice
+        self._compiled: dict[str, Any] = {}
+
+    def __call__(self, name: str) -> Any:
+        """The compiled function cached on disk under ``name`` (once per process)."""
+        if name not in self._compiled:
+            self._compiled[name] = specialise(self.templates[name], name, {})
+        return self._compiled[name]
+
+    def notice(self) -> str | None:
+        """The notice when some loop is not in numba's cache yet (the first run), else ``None``."""
+        from cartpole_q.numba_cache import is_cached
+
+        if all(is_cached(name) for name in self.templates):
+            return None
+        return self._notice

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.compile import LoopSet
 from cartpole_q.families.tables.twin import initial_state, table_step
 from cartpole_q.rl.linear import (
     GRADIENT_MC,
@@ -153,36 +153,23 @@ def _sweeps(learner: Any, model: Any, count: int) -> None:
         sweep(learner, model)
 
 
-_compiled: dict[str, Any] = {}
-
 LOOP_NAMES = (
     "linear_play_episodes", "linear_play_steps", "linear_first_state", "linear_sweeps",
     "linear_choose", "linear_learn_step", "linear_learn_episode", "linear_root_ve",
     "linear_root_pbe",
 )  # fmt: skip
 """the compiled functions, by their cache names"""
-_TEMPLATES: dict[str, Callable[..., Any]] = dict(
-    zip(LOOP_NAMES, (
+LOOPS = LoopSet(
+    dict(zip(LOOP_NAMES, (
         _play_episodes, _play_steps, _first_state, _sweeps, choose, learn_step, learn_episode,
         root_ve, root_pbe,
-    ), strict=True)
+    ), strict=True)),
+    "compiling the linear methods' loops: once per machine and version, a few seconds...",
 )  # fmt: skip
-
-
-def compiled(name: str) -> Any:
-    """The compiled function cached on disk under ``name`` (once per process)."""
-    if name not in _compiled:
-        _compiled[name] = specialise(_TEMPLATES[name], name, {})
-    return _compiled[name]
-
-
-def compile_notice() -> str | None:
-    """A sentence when the loops are not compiled yet (the first run), else ``None``."""
-    from cartpole_q.numba_cache import is_cached
-
-    if all(is_cached(name) for name in LOOP_NAMES):
-        return None
-    return "compiling the linear methods' loops: once per machine and version, a few seconds..."
+compiled = LOOPS
+"""``compiled(name)``: the compiled function cached on disk under ``name``"""
+compile_notice = LOOPS.notice
+"""a sentence when the loops are not compiled yet (the first run), else ``None``"""
 
 
 def run_generators(seed: int) -> tuple[np.random.Generator, int]:

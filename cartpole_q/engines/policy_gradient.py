@@ -22,7 +22,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from cartpole_q.engines.compile import specialise
+from cartpole_q.engines.compile import LoopSet
 from cartpole_q.engines.linear import EPISODES_PER_CALL, STEPS_PER_CALL, World, run_generators
 from cartpole_q.families.tables.twin import initial_state, table_step
 from cartpole_q.rl.policy_gradient import (
@@ -98,32 +98,20 @@ def _play_episodes(
     return int(totals.shape[0])
 
 
-_compiled: dict[str, Any] = {}
-
 LOOP_NAMES = (
     "policy_gradient_play_episodes", "policy_gradient_choose", "policy_gradient_learn_step",
     "policy_gradient_learn_episode", "policy_gradient_clear_traces",
 )  # fmt: skip
 """the compiled functions, by their cache names"""
-_TEMPLATES: dict[str, Callable[..., Any]] = dict(
-    zip(LOOP_NAMES, (_play_episodes, choose, learn_step, learn_episode, clear_traces), strict=True)
-)
-
-
-def compiled(name: str) -> Any:
-    """The compiled function cached on disk under ``name`` (once per process)."""
-    if name not in _compiled:
-        _compiled[name] = specialise(_TEMPLATES[name], name, {})
-    return _compiled[name]
-
-
-def compile_notice() -> str | None:
-    """A sentence when the loops are not compiled yet (the first run), else ``None``."""
-    from cartpole_q.numba_cache import is_cached
-
-    if all(is_cached(name) for name in LOOP_NAMES):
-        return None
-    return "compiling the policy-gradient loops: once per machine and version, a few seconds..."
+LOOPS = LoopSet(
+    dict(zip(LOOP_NAMES, (_play_episodes, choose, learn_step, learn_episode, clear_traces),
+             strict=True)),
+    "compiling the policy-gradient loops: once per machine and version, a few seconds...",
+)  # fmt: skip
+compiled = LOOPS
+"""``compiled(name)``: the compiled function cached on disk under ``name``"""
+compile_notice = LOOPS.notice
+"""a sentence when the loops are not compiled yet (the first run), else ``None``"""
 
 
 class Records(NamedTuple):
