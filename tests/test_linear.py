@@ -363,3 +363,20 @@ def test_a_long_stretch_between_records_still_returns_to_python_and_stops() -> N
         study, {"curve": 0, "seed": 0}, RunHandle(lambda: bool(seen), seen.append)
     )
     assert stopped is None and seen == [100_000]  # asked after every compiled call
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_long_episodes_return_to_python_every_hundred_thousand_steps(engine: str) -> None:
+    """Episodes of 10,000 steps (the short corridor, almost always left): 10 per call."""
+    raw = {
+        "kind": "linear", "world": {"id": "cartpole_q/ShortCorridor-v0"}, "gamma": 1.0,
+        "target": [0.9999, 0.0001], "episodes": 12, "record_every": 12, "engine": engine,
+        "curves": [{"algorithm": "gradient_mc", "features": {"kind": "table"}, "alpha": 1e-6}],
+    }  # fmt: skip
+    reports: list[int] = []
+    record = study_kind.run_one(
+        read(raw), {"curve": 0, "seed": 0}, RunHandle(lambda: False, reports.append)
+    )
+    assert record is not None
+    assert reports == [10, 12]
+    assert np.asarray(record.arrays["at"]).tolist() == [0, 12]

@@ -11,7 +11,8 @@ and the same draws, so their weights and errors agree byte for byte
 
 A run goes in chunks of ``record_every`` episodes (or steps, or sweeps), after each of
 which the errors are measured; a compiled call runs at most :data:`EPISODES_PER_CALL`
-episodes (:data:`STEPS_PER_CALL` steps, :data:`SWEEPS_PER_CALL` sweeps), and between calls
+episodes (ending sooner, after the episode that reaches :data:`STEPS_PER_CALL` steps),
+:data:`STEPS_PER_CALL` steps or :data:`SWEEPS_PER_CALL` sweeps, and between calls
 the run's ``should_stop`` is asked, so a stop is seen within a fraction of a second. An expected algorithm sweeps the model and never steps the world (one engine).
 
 **Seeds** (docs/algorithms.md, "Linear function approximation"): run ``seed``:
@@ -99,13 +100,16 @@ def choose(behaviour: Any, rng: Any) -> int:
 def _play_episodes(
     learner: Any, behaviour: Any, params: Any, agent_rng: Any, env_rng: Any, episodes: int,
     cap: int, buffers: Any,
-) -> None:  # fmt: skip
-    """``episodes`` episodes on the table (compiled): reset, step to the end, learn.
+) -> int:  # fmt: skip
+    """Up to ``episodes`` episodes on the table (compiled): reset, step to the end, learn.
 
     ``buffers`` is ``(states, rewards, returns)``, room for an episode of ``cap`` steps.
+    Returns after the episode that brings the steps to :data:`STEPS_PER_CALL` (a call stays
+    short when episodes are long): the number of episodes played.
     """
     states, rewards, returns = buffers
-    for _ in range(episodes):
+    steps = 0
+    for episode in range(episodes):
         state = initial_state(params, env_rng)
         states[0] = state
         length = 0
@@ -126,6 +130,10 @@ def _play_episodes(
                 break
         if learner.code == GRADIENT_MC:
             learn_episode(learner, states, rewards, length, truncated, returns)
+        steps += length
+        if steps >= STEPS_PER_CALL:
+            return episode + 1
+    return episodes
 
 
 def _play_steps(
@@ -262,9 +270,7 @@ def run(
         while done < target:  # a long stretch between records still returns to Python often
             if should_stop():
                 return None
-            size = min(most, target - done)
-            chunk(size)
-            done += size
+            done += chunk(min(most, target - done))
             report(done)
         record(done)
     return records
@@ -277,34 +283,43 @@ def _most_per_call(learner: Learner, world: World) -> int:
     return STEPS_PER_CALL if world.continuing else EPISODES_PER_CALL
 
 
-def _sweep_chunk(learner: Learner, model: Model) -> Callable[[int], None]:
+Chunk = Callable[[int], int]
+"""plays up to ``size`` episodes, steps or sweeps; returns how many it played (fewer
+episodes only, once they took :data:`STEPS_PER_CALL` steps)"""
+
+
+def _sweep_chunk(learner: Learner, model: Model) -> Chunk:
     """Sweeps of an expected algorithm."""
     sweeps = compiled("linear_sweeps")
-    return lambda size: sweeps(learner, model, size)
+
+    def chunk(size: int) -> int:
+        sweeps(learner, model, size)
+        return size
+
+    return chunk
 
 
-def _numba_chunk(
-    learner: Learner, behaviour: Behaviour, world: World, seed: int
-) -> Callable[[int], None]:
+def _numba_chunk(learner: Learner, behaviour: Behaviour, world: World, seed: int) -> Chunk:
     """Episodes or steps on the compiled table."""
     agent_rng, env_seed = run_generators(seed)
     env_rng = np.random.Generator(np.random.PCG64(np.random.SeedSequence(env_seed)))
     if world.continuing:
         position = np.array([compiled("linear_first_state")(world.params, env_rng)])
         steps = compiled("linear_play_steps")
-        return lambda size: steps(
-            learner, behaviour, world.params, agent_rng, env_rng, size, position
-        )
+
+        def step_chunk(size: int) -> int:
+            steps(learner, behaviour, world.params, agent_rng, env_rng, size, position)
+            return size
+
+        return step_chunk
     buffers = (np.zeros(world.cap + 1, dtype=np.int64), np.zeros(world.cap), np.zeros(world.cap))
     episodes = compiled("linear_play_episodes")
-    return lambda size: episodes(
-        learner, behaviour, world.params, agent_rng, env_rng, size, world.cap, buffers
+    return lambda size: int(
+        episodes(learner, behaviour, world.params, agent_rng, env_rng, size, world.cap, buffers)
     )
 
 
-def _gymnasium_chunk(
-    learner: Learner, behaviour: Behaviour, world: World, seed: int
-) -> Callable[[int], None]:
+def _gymnasium_chunk(learner: Learner, behaviour: Behaviour, world: World, seed: int) -> Chunk:
     """Episodes or steps on ``gymnasium.make``: the loop in Python, the rules compiled."""
     agent_rng, env_seed = run_generators(seed)
     env = world.make()
@@ -322,7 +337,7 @@ def _gymnasium_chunk(
     if world.continuing:
         position = [reset()]
 
-        def steps(size: int) -> None:
+        def steps(size: int) -> int:
             state = position[0]
             for _ in range(size):
                 action = int(choose_action(behaviour, agent_rng))
@@ -333,12 +348,14 @@ def _gymnasium_chunk(
                 )
                 state = following
             position[0] = state
+            return size
 
         return steps
     returns = np.zeros(world.cap)
 
-    def episodes(size: int) -> None:
-        for _ in range(size):
+    def episodes(size: int) -> int:
+        played = 0
+        for episode in range(size):
             state = reset()
             states, rewards = [state], []
             truncated = False
@@ -363,6 +380,10 @@ def _gymnasium_chunk(
                     learner, np.asarray(states, dtype=np.int64), np.asarray(rewards), len(rewards),
                     truncated, returns,
                 )  # fmt: skip
+            played += len(rewards)
+            if played >= STEPS_PER_CALL:
+                return episode + 1
+        return size
 
     return episodes
 
