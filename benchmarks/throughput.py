@@ -30,11 +30,14 @@ Rows:
                     with traces on the short corridor (Figure 13.2's settings, 1,000
                     episodes; the gymnasium engine 100): the numba engine
                     against the gymnasium engine on the same run, env steps per second
+  average_reward    differential semi-gradient SARSA on access control (Figure 10.5's
+                    settings; 2 million steps, the gymnasium engine 50,000): the numba
+                    engine against the gymnasium engine, env steps per second
 
 Every figure is the median of --repeats runs; ratios are against baselines measured in this
 same run, so they hold across machines even when absolute rates do not. --only SECTION runs
 one section (cartpole, algorithms, environments, tabular, prediction, tiles, linear,
-policy_gradient, progress); the algorithms section
+policy_gradient, average_reward, progress); the algorithms section
 then measures its own Q-learning baseline.
 """
 
@@ -207,7 +210,7 @@ TABULAR = (("FrozenLake8x8-v1 (frozenlake8x8)", "frozenlake8x8", 22_000),
 
 SECTIONS = (
     "cartpole", "algorithms", "environments", "tabular", "prediction", "tiles", "linear",
-    "policy_gradient", "progress",
+    "policy_gradient", "average_reward", "progress",
 )  # fmt: skip
 """what --only can pick; by default every section runs, in this order"""
 
@@ -530,6 +533,44 @@ def policy_gradient_rows(repeats: int, scale: float) -> None:
         )
 
 
+def average_reward_rate(engine: str, steps: int) -> tuple[int, float]:
+    """One run of Figure 10.5's curve on access control: ``(env steps, seconds)``."""
+    from cartpole_q.experiments import average_reward, linear
+    from cartpole_q.experiments.study import RunHandle, study_of
+
+    study = average_reward.read_study(study_of(
+        {"kind": "average_reward", "world": {"id": "cartpole_q/AccessControl-v0"},
+         "steps": steps, "engine": engine,
+         "curves": [{"algorithm": "differential_sarsa", "alpha": 0.01, "beta": 0.01}]},
+        "benchmark", "b", Path("."),
+    ))  # fmt: skip
+    linear.world_table(study.world_id, study.world_kwargs, study.where)
+    start = time.perf_counter()
+    record = average_reward.run_one(
+        study, {"curve": 0, "seed": 0}, RunHandle(lambda: False, lambda n: None)
+    )
+    seconds = time.perf_counter() - start
+    assert record is not None
+    return steps, seconds
+
+
+def average_reward_rows(repeats: int, scale: float) -> None:
+    """Differential SARSA: the numba engine against the gymnasium engine."""
+    print(
+        f"{'average-reward method':40s} {'gymnasium':>14s} {'numba':>13s} {'ratio':>7s} {'steps':>11s}"
+    )
+    steps = max(100_000, int(2_000_000 * scale))
+    average_reward_rate("numba", 10)  # compile or load the cache
+    numba_rate = median_rate(lambda: average_reward_rate("numba", steps), max(3, repeats))
+    gym_rate = median_rate(
+        lambda: average_reward_rate("gymnasium", max(10_000, steps // 40)), repeats
+    )
+    print(
+        f"{'differential_sarsa, access control':40s} {gym_rate:14,.0f} {numba_rate:13,.0f} "
+        f"{numba_rate / gym_rate:6,.0f}x {steps:11,d}"
+    )
+
+
 TILINGS = (1, 2, 4, 8, 16)
 """the tiles section's tiling counts (1: the plain grid, the baseline)"""
 
@@ -615,6 +656,8 @@ def main() -> None:
             linear_rows(args.repeats, scale)
         elif section == "policy_gradient":
             policy_gradient_rows(args.repeats, scale)
+        elif section == "average_reward":
+            average_reward_rows(args.repeats, scale)
         else:
             progress_row(args.repeats, python_episodes)
 

@@ -85,6 +85,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/RandomWalk1000-v0": (1002, 2, 10_000),
         "cartpole_q/Baird-v0": (7, 2, None),  # continuing: no time limit, nothing ends
         "cartpole_q/ShortCorridor-v0": (4, 2, None),  # the engines cut at 10,000 steps
+        "cartpole_q/AccessControl-v0": (44, 2, None),  # continuing: nothing ends
     }
     assert set(expected) == set(IDS)
     for env_id, (states, actions, limit) in expected.items():

@@ -46,7 +46,7 @@ def test_check_refuses_a_bad_file_naming_the_key(tmp_path: Path) -> None:
     path = write_yaml(tmp_path / "k.yaml", {**study, "kind": "bandits"})
     assert_refused(
         invoke("study", path, "--check"),
-        "kind: must be one of bandit, dp, linear, policy_gradient, sweep",
+        "kind: must be one of average_reward, bandit, dp, linear, policy_gradient, sweep",
     )
 
 

@@ -441,7 +441,11 @@ def optimum_command(
     ] = None,
     json_output: JsonOutput = False,
 ) -> None:
-    """The best expected return from the start, by value iteration on the environment's model."""
+    """The best expected return from the start, by value iteration on the environment's model.
+
+    On an average-reward world (access control), the optimal reward per step instead, by
+    relative value iteration.
+    """
     with exit_codes():
         from cartpole_q.cli.exact_text import exact_lines, policy_grid, state_label
         from cartpole_q.config import parse_assignment
@@ -459,6 +463,17 @@ def optimum_command(
             blackjack = profile_for(env_id).model == "blackjack"
             for state, value in values.values.items():
                 typer.echo(f"  {state_label(blackjack, state)}: {value:.6g}")
+            return
+        if gamma is None and profile_for(env_id).average_reward:
+            from cartpole_q.experiments.average_reward import gain_optimum
+
+            gain = gain_optimum(env_id, assignments)
+            if json_output:
+                typer.echo(json.dumps(gain.to_json()))
+                return
+            typer.echo(f"{env_id} {json.dumps(gain.kwargs)}")
+            for line in gain.lines():
+                typer.echo(line)
             return
         found = optimum(env_id, assignments, gamma)
         if json_output:

@@ -63,6 +63,7 @@ STUDY_LOOPS: dict[str, tuple[str, Callable[[], None]]] = {
     "bandit_gymnasium": ("the bandit testbed", lambda: _bandit("gymnasium")),
     "linear": ("the linear methods (both engines)", lambda: _linear()),
     "policy_gradient": ("the policy-gradient methods (both engines)", lambda: _policy_gradient()),
+    "average_reward": ("the average-reward methods (both engines)", lambda: _average_reward()),
 }
 """the compiled loops the studies run outside training (by a name, with what they play
 and how to compile them): ``compile --all`` fills the cache with them too"""
@@ -82,6 +83,12 @@ def _linear() -> None:
 
 def _policy_gradient() -> None:
     from cartpole_q.engines.policy_gradient import warm_up
+
+    warm_up()
+
+
+def _average_reward() -> None:
+    from cartpole_q.engines.average_reward import warm_up
 
     warm_up()
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, shown_value
 from cartpole_q.config.bounds import check_count, check_memory
+from cartpole_q.experiments.average_reward import action_rows
 from cartpole_q.experiments.linear import (
     WorldFacts,
     flag_of,
@@ -284,22 +285,8 @@ def runs_of(study: Study) -> list[dict[str, Cell]]:
 
 
 def policy_rows(curve: CurveSpec, facts: WorldFacts) -> tuple[np.ndarray, np.ndarray]:
-    """The policy layer's rows, row ``s * n + a``: ``(index, value)``, padded with zero values."""
-    n_states, n = facts.n_states, facts.n_actions
-    if curve.policy_features == "table":
-        groups = facts.groups if facts.groups is not None else np.arange(n_states)
-        index = (np.repeat(groups, n) * n + np.tile(np.arange(n), n_states)).astype(np.int64)
-        return index.reshape(-1, 1), np.ones((n_states * n, 1))
-    assert facts.declared_actions is not None
-    flat = np.asarray(facts.declared_actions, dtype=np.float64).reshape(n_states * n, -1)
-    width = max(1, int(np.count_nonzero(flat, axis=1).max()))
-    index = np.zeros((flat.shape[0], width), dtype=np.int64)
-    value = np.zeros((flat.shape[0], width))
-    for row in range(flat.shape[0]):
-        nonzero = np.flatnonzero(flat[row])
-        index[row, : nonzero.size] = nonzero
-        value[row, : nonzero.size] = flat[row, nonzero]
-    return index, value
+    """The policy layer's rows, row ``s * n + a``: ``(index, value)`` (:func:`~cartpole_q.experiments.average_reward.action_rows`)."""
+    return action_rows(curve.policy_features, facts)
 
 
 def value_rows(curve: CurveSpec, facts: WorldFacts) -> tuple[np.ndarray, np.ndarray]:

@@ -39,6 +39,7 @@ from cartpole_q.config.json_schema import (
 )
 from cartpole_q.config.overrides import TUNE_FILE_KEYS
 from cartpole_q.experiments import (
+    average_reward,
     bandits,
     linear,
     planning,
@@ -93,9 +94,9 @@ def study_schema() -> Schema:
 
     >>> schema = study_schema()
     >>> sorted(name for name in schema["$defs"] if "." not in name)
-    ['bandit', 'config', 'dp', 'linear', 'policy_gradient', 'sweep', 'tune', 'updates']
+    ['average_reward', 'bandit', 'config', 'dp', 'linear', 'policy_gradient', 'sweep', 'tune', 'updates']
     >>> schema["properties"]["kind"]["enum"]
-    ['bandit', 'dp', 'linear', 'policy_gradient', 'sweep', 'updates']
+    ['average_reward', 'bandit', 'dp', 'linear', 'policy_gradient', 'sweep', 'updates']
     """
     schemas = kind_schemas()
     kinds = sorted(schemas)
@@ -162,6 +163,7 @@ def kind_schemas() -> dict[str, Schema]:
     built = {
         "sweep": _sweep(), "bandit": _bandit(), "dp": _dp(), "updates": _updates(),
         "linear": _linear(), "policy_gradient": _policy_gradient(),
+        "average_reward": _average_reward(),
     }  # fmt: skip
     missing = sorted(set(study_kinds.registered()) - set(built))
     if missing:
@@ -781,6 +783,43 @@ def _policy_gradient() -> Schema:
         "policy_gradient", policy_gradient.STUDY_KEYS, properties, "Policy-gradient files"
     )
     schema["required"] = ["world", "episodes", "curves"]
+    return schema
+
+
+def _average_reward() -> Schema:
+    from cartpole_q.rl import average_reward as methods
+
+    number = _bandit_number()
+    world = _object(
+        {"id": {"type": "string", "minLength": 1}, "kwargs": {"type": "object"}}, ["id"]
+    )
+    count = {"type": "integer", "minimum": 1, "maximum": MAX_COUNT}
+    positive = _bandit_number(0.0, low_open=True)
+    numbers = {"type": "array", "minItems": 1, "items": number}
+    curve = _object({
+        "label": TEXT,
+        "algorithm": {"enum": list(methods.ALGORITHMS)},
+        "alpha": positive,
+        "beta": positive,
+        "epsilon": _bandit_number(0.0, 1.0),
+        "features": {"enum": list(methods.LAYERS)},
+        "w0": {"anyOf": [number, numbers]},
+        "r_bar0": number,
+    }, ["algorithm", "alpha", "beta"])  # fmt: skip
+    _check_keys(curve, average_reward.CURVE_KEYS)
+    own = {"y_min": number, "y_max": number, "optimum": BOOLEAN}
+    properties: dict[str, Schema] = {
+        "name": NAME,
+        "world": world,
+        "seeds": seeds_schema(),
+        "steps": count,
+        "record_every": count,
+        "engine": {"enum": list(average_reward.ENGINES)},
+        "curves": {"type": "array", "minItems": 1, "items": curve},
+        "figure": _study_figure(average_reward.FIGURE_KEYS, average_reward.FIGURE_KINDS, own),
+    }
+    schema = _kind("average_reward", average_reward.STUDY_KEYS, properties, "Average-reward files")
+    schema["required"] = ["world", "steps", "curves"]
     return schema
 
 

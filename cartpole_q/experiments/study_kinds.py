@@ -7,10 +7,18 @@ A new kind is one module defining a :class:`~cartpole_q.experiments.study.StudyK
 
 from __future__ import annotations
 
-from cartpole_q.experiments import bandits, linear, planning, policy_gradient, sweep, updates
+from cartpole_q.experiments import (
+    average_reward,
+    bandits,
+    linear,
+    planning,
+    policy_gradient,
+    sweep,
+    updates,
+)
 from cartpole_q.experiments.study import StudyKind, kinds
 
-MODULES = (sweep, bandits, planning, updates, linear, policy_gradient)
+MODULES = (sweep, bandits, planning, updates, linear, policy_gradient, average_reward)
 """the modules that register the kinds (imported for that)"""
 
 

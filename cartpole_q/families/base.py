@@ -89,6 +89,12 @@ class EnvProfile:
     """with ``components``: the sizes a Discrete state decomposes into, in C order"""
     component_names: tuple[str, ...] = ()
     """with ``components``: a name per component"""
+    component_values: tuple[tuple[str, ...], ...] = ()
+    """with ``components``: what each value of each component means, for figures (empty:
+    the values 0, 1, 2, ...)"""
+    average_reward: bool = False
+    """a continuing world whose objective is the reward per step (Sutton & Barto section
+    10.3): ``cartpole-q optimum`` gives its optimal gain by relative value iteration"""
     rows_down: bool = False
     """the first map dimension is a grid world's rows, drawn downwards (Taxi)"""
     grid: Callable[[Any], GridCells] | None = None

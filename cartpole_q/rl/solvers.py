@@ -530,3 +530,81 @@ def policy_iteration(
         policies.append(policy.copy())
         values.append(policy_values(model, policy, gamma).values)
     raise ValueError(f"policy iteration did not settle in {max_iterations} improvements")
+
+
+@dataclass(frozen=True)
+class GainSolution:
+    """An average-reward solution: the gain, the differential values and the greedy policy."""
+
+    gain: float
+    """the reward per step (the average reward ``r(π)``, section 10.3)"""
+    values: np.ndarray
+    """float64, ``(n_states,)``: the differential values, 0 at the reference state"""
+    q: np.ndarray
+    """float64, ``(n_states, n_actions)``: ``r(s, a) - gain + sum p v(s')``"""
+    policy: np.ndarray
+    """int64, ``(n_states,)``: the lowest action among the tied best of ``q``"""
+    iterations: int
+    bounds: tuple[float, float]
+    """the last sweep's ``(min, max)`` of ``T v - v``: the optimal gain lies between them"""
+
+
+def relative_value_iteration(
+    model: FiniteMDP, reference: int = 0, tolerance: float = 1e-12,
+    max_iterations: int = 1_000_000,
+) -> GainSolution:  # fmt: skip
+    """The optimal gain and differential values of a continuing MDP (relative value iteration).
+
+    From ``v = 0``: ``T v(s) = max_a sum p (r + v(s'))`` (:meth:`FiniteMDP.backup` with gamma
+    1), then ``v = T v - T v(reference)``; stop after the first sweep whose span
+    ``max(T v - v) - min(T v - v)`` is at most ``tolerance``, the gain being ``T v(reference)``
+    of that sweep (Puterman, section 8.5.5). It converges on an aperiodic unichain MDP (one
+    whose every policy has one recurrent class and a state that can stay put, as access
+    control's). The policy is :func:`greedy` on ``q`` (ties within ``1e-9``: the lowest).
+
+    Raises:
+        ValueError: an outcome that ends (not a continuing MDP), or no convergence.
+    """
+    if bool(model.terminated.any()):
+        raise ValueError("relative value iteration needs a continuing MDP: an outcome ends")
+    values = np.zeros(model.n_states)
+    for iteration in range(1, max_iterations + 1):
+        updated = model.masked(model.backup(values, 1.0)).max(axis=1)
+        change = updated - values
+        low, high = float(change.min()), float(change.max())
+        gain = float(updated[reference])
+        values = updated - gain
+        if high - low <= tolerance:
+            q = model.masked(model.backup(values, 1.0)) - gain
+            policy = greedy(q, model.allowed)
+            return GainSolution(gain, values, q, policy, iteration, (low, high))
+    raise ValueError(f"relative value iteration did not converge in {max_iterations} sweeps")
+
+
+def policy_gain(
+    model: FiniteMDP, policy: np.ndarray, reference: int = 0
+) -> tuple[float, np.ndarray]:
+    """A deterministic policy's exact gain and differential values (a unichain policy).
+
+    Solves ``v(s) + g = r_pi(s) + sum_s' P_pi(s, s') v(s')`` with ``v(reference) = 0``: one
+    dense linear system in ``(v, g)``.
+
+    Raises:
+        ValueError: an outcome that ends, or a singular system (a policy with more than one
+            recurrent class has no single gain).
+    """
+    if bool(model.terminated.any()):
+        raise ValueError("a gain needs a continuing MDP: an outcome ends")
+    n = model.n_states
+    expected, matrix = model.policy_matrix(np.asarray(policy, dtype=np.int64))
+    system = np.zeros((n + 1, n + 1))
+    system[:n, :n] = np.eye(n) - matrix
+    system[:n, n] = 1.0
+    system[n, reference] = 1.0
+    right = np.concatenate([expected, [0.0]])
+    try:
+        with one_thread():
+            solved = np.linalg.solve(system, right)
+    except np.linalg.LinAlgError:
+        raise ValueError("the policy has no single gain (more than one recurrent class)") from None
+    return float(solved[n]), solved[:n]

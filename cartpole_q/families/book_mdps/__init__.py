@@ -1,4 +1,4 @@
-"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1), the short corridor (13.1).
+"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1), access control (10.2), the short corridor (13.1).
 
 Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state`,
 :mod:`~cartpole_q.families.book_mdps.bias` and :mod:`~cartpole_q.families.book_mdps.baird`
@@ -22,6 +22,7 @@ _BAIRD = "cartpole_q.families.book_mdps.baird"
 _BIAS = "cartpole_q.families.book_mdps.bias"
 _ONE_STATE = "cartpole_q.families.book_mdps.one_state"
 _CORRIDOR = "cartpole_q.families.book_mdps.short_corridor"
+_ACCESS = "cartpole_q.families.book_mdps.access_control"
 ONE_STATE_TIME_LIMIT = 1_000
 """steps before an episode of the one-state MDP is truncated (left comes back with
 probability 0.9: ten steps on average)"""
@@ -80,12 +81,30 @@ SHORT_CORRIDOR = EnvProfile(
     twin=load_table_twin,
 )
 
-PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR)
+ACCESS_CONTROL = EnvProfile(
+    name="AccessControl",
+    description="the access-control queuing task: accept or reject the customer of priority "
+    "1, 2, 4 or 8 at the head of the queue for one of 10 servers, each busy one freeing with "
+    "probability 0.06 a step; continuing, average reward (Sutton & Barto's Example 10.2)",
+    ids=("cartpole_q/AccessControl-v0",),
+    entry_points=(f"{_ACCESS}:AccessControlEnv",),
+    action_names=("reject", "accept"),
+    model="transition_table",
+    twin=load_table_twin,
+    policy_map="components",
+    state_components=(4, 11),
+    component_names=("priority", "free servers"),
+    component_values=(("1", "2", "4", "8"), tuple(str(free) for free in range(11))),
+    average_reward=True,
+)
+
+PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR, ACCESS_CONTROL)
 """the family's profiles"""
 WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
     World(f"{NAMESPACE}/OneState-v0", f"{_ONE_STATE}:OneStateEnv", ONE_STATE_TIME_LIMIT),
     World(f"{NAMESPACE}/Baird-v0", f"{_BAIRD}:BairdEnv", None),
     World(f"{NAMESPACE}/ShortCorridor-v0", f"{_CORRIDOR}:ShortCorridorEnv", None),
+    World(f"{NAMESPACE}/AccessControl-v0", f"{_ACCESS}:AccessControlEnv", None),
 )
 """the worlds it registers"""
