@@ -110,6 +110,10 @@ RESUMED = {
     ),
     "linear": lambda tmp: small(tmp, "fig9_10_tile_coding", seeds="0-2", episodes=40, book=[]),
     "policy_gradient": lambda tmp: small(tmp, "fig13_2_reinforce_baseline", seeds="0-2", episodes=60),
+    "average_reward": lambda tmp: small(
+        tmp, "fig10_5_access_control", seeds="0-2", steps=20_000, record_every=1_000,
+        figure={"kind": "average_reward"},
+    ),
 }  # fmt: skip
 
 
