@@ -1310,6 +1310,77 @@ def rms_error(agent: Prediction, measured: list[Any], truth: list[float]) -> flo
     return math.sqrt(total / len(measured))
 
 
+class ActorCritic(Agent):
+    """``actor_critic``: a softmax actor on the table's preferences, a critic ``v``, traces.
+
+    docs/algorithms.md, ``actor_critic``: dicts of traces (the critic's by state, the actor's
+    by flat index), each decayed by ``(gamma * lambda)`` after its update.
+    """
+
+    def __init__(self, n_states: int, n: int, *args: Any) -> None:
+        super().__init__(n_states, n, *args)
+        self.v = [float(self.params["v_init"])] * n_states
+        self.discount = 1.0
+        self.z_w: dict[int, float] = {}
+        self.z_theta: dict[int, float] = {}
+
+    def policy(self, x: int) -> list[float]:
+        """``π(· | x)``: the softmax of the preferences, from the largest."""
+        row = self.q[x]
+        largest = row[0]
+        for b in range(1, self.n):
+            if row[b] > largest:
+                largest = row[b]
+        e = [math.exp(row[b] - largest) for b in range(self.n)]
+        total = 0.0
+        for b in range(self.n):
+            total = total + e[b]
+        return [e[b] / total for b in range(self.n)]
+
+    def draw(self, x: int) -> int:
+        """One ``rng.random()``: the lowest action whose running sum exceeds it."""
+        pi = self.policy(x)
+        u = self.rng.random()
+        running = 0.0
+        for b in range(self.n):
+            running = running + pi[b]
+            if u < running:
+                return b
+        return max(b for b in range(self.n) if pi[b] > 0.0)
+
+    def start(self, x: int) -> int:
+        self.discount = 1.0
+        return self.draw(x)
+
+    def step(
+        self, s: int, a: int, r: float, s2: int, terminated: bool, truncated: bool
+    ) -> int | None:
+        later = 0.0 if terminated else self.v[s2]
+        delta = (r + self.gamma * later) - self.v[s]
+        self.z_w[s] = self.z_w.get(s, 0.0) + 1.0
+        pi = self.policy(s)
+        for b in range(self.n):
+            g = (1.0 if b == a else 0.0) - pi[b]
+            flat = s * self.n + b
+            self.z_theta[flat] = self.z_theta.get(flat, 0.0) + self.discount * g
+        alpha_w = float(self.params["alpha_w"])
+        for x, z in self.z_w.items():
+            self.v[x] = self.v[x] + (alpha_w * delta) * z
+        for flat, z in self.z_theta.items():
+            x, b = divmod(flat, self.n)
+            self.q[x][b] = self.q[x][b] + (self.alpha * delta) * z
+        if terminated or truncated:
+            self.z_w.clear()
+            self.z_theta.clear()
+            return None
+        decay_w = self.gamma * float(self.params["lambda_w"])
+        decay_theta = self.gamma * float(self.params["lambda_theta"])
+        self.z_w = {x: decay_w * z for x, z in self.z_w.items()}
+        self.z_theta = {flat: decay_theta * z for flat, z in self.z_theta.items()}
+        self.discount = self.gamma * self.discount
+        return self.draw(s2)
+
+
 ALGORITHMS: dict[str, type[Agent]] = {
     "q_learning": QLearning,
     "sarsa": Sarsa,
@@ -1326,6 +1397,7 @@ ALGORITHMS: dict[str, type[Agent]] = {
     "monte_carlo": MonteCarlo,
     "monte_carlo_es": MonteCarloES,
     "off_policy_monte_carlo": OffPolicyMonteCarlo,
+    "actor_critic": ActorCritic,
     "td": TD,
     "n_step_td": NStepTD,
     "mc_prediction": MCPrediction,
@@ -1354,6 +1426,10 @@ PARAMETER_DEFAULTS: dict[str, Any] = {
     "sampling": "weighted",
     "policy_run": "",
     "policy_epsilon": 0.1,
+    "alpha_w": 0.1,
+    "lambda_theta": 0.9,
+    "lambda_w": 0.9,
+    "v_init": 0.0,
 }
 PREDICTION_DEFAULTS: dict[str, Any] = {"update": "constant_alpha"}
 """mc_prediction's own default of a key another algorithm defaults otherwise"""

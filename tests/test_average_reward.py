@@ -62,7 +62,9 @@ def test_both_engines_equal_the_re_derivation_byte_for_byte(
     raw = {"kind": "average_reward", "world": {"id": ACCESS, "kwargs": kwargs}, "seeds": 3,
            "steps": 3_001, "record_every": 500, "engine": engine,
            "curves": [{"algorithm": "differential_sarsa", **curve}]}  # fmt: skip
-    record = study_kind.run_one(read(raw), {"curve": 0, "seed": 3}, RunHandle(lambda: False, lambda n: None))
+    record = study_kind.run_one(
+        read(raw), {"curve": 0, "seed": 3}, RunHandle(lambda: False, lambda n: None)
+    )
     assert record is not None
     ours = {name: np.asarray(value) for name, value in record.arrays.items()}
     theirs = reference.run_differential_sarsa(
@@ -112,7 +114,7 @@ def test_the_optimal_gain_by_relative_value_iteration_agrees_with_a_second_compu
     # (gain, values) solve the average-reward optimality equation: no action improves
     backup = model.backup(values, 1.0)
     assert np.allclose(backup.max(axis=1) - values, gain, atol=1e-9)
-    # the discounted optimum's (1 - γ) v*(s) nears the gain as γ nears 1
+    # the discounted optimum's (1 - gamma) v*(s) nears the gain as gamma nears 1
     for gamma, tolerance in ((0.999, 2e-2), (0.9999, 2e-3)):
         discounted = value_iteration(model, gamma, tolerance=1e-9)
         assert (1 - gamma) * discounted.values == pytest.approx(gain, abs=tolerance)
@@ -144,7 +146,10 @@ def test_on_a_small_task_no_deterministic_policy_beats_the_optimal_gain() -> Non
 def test_optimum_prints_the_gain_and_the_policy_by_priority() -> None:
     result = invoke("optimum", ACCESS)
     assert result.exit_code == 0, result.output
-    assert "optimal gain (reward per step, relative value iteration, 167 sweeps): 2.747642" in result.output
+    assert (
+        "optimal gain (reward per step, relative value iteration, 167 sweeps): 2.747642"
+        in result.output
+    )
     assert "  2  reject reject reject reject accept accept" in result.output
     data = json.loads(invoke("optimum", ACCESS, "--json").output)
     assert data["gain"] == pytest.approx(2.747642, abs=1e-6) and len(data["policy"]) == 44

@@ -69,6 +69,7 @@ CANON_CONFIGS = {
     "dyna_q": 19,
     "dyna_q_plus": 19,
     "monte_carlo": 17,
+    "actor_critic": 19,
 }
 
 

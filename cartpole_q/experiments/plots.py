@@ -339,6 +339,8 @@ def plot_policy(
     run = runs[0]
     title = f"Policy of {run_dir.name}" + (f", seed {seed}" if seed is not None else "")
     value_name = "state value max_a Q"
+    if run.config.agent.algorithm == "actor_critic":  # its table holds a policy's preferences
+        value_name = "largest action preference max_a theta"
     q_table, visits = run.q_table, run.visits
     if len(runs) > 1:
         q_table, visits = agreement_table(runs)

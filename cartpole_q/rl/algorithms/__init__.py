@@ -15,6 +15,7 @@ from collections.abc import Iterator
 
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.algorithms import (
+    actor_critic,
     batch_prediction,
     double_q_learning,
     dyna_q,
@@ -43,7 +44,7 @@ from cartpole_q.rl.algorithms import (
 PACKAGE = (
     q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
     sarsa_lambda, watkins_q_lambda, true_online_sarsa_lambda, dyna_q, dyna_q_plus,
-    prioritized_sweeping, monte_carlo, monte_carlo_es, off_policy_monte_carlo, td,
+    prioritized_sweeping, monte_carlo, monte_carlo_es, off_policy_monte_carlo, actor_critic, td,
     mc_prediction, batch_prediction, off_policy_mc_prediction, n_step_td, offline_lambda_return,
     td_lambda, true_online_td_lambda,
 )  # fmt: skip
