@@ -452,3 +452,26 @@ def test_compile_names_what_it_skipped_and_counts_it_apart(in_tmp: Path) -> None
     assert len(skipped) == 1 and "q_learning on FrozenLake-v1 (numba engine): " in skipped[0]
     assert "train.info_metric" in skipped[0]
     assert lines[-1].startswith("1 compiled or loaded, 1 skipped, in ")
+
+
+def test_figure_7_4_sets_one_arrow_for_one_step_sarsa_and_the_last_ten_steps_for_ten(
+    tmp_path: Path,
+) -> None:
+    """The shipped study: one episode on the Dyna maze, the same path for both n."""
+    out = tmp_path / "f74"
+    study = Path(__file__).resolve().parents[1] / "examples/book/fig7_4_n_step_sarsa_path.yaml"
+    result = invoke("study", study, "--out", out, "-q")
+    assert result.exit_code == 0, result.output
+    rows = (out / "fig7_4_n_step_sarsa_path.csv").read_text(encoding="utf-8").splitlines()[1:]
+    arrows: dict[str, dict[tuple[int, int], int]] = {}
+    for row in rows:
+        panel, series, x, y, _, _, value = row.rsplit(",", 6)
+        if series == "greedy action (empty: all values equal)" and value:
+            arrows.setdefault(panel.strip('"'), {})[(int(y), int(x))] = int(value)
+    # one-step SARSA: only the last action, up from (1, 8) into the goal at (0, 8)
+    assert arrows["n 1, seed 4"] == {(1, 8): 0}
+    # 10-step: the last ten actions, from six cells up the right-hand column (up 0, down 1,
+    # right 3: in (1, 8) the bumps to the right, each strengthened, outweigh the last step)
+    assert arrows["n 10, seed 4"] == {
+        (4, 7): 3, (3, 7): 1, (4, 8): 0, (3, 8): 0, (2, 8): 0, (1, 8): 3,
+    }  # fmt: skip

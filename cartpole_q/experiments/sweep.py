@@ -627,6 +627,8 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
+    if profile_for(first.env.id).grid is not None:
+        return _plot_grid_arrows(spec, paths, labels, out)
     info = env_facts(first)
     q_star, optimal, v_star = blackjack_optimum(first)
     maps = []
@@ -639,6 +641,25 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         maps.append((name, np.argmax(q_table, axis=-1), q_table.max(axis=-1)))
     maps.append(("exact optimum (the rules)", optimal, v_star))
     return write_figure(out, blackjack_optimal_figure(maps, figure.title or spec.name))
+
+
+def _plot_grid_arrows(
+    spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path
+) -> Path:
+    """Figures 7.4 and 8.3: each point's first seed, arrows where its greedy action is set."""
+    from cartpole_q.envs.models import grid_layout
+    from cartpole_q.figures.maps import GridMap, grid_arrows_figure
+
+    figure = spec.figure
+    assert figure is not None
+    layout = grid_layout(spec.points[0].config.env)
+    assert layout is not None
+    grid = GridMap(layout.rows, layout.columns, layout.cells, layout.moves)
+    panels = []
+    for label, path in zip(labels, paths, strict=True):
+        run = load_run_set(path).runs[0]
+        panels.append((f"{label}, seed {run.config.seed}", run.q_table, run.visits))
+    return write_figure(out, grid_arrows_figure(panels, grid, figure.title or spec.name))
 
 
 def plan_tasks(

@@ -73,7 +73,9 @@ values (prediction; Sutton & Barto Example 6.2's left panel)"""
 POLICY_FIGURE = "policy"
 """``figure.metric: policy``: each point's greedy policy and its values ``max_b Q``, beside
 the exact optimal policy and ``v*`` from the world's model (control on a Blackjack world;
-Sutton & Barto Figure 5.2)"""
+Sutton & Barto Figure 5.2); on a grid world, the first seed's table of each point as arrows
+where its greedy action is set, blank where all its values are equal, over the cells its
+training visited (Figures 7.4, 8.3)"""
 
 
 @dataclass(frozen=True)
@@ -335,11 +337,16 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
                     f"point {point.index} runs agent.algorithm {config.agent.algorithm}, a "
                     "prediction algorithm; draw values of it instead."
                 )
-            if profile_for(config.env.id).policy_map != "blackjack":
+            profile = profile_for(config.env.id)
+            if profile.grid is not None and config.discretization is None:
+                continue  # a grid world: Figures 7.4 and 8.3, arrows where a greedy action is set
+            if profile.policy_map != "blackjack":
                 raise ConfigError(
                     f"{where}: figure.metric: policy draws Blackjack's policy as Sutton & "
-                    f"Barto's Figure 5.2, but point {point.index} plays {config.env.id}; it "
-                    "needs a Blackjack world (Blackjack-v1, cartpole_q/BlackjackES-v0)."
+                    f"Barto's Figure 5.2, or a grid world's arrows as Figures 7.4 and 8.3, but "
+                    f"point {point.index} plays {config.env.id}; it needs a Blackjack world "
+                    "(Blackjack-v1, cartpole_q/BlackjackES-v0) or a grid world "
+                    "(cartpole_q/DynaMaze-v0, FrozenLake-v1, ...)."
                 )
             if config.agent.gamma != 1.0:
                 raise ConfigError(

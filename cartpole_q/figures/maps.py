@@ -269,6 +269,58 @@ def grid_policy_figure(
     return figure
 
 
+def grid_arrows_figure(
+    panels: Sequence[tuple[str, np.ndarray, np.ndarray | None]], grid: GridMap, title: str
+) -> DataFigure:
+    """Figures 7.4 and 8.3: per run, an arrow where the greedy action is set.
+
+    A cell gets its greedy action's arrow (the lowest among the largest ``Q``) where its
+    values are not all equal, and none where they are (nothing learned there yet); cells
+    the run visited are shaded (the path it took) where its visits are known (a run
+    directory's; a sweep keeps none). The data: per panel, ``greedy action`` (empty: all
+    equal) and ``visits`` (the steps taken from the cell) per cell.
+    """
+    across = len(panels)
+    width = min(18.0, across * (0.6 * grid.columns + 1.0) + 0.5)
+    figure = DataFigure(figsize=(width, 0.6 * grid.rows + 1.6), dpi=DPI, layout="constrained")
+    for index, (name, q_table, visits) in enumerate(panels):
+        axes = figure.add_subplot(1, across, index + 1)
+        record = figure.data.panel(name)
+        q = q_table.reshape(grid.rows * grid.columns, -1)
+        counts = (
+            np.zeros(len(q)) if visits is None else visits.reshape(len(q), -1).sum(axis=1)
+        ).astype(np.int64)
+        _draw_grid(axes, grid)
+        for state in range(len(q)):
+            if counts[state] > 0 and grid.cells[state] not in _CELL_COLOURS:
+                row, column = divmod(state, grid.columns)
+                axes.add_patch(cell_square(row, column, "#f2d98c"))
+        arrows = np.ma.masked_array(np.zeros((grid.rows, grid.columns), dtype=np.int64), mask=True)
+        for state in range(len(q)):
+            if grid.cells[state] in _CELL_COLOURS or q[state].max() == q[state].min():
+                continue
+            row, column = divmod(state, grid.columns)
+            action = int(np.argmax(q[state]))
+            arrows[row, column] = action
+            d_row, d_col = grid.moves[action]
+            axes.annotate("", xy=(column + 0.32 * d_col, row + 0.32 * d_row),
+                          xytext=(column - 0.32 * d_col, row - 0.32 * d_row),
+                          arrowprops={"arrowstyle": "->", "color": "#1f4e79", "linewidth": 1.8},
+                          zorder=3)  # fmt: skip
+        record.cells("greedy action (empty: all values equal)", range(grid.columns),
+                     range(grid.rows), arrows)  # fmt: skip
+        if visits is not None:
+            record.cells("visits", range(grid.columns), range(grid.rows),
+                         counts.reshape(grid.rows, grid.columns))  # fmt: skip
+        shown = int(arrows.count())
+        told = f"{shown} arrow{'s' if shown != 1 else ''}"
+        if visits is not None:
+            told += f", {int((counts > 0).sum())} cells visited"
+        axes.set_title(f"{name}\n{told}", fontsize=9)
+    figure.suptitle(title)
+    return figure
+
+
 def draw_paths(
     axes: Axes,
     record: PanelData,
