@@ -35,7 +35,14 @@ from cartpole_q.experiments.linear import (
     world_facts,
     world_key,
 )
-from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
+from cartpole_q.experiments.study import (
+    CurveFunctions,
+    CurvesKind,
+    Finished,
+    RunHandle,
+    StudyFile,
+    register_kind,
+)
 from cartpole_q.experiments.sweep_spec import check_top_keys, checked_figure_section, checked_study
 from cartpole_q.progress import Units
 from cartpole_q.rl import average_reward as methods
@@ -561,57 +568,46 @@ def summary(
     return lines
 
 
-class AverageRewardKind(RunsKind):
+def finish(
+    study: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+) -> Finished:
+    """The figure and the summary."""
+    return Finished(
+        [(study.file, study_figure(study, keys, records))], (), summary(study, keys, records)
+    )
+
+
+def _columns(study: Study) -> tuple[str, ...]:
+    return ("r_bar", "final_r_bar", "final_rate")
+
+
+def _steps(study: Study) -> int:
+    return study.steps
+
+
+def _unit(study: Study) -> str:
+    return "steps"
+
+
+def _compile_notice() -> str | None:
+    from cartpole_q.engines.average_reward import compile_notice
+
+    return compile_notice()
+
+
+class AverageRewardKind(CurvesKind):
     """``kind: average_reward``: differential semi-gradient SARSA (Figure 10.5)."""
 
     name = "average_reward"
     units = Units("average reward", "steps", "runs")
     runs_per_task = 1
 
-    def run_size(self, spec: Study, key: Mapping[str, Cell]) -> int:
-        """A run's steps (what the progress counts)."""
-        return spec.steps
 
-    def read(self, study: StudyFile) -> Study:
-        """Check the file (:func:`read_study`)."""
-        return read_study(study)
-
-    def runs(self, spec: Study) -> list[dict[str, Cell]]:
-        """Each curve on each seed (:func:`runs_of`)."""
-        return runs_of(spec)
-
-    def describe(self, spec: Study) -> tuple[int, str]:
-        """The runs, by curves and seeds."""
-        runs = len(runs_of(spec))
-        seeds = f"{len(spec.seeds):,} seed{'s' if len(spec.seeds) != 1 else ''}"
-        return runs, (
-            f"an average_reward study of {runs:,} run{'s' if runs != 1 else ''}: "
-            f"{len(spec.curves)} curve{'s' if len(spec.curves) != 1 else ''} x {seeds} "
-            f"({spec.steps:,} steps each, the {spec.engine} engine)"
+AVERAGE_REWARD = register_kind(
+    AverageRewardKind(
+        CurveFunctions(
+            read_study, runs_of, run_one, finish, _columns, _steps, _unit, _compile_notice,
         )
-
-    def result_columns(self, spec: Study) -> tuple[str, ...]:
-        """A run's final ``R̄``; its ``R̄`` and reward per step over the last tenth of the records."""
-        return ("r_bar", "final_r_bar", "final_rate")
-
-    def before_runs(self, spec: Study) -> str | None:
-        """The compile notice."""
-        from cartpole_q.engines.average_reward import compile_notice
-
-        return compile_notice()
-
-    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
-        """One run (:func:`run_one`)."""
-        return run_one(spec, key, handle)
-
-    def finish(
-        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
-    ) -> Finished:
-        """The figure and the summary."""
-        return Finished(
-            [(spec.file, study_figure(spec, keys, records))], (), summary(spec, keys, records)
-        )
-
-
-AVERAGE_REWARD = register_kind(AverageRewardKind())
+    )
+)  # fmt: skip
 """the average-reward kind (registered)"""

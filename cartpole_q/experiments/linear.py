@@ -24,7 +24,14 @@ import numpy as np
 
 from cartpole_q.config import ConfigError, parse_seeds, shown_value
 from cartpole_q.config.bounds import check_count, check_memory
-from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
+from cartpole_q.experiments.study import (
+    CurveFunctions,
+    CurvesKind,
+    Finished,
+    RunHandle,
+    StudyFile,
+    register_kind,
+)
 from cartpole_q.experiments.sweep_spec import check_top_keys, checked_figure_section, checked_study
 from cartpole_q.progress import Units
 from cartpole_q.rl import features as layers
@@ -1063,56 +1070,45 @@ def _book_line(study: Study, found: Sequence[CurveOutcome], number: BookNumber) 
     return f"{number.label}: {book}; ours {ours:.4g} ({where})"
 
 
-class LinearKind(RunsKind):
+def finish(
+    study: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+) -> Finished:
+    """The figure and the summary."""
+    found = outcomes(study, keys, records)
+    return Finished([(study.file, study_figure(study, found))], (), summary(study, found))
+
+
+def _columns(study: Study) -> tuple[str, ...]:
+    return study.errors
+
+
+def _count(study: Study) -> int:
+    return study.count
+
+
+def _unit(study: Study) -> str:
+    return study.unit
+
+
+def _compile_notice() -> str | None:
+    from cartpole_q.engines.linear import compile_notice
+
+    return compile_notice()
+
+
+class LinearKind(CurvesKind):
     """``kind: linear``: linear methods on feature layers (Figures 9.5, 9.10, 11.2, 11.5, 11.6)."""
 
     name = "linear"
     units = Units("linear", "episodes or steps", "runs")
     runs_per_task = 4
 
-    def run_size(self, spec: Study, key: Mapping[str, Cell]) -> int:
-        """A run's episodes, steps or sweeps (what the progress counts)."""
-        return spec.count
 
-    def read(self, study: StudyFile) -> Study:
-        """Check the file (:func:`read_study`)."""
-        return read_study(study)
-
-    def runs(self, spec: Study) -> list[dict[str, Cell]]:
-        """Each curve on each seed (:func:`runs_of`)."""
-        return runs_of(spec)
-
-    def describe(self, spec: Study) -> tuple[int, str]:
-        """The runs, by curves and seeds."""
-        runs = len(runs_of(spec))
-        seeds = f"{len(spec.seeds):,} seed{'s' if len(spec.seeds) != 1 else ''}"
-        return runs, (
-            f"a linear study of {runs:,} run{'s' if runs != 1 else ''}: {len(spec.curves)} "
-            f"curve{'s' if len(spec.curves) != 1 else ''} x {seeds} ({spec.count:,} {spec.unit} "
-            f"each, the {spec.engine} engine)"
+LINEAR = register_kind(
+    LinearKind(
+        CurveFunctions(
+            read_study, runs_of, run_one, finish, _columns, _count, _unit, _compile_notice,
         )
-
-    def result_columns(self, spec: Study) -> tuple[str, ...]:
-        """The run's last errors."""
-        return spec.errors
-
-    def before_runs(self, spec: Study) -> str | None:
-        """The compile notice."""
-        from cartpole_q.engines.linear import compile_notice
-
-        return compile_notice()
-
-    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
-        """One run (:func:`run_one`)."""
-        return run_one(spec, key, handle)
-
-    def finish(
-        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
-    ) -> Finished:
-        """The figure and the summary."""
-        found = outcomes(spec, keys, records)
-        return Finished([(spec.file, study_figure(spec, found))], (), summary(spec, found))
-
-
-LINEAR = register_kind(LinearKind())
+    )
+)  # fmt: skip
 """the linear-methods kind (registered)"""

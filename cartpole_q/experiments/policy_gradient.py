@@ -33,7 +33,14 @@ from cartpole_q.experiments.linear import (
     world_facts,
     world_key,
 )
-from cartpole_q.experiments.study import Finished, RunHandle, RunsKind, StudyFile, register_kind
+from cartpole_q.experiments.study import (
+    CurveFunctions,
+    CurvesKind,
+    Finished,
+    RunHandle,
+    StudyFile,
+    register_kind,
+)
 from cartpole_q.experiments.sweep_spec import check_top_keys, checked_figure_section, checked_study
 from cartpole_q.progress import Units
 from cartpole_q.rl import policy_gradient as methods
@@ -463,56 +470,45 @@ def summary(study: Study, means: Sequence[np.ndarray]) -> list[str]:
     return lines
 
 
-class PolicyGradientKind(RunsKind):
+def finish(
+    study: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+) -> Finished:
+    """The figure and the summary."""
+    means = mean_rewards(study, keys, records)
+    return Finished([(study.file, study_figure(study, means))], (), summary(study, means))
+
+
+def _columns(study: Study) -> tuple[str, ...]:
+    return ("mean_reward", "final_reward")
+
+
+def _episodes(study: Study) -> int:
+    return study.episodes
+
+
+def _unit(study: Study) -> str:
+    return "episodes"
+
+
+def _compile_notice() -> str | None:
+    from cartpole_q.engines.policy_gradient import compile_notice
+
+    return compile_notice()
+
+
+class PolicyGradientKind(CurvesKind):
     """``kind: policy_gradient``: REINFORCE and actor-critic (Figures 13.1, 13.2)."""
 
     name = "policy_gradient"
     units = Units("policy gradient", "episodes", "runs")
     runs_per_task = 8
 
-    def run_size(self, spec: Study, key: Mapping[str, Cell]) -> int:
-        """A run's episodes (what the progress counts)."""
-        return spec.episodes
 
-    def read(self, study: StudyFile) -> Study:
-        """Check the file (:func:`read_study`)."""
-        return read_study(study)
-
-    def runs(self, spec: Study) -> list[dict[str, Cell]]:
-        """Each curve on each seed (:func:`runs_of`)."""
-        return runs_of(spec)
-
-    def describe(self, spec: Study) -> tuple[int, str]:
-        """The runs, by curves and seeds."""
-        runs = len(runs_of(spec))
-        seeds = f"{len(spec.seeds):,} seed{'s' if len(spec.seeds) != 1 else ''}"
-        return runs, (
-            f"a policy_gradient study of {runs:,} run{'s' if runs != 1 else ''}: "
-            f"{len(spec.curves)} curve{'s' if len(spec.curves) != 1 else ''} x {seeds} "
-            f"({spec.episodes:,} episodes each, the {spec.engine} engine)"
+POLICY_GRADIENT = register_kind(
+    PolicyGradientKind(
+        CurveFunctions(
+            read_study, runs_of, run_one, finish, _columns, _episodes, _unit, _compile_notice,
         )
-
-    def result_columns(self, spec: Study) -> tuple[str, ...]:
-        """A run's mean total reward, and over its last tenth of episodes."""
-        return ("mean_reward", "final_reward")
-
-    def before_runs(self, spec: Study) -> str | None:
-        """The compile notice."""
-        from cartpole_q.engines.policy_gradient import compile_notice
-
-        return compile_notice()
-
-    def run_one(self, spec: Study, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
-        """One run (:func:`run_one`)."""
-        return run_one(spec, key, handle)
-
-    def finish(
-        self, spec: Study, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
-    ) -> Finished:
-        """The figure and the summary."""
-        means = mean_rewards(spec, keys, records)
-        return Finished([(spec.file, study_figure(spec, means))], (), summary(spec, means))
-
-
-POLICY_GRADIENT = register_kind(PolicyGradientKind())
+    )
+)  # fmt: skip
 """the policy-gradient kind (registered)"""

@@ -422,6 +422,78 @@ _READ: dict[tuple[str, str], Any] = {}
 """the studies this process has read, by their ``study.yaml`` digest and file"""
 
 
+@dataclass(frozen=True)
+class CurveFunctions:
+    """What a curves kind's module does: read a file, list, run and finish the runs."""
+
+    read: Callable[[StudyFile], Any]
+    runs: Callable[[Any], list[dict[str, Cell]]]
+    run_one: Callable[[Any, Mapping[str, Cell], RunHandle], RunRecord | None]
+    finish: Callable[[Any, Sequence[Mapping[str, Cell]], Sequence[RunRecord]], Finished]
+    columns: Callable[[Any], tuple[str, ...]]
+    """a run's ``results.csv`` columns"""
+    length: Callable[[Any], int]
+    """a run's episodes, steps or sweeps (what the progress counts)"""
+    unit: Callable[[Any], str]
+    """what :attr:`length` counts (``episodes``, ``steps``)"""
+    compile_notice: Callable[[], str | None]
+    """a sentence when the kind's loops are not compiled yet"""
+
+
+class CurvesKind(RunsKind):
+    """A kind whose study is curves, each run on each seed (linear, policy gradient, average reward).
+
+    The study (``read``'s result) has ``curves``, ``seeds`` and ``engine``; the module's
+    functions (:class:`CurveFunctions`) do the work, so a kind is a name and its units.
+    """
+
+    def __init__(self, functions: CurveFunctions) -> None:
+        super().__init__()
+        self.functions = functions
+
+    def read(self, study: StudyFile) -> Any:
+        """Check the file."""
+        return self.functions.read(study)
+
+    def runs(self, spec: Any) -> list[dict[str, Cell]]:
+        """Each curve on each seed."""
+        return self.functions.runs(spec)
+
+    def run_size(self, spec: Any, key: Mapping[str, Cell]) -> int:
+        """A run's episodes, steps or sweeps."""
+        return self.functions.length(spec)
+
+    def result_columns(self, spec: Any) -> tuple[str, ...]:
+        """A run's scalar results."""
+        return self.functions.columns(spec)
+
+    def before_runs(self, spec: Any) -> str | None:
+        """The compile notice."""
+        return self.functions.compile_notice()
+
+    def run_one(self, spec: Any, key: Mapping[str, Cell], handle: RunHandle) -> RunRecord | None:
+        """One run."""
+        return self.functions.run_one(spec, key, handle)
+
+    def finish(
+        self, spec: Any, keys: Sequence[Mapping[str, Cell]], records: Sequence[RunRecord]
+    ) -> Finished:
+        """The figure and the summary."""
+        return self.functions.finish(spec, keys, records)
+
+    def describe(self, spec: Any) -> tuple[int, str]:
+        """The runs, by curves and seeds."""
+        runs = len(self.runs(spec))
+        seeds, curves = len(spec.seeds), len(spec.curves)
+        article = "an" if self.name[:1] in "aeiou" else "a"
+        return runs, (
+            f"{article} {self.name} study of {runs:,} run{'s' if runs != 1 else ''}: {curves} "
+            f"curve{'s' if curves != 1 else ''} x {seeds:,} seed{'s' if seeds != 1 else ''} "
+            f"({self.functions.length(spec):,} {self.functions.unit(spec)} each, the "
+            f"{spec.engine} engine)"
+        )
+
+
 def run_task(
     handle: JobHandle,
     kind: RunsKind,
