@@ -86,6 +86,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/Baird-v0": (7, 2, None),  # continuing: no time limit, nothing ends
         "cartpole_q/ShortCorridor-v0": (4, 2, None),  # the engines cut at 10,000 steps
         "cartpole_q/AccessControl-v0": (44, 2, None),  # continuing: nothing ends
+        "cartpole_q/Racetrack-v0": (7300, 9, 100_000),  # the left track
     }
     assert set(expected) == set(IDS)
     for env_id, (states, actions, limit) in expected.items():

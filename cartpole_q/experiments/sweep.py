@@ -627,6 +627,8 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
     figure = spec.figure
     assert figure is not None
     first = spec.points[0].config
+    if profile_for(first.env.id).policy_map == "racetrack":
+        return _plot_racetrack(spec, paths, labels, out)
     if profile_for(first.env.id).grid is not None:
         return _plot_grid_arrows(spec, paths, labels, out)
     info = env_facts(first)
@@ -641,6 +643,74 @@ def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         maps.append((name, np.argmax(q_table, axis=-1), q_table.max(axis=-1)))
     maps.append(("exact optimum (the rules)", optimal, v_star))
     return write_figure(out, blackjack_optimal_figure(maps, figure.title or spec.name))
+
+
+RACETRACK_PATHS = 6
+"""how many start cells Figure 5.5 drives from (spread evenly along the start line)"""
+
+
+def _plot_racetrack(
+    spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path
+) -> Path:
+    """Figure 5.5: per point, its first seed's greedy policy and the optimal one on its track.
+
+    Trajectories without failed increments from :data:`RACETRACK_PATHS` start cells; each
+    panel gives the policy's exact expected return from the start line (weighted by the
+    start distribution; the optimum's by value iteration on the world's model).
+    """
+    from cartpole_q.envs.gym import make_env
+    from cartpole_q.figures.maps import racetrack_figure
+
+    figure = spec.figure
+    assert figure is not None
+    panels = []
+    for point, label, path in zip(spec.points, labels, paths, strict=True):
+        env = make_env(point.config.env)
+        world: Any = env.unwrapped
+        env.close()
+        run = load_run_set(path).runs[0]
+        learned = np.argmax(run.q_table.reshape(len(world.P), -1), axis=1)
+        panels.extend(_racetrack_panels(world, learned, f"{label}, seed {run.config.seed}"))
+    return write_figure(out, racetrack_figure(panels, figure.title or spec.name))
+
+
+def _racetrack_panels(
+    world: Any, learned: np.ndarray, label: str
+) -> list[tuple[str, Sequence[str], list[tuple[str, Any, str]]]]:
+    """A learned greedy policy's panel and the optimal policy's, on one track."""
+    from cartpole_q.families.book_mdps.racetrack import noiseless_path
+    from cartpole_q.rl.mdp import FiniteMDP
+    from cartpole_q.rl.solvers import evaluate_policy, reachable_states, value_iteration
+
+    model = FiniteMDP.from_transitions(
+        world.P, world.initial_state_distrib, int(world.action_space.n)
+    )
+    optimum = value_iteration(model, 1.0)
+    starts = world.starts
+    most = min(RACETRACK_PATHS, len(starts))
+    chosen = sorted({starts[round(i * (len(starts) - 1) / max(1, most - 1))] for i in range(most)})
+
+    def drive(policy: np.ndarray) -> list[tuple[str, Any, str]]:
+        found = []
+        for start in chosen:
+            cells, how = noiseless_path(world, policy, start)
+            found.append((f"from column {world.cells[start][1]}", cells, how))
+        return found
+
+    pi = np.zeros((model.n_states, model.n_actions))
+    pi[np.arange(model.n_states), learned] = 1.0
+    reached = np.flatnonzero(reachable_states(model, pi))  # solved on these alone: fast
+    try:
+        values = evaluate_policy(model, pi, 1.0, reached)
+        told = f"expected return {float(model.initial[reached] @ values):.2f}"
+    except ValueError:
+        told = "never finishes from some state it reaches"
+    size = "x".join(str(n) for n in world.track_size)
+    return [
+        (f"{label}: greedy policy,\n{told}", world.track_rows, drive(learned)),
+        (f"{size} track, optimal policy (value iteration),\nexpected return "
+         f"{optimum.start_value:.2f}", world.track_rows, drive(optimum.policy)),
+    ]  # fmt: skip
 
 
 def _plot_grid_arrows(

@@ -340,6 +340,8 @@ def _check_info_metric(metric: str, points: Sequence[Point], where: str) -> None
             profile = profile_for(config.env.id)
             if profile.grid is not None and config.discretization is None:
                 continue  # a grid world: Figures 7.4 and 8.3, arrows where a greedy action is set
+            if profile.policy_map == "racetrack":
+                continue  # Figure 5.5: trajectories on the track
             if profile.policy_map != "blackjack":
                 raise ConfigError(
                     f"{where}: figure.metric: policy draws Blackjack's policy as Sutton & "

@@ -83,8 +83,9 @@ class EnvProfile:
     steps becomes 950 of 1000)"""
     policy_map: str = "binned"
     """how ``plot --policy`` lays out states: ``binned`` (two dimensions of the grid), ``grid``
-    (a grid world's cells), ``blackjack`` (Sutton & Barto's two panels) or ``components``
-    (a Discrete state decomposed into :attr:`state_components`)"""
+    (a grid world's cells), ``blackjack`` (Sutton & Barto's two panels), ``components``
+    (a Discrete state decomposed into :attr:`state_components`) or ``racetrack`` (a
+    study's ``figure.metric: policy`` draws trajectories on the track)"""
     state_components: tuple[int, ...] = ()
     """with ``components``: the sizes a Discrete state decomposes into, in C order"""
     component_names: tuple[str, ...] = ()

@@ -321,6 +321,58 @@ def grid_arrows_figure(
     return figure
 
 
+_TRACK_COLOURS = {"#": "#4a4a4a", ".": "#f4f1e8", "S": "#f2d98c", "F": "#3c9a4a"}
+
+
+def racetrack_figure(
+    panels: Sequence[
+        tuple[str, Sequence[str], Sequence[tuple[str, Sequence[tuple[int, int]], str]]]
+    ],
+    title: str,
+) -> DataFigure:
+    """Exercise 5.12 (Figure 5.5): a policy's trajectories from start cells, drawn on its track.
+
+    ``panels``: per panel its name, its track's rows and paths ``(label, cells, how)``,
+    ``cells`` the ``(row, column)`` the car passes, ``how`` ``finish``, ``crash`` or
+    ``stuck`` (a crash or a stall is dashed and ends in a cross). The data: each path's
+    cells, per panel.
+    """
+    from matplotlib.colors import ListedColormap
+
+    kinds = "#.SF"
+    cmap = ListedColormap([_TRACK_COLOURS[kind] for kind in kinds])
+    across = len(panels)
+    widest = max(len(track[0]) for _, track, _ in panels)
+    tallest = max(len(track) for _, track, _ in panels)
+    figure = DataFigure(
+        figsize=(min(20.0, 1.0 + across * (0.2 * widest + 1.4)), 0.2 * tallest + 2.6),
+        dpi=DPI, layout="constrained",
+    )  # fmt: skip
+    for index, (name, track, paths) in enumerate(panels):
+        axes = figure.add_subplot(1, across, index + 1)
+        record = figure.data.panel(name.replace("\n", " "))
+        codes = np.array([[kinds.index(char) for char in line] for line in track])
+        axes.imshow(codes, cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest")
+        colours = colour_cycle(len(paths))
+        for (label, cells, how), colour in zip(paths, colours, strict=True):
+            ys = [row for row, _ in cells]
+            xs = [column for _, column in cells]
+            record.line(f"{label} ({how})", xs, ys)
+            dashed = how != "finish"
+            axes.plot(xs, ys, color=colour, linewidth=1.6, linestyle="--" if dashed else "-",
+                      marker="o", markersize=3, label=f"{label}: {how}")  # fmt: skip
+            if dashed:
+                axes.plot(xs[-1], ys[-1], color=colour, marker="x", markersize=8)
+        axes.set_xlim(-0.5, len(track[0]) - 0.5)
+        axes.set_ylim(len(track) - 0.5, -0.5)
+        axes.set_xticks(range(0, len(track[0]), 5))
+        axes.set_yticks(range(0, len(track), 5))
+        axes.set_title(name, fontsize=8)
+        axes.legend(fontsize="xx-small", loc="lower right")
+    figure.suptitle(title)
+    return figure
+
+
 def draw_paths(
     axes: Axes,
     record: PanelData,

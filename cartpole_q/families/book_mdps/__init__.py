@@ -23,9 +23,13 @@ _BIAS = "cartpole_q.families.book_mdps.bias"
 _ONE_STATE = "cartpole_q.families.book_mdps.one_state"
 _CORRIDOR = "cartpole_q.families.book_mdps.short_corridor"
 _ACCESS = "cartpole_q.families.book_mdps.access_control"
+_RACETRACK = "cartpole_q.families.book_mdps.racetrack"
 ONE_STATE_TIME_LIMIT = 1_000
 """steps before an episode of the one-state MDP is truncated (left comes back with
 probability 0.9: ten steps on average)"""
+RACETRACK_TIME_LIMIT = 100_000
+"""steps before a racetrack episode is truncated: far beyond what an exploring behaviour
+needs, a bound on a greedy policy that crashes for ever"""
 
 
 MAXIMIZATION_BIAS = EnvProfile(
@@ -98,7 +102,22 @@ ACCESS_CONTROL = EnvProfile(
     average_reward=True,
 )
 
-PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR, ACCESS_CONTROL)
+RACETRACK = EnvProfile(
+    name="Racetrack",
+    description="the racetrack: a car with a velocity of 0-4 cells a step up and right, nine "
+    "actions of -1, 0, +1 to each component (none, with probability 0.1), -1 a step, back "
+    "to the start line after a crash (Sutton & Barto's Exercise 5.12, Figure 5.5)",
+    ids=("cartpole_q/Racetrack-v0",),
+    entry_points=(f"{_RACETRACK}:RacetrackEnv",),
+    action_names=tuple(
+        f"up {up:+d}, right {right:+d}" for up in (-1, 0, 1) for right in (-1, 0, 1)
+    ),
+    model="transition_table",
+    twin=load_table_twin,
+    policy_map="racetrack",
+)
+
+PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR, ACCESS_CONTROL, RACETRACK)
 """the family's profiles"""
 WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
@@ -106,5 +125,6 @@ WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/Baird-v0", f"{_BAIRD}:BairdEnv", None),
     World(f"{NAMESPACE}/ShortCorridor-v0", f"{_CORRIDOR}:ShortCorridorEnv", None),
     World(f"{NAMESPACE}/AccessControl-v0", f"{_ACCESS}:AccessControlEnv", None),
+    World(f"{NAMESPACE}/Racetrack-v0", f"{_RACETRACK}:RacetrackEnv", RACETRACK_TIME_LIMIT),
 )
 """the worlds it registers"""
