@@ -11,6 +11,7 @@ uniformly from the four. Nothing ends: a continuing task, for the average-reward
 **States.** ``state = priority_index * (servers + 1) + free``, ``priority_index`` 0-3 for
 the priorities 1, 2, 4, 8 and ``free`` 0-``servers``: 44 states by default, the components
 ``(4, 11)`` in C order. The start has every server free, the priority drawn uniformly.
+The first outcome below: no busy server freed (0.94), the next customer of priority 1.
 
 **Outcomes.** ``P[s][a]`` lists, for ``freed = 0 .. busy`` (``busy`` counted after the
 acceptance) and then each next priority, the outcome ``(C(busy, freed) p^freed (1 -
@@ -19,8 +20,8 @@ p)^(busy - freed) / 4, next state, reward, False)``, the binomial factor as
 after. So a step is one draw against the running sums, as every table world's.
 
 >>> world = AccessControlEnv()
->>> len(world.P), world.P[state_of(3, 10)][ACCEPT][0]  # priority 8, all free: accept pays 8
-(44, (0.25, 39, 8.0, False))
+>>> len(world.P), world.P[state_of(3, 10)][ACCEPT][0]  # priority 8, all free: accept pays 8,
+(44, (0.235, 9, 8.0, False))
 >>> world.P[state_of(0, 0)][ACCEPT] == world.P[state_of(0, 0)][REJECT]  # no free server
 True
 """

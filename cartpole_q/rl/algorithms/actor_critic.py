@@ -20,8 +20,8 @@ contract: docs/algorithms.md.
 >>> step(q, memory, (0.1, 0.0, 0.0, 0.0), 0, first, 1.0, 1, True, False, 0.5, 1.0, 0.0,
 ...      np.random.default_rng(0))
 -1
->>> float(memory[0][0, 0]), q[0].tolist()  # v(0) = 0.1 * 1; theta(0, a) moves by 0.5 * (1 - 0.5)
-(0.1, [0.25, -0.25])
+>>> first, float(memory[0][0, 0]), q[0].tolist()  # v(0) = 0.1 * 1; theta(0, 1) by 0.5 * (1 - 0.5)
+(1, 0.1, [-0.25, 0.25])
 """
 
 from __future__ import annotations
