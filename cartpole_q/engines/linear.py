@@ -388,6 +388,22 @@ def _gymnasium_chunk(learner: Learner, behaviour: Behaviour, world: World, seed:
     return episodes
 
 
+def warm_up_world(world_id: str, continuing: bool, cap: int) -> tuple[World, int, int]:
+    """A registered table world as the loops take it, for a warm-up: ``(world, N, n)``."""
+    import gymnasium
+
+    from cartpole_q.families.tables.twin import table_params
+
+    env = gymnasium.make(world_id)
+    table: Any = env.unwrapped
+    params = table_params(table, aggregated=True)
+    assert not isinstance(params, str)
+    world = World(params, continuing, cap, functools.partial(gymnasium.make, world_id))
+    sizes = len(table.P), int(table.action_space.n)
+    env.close()
+    return world, sizes[0], sizes[1]
+
+
 def warm_up() -> None:
     """Compile (or load from the cache) every loop: tiny runs of each kind, on both engines.
 

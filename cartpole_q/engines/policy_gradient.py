@@ -226,20 +226,10 @@ def warm_up() -> None:
     The loops take every world and layer alike (their argument types do not change), so
     this compiles what every policy-gradient study plays (``cartpole-q compile --all``).
     """
-    import functools
-
-    import gymnasium
-
-    from cartpole_q.families.tables.twin import table_params
+    from cartpole_q.engines.linear import warm_up_world
     from cartpole_q.rl.policy_gradient import ALGORITHMS, new_agent
 
-    world_id = "cartpole_q/ShortCorridor-v0"
-    env = gymnasium.make(world_id)
-    table: Any = env.unwrapped
-    params = table_params(table, aggregated=True)
-    assert not isinstance(params, str)
-    world = World(params, False, 20, functools.partial(gymnasium.make, world_id))
-    n_states, n_actions = len(table.P), int(table.action_space.n)
+    world, n_states, n_actions = warm_up_world("cartpole_q/ShortCorridor-v0", False, 20)
     policy_rows = (
         np.arange(n_states * n_actions, dtype=np.int64).reshape(-1, 1),
         np.ones((n_states * n_actions, 1)),
@@ -252,4 +242,3 @@ def warm_up() -> None:
                 np.zeros(n_states * n_actions), value_rows, np.zeros(1), (0.5, 0.5),
             )  # fmt: skip
             run(agent, world, 0, 1, engine)
-    env.close()

@@ -736,9 +736,8 @@ def _linear_book() -> Schema:
 # -- policy gradient ------------------------------------------------------------------------
 
 
-def _policy_gradient() -> Schema:
-    from cartpole_q.rl import policy_gradient as methods
-
+def _curve_study_parts() -> tuple[Schema, Schema, Schema, Schema, Schema]:
+    """What the curve kinds' files share: a number, ``world``, a count, a step size, a list."""
     number = _bandit_number()
     world = _object(
         {"id": {"type": "string", "minLength": 1}, "kwargs": {"type": "object"}}, ["id"]
@@ -746,6 +745,13 @@ def _policy_gradient() -> Schema:
     count = {"type": "integer", "minimum": 1, "maximum": MAX_COUNT}
     positive = _bandit_number(0.0, low_open=True)
     numbers = {"type": "array", "minItems": 1, "items": number}
+    return number, world, count, positive, numbers
+
+
+def _policy_gradient() -> Schema:
+    from cartpole_q.rl import policy_gradient as methods
+
+    number, world, count, positive, numbers = _curve_study_parts()
     curve = _object({
         "label": TEXT,
         "algorithm": {"enum": list(methods.ALGORITHMS)},
@@ -789,13 +795,7 @@ def _policy_gradient() -> Schema:
 def _average_reward() -> Schema:
     from cartpole_q.rl import average_reward as methods
 
-    number = _bandit_number()
-    world = _object(
-        {"id": {"type": "string", "minLength": 1}, "kwargs": {"type": "object"}}, ["id"]
-    )
-    count = {"type": "integer", "minimum": 1, "maximum": MAX_COUNT}
-    positive = _bandit_number(0.0, low_open=True)
-    numbers = {"type": "array", "minItems": 1, "items": number}
+    number, world, count, positive, numbers = _curve_study_parts()
     curve = _object({
         "label": TEXT,
         "algorithm": {"enum": list(methods.ALGORITHMS)},
