@@ -1473,6 +1473,7 @@ def reference_train(
     randomize: Mapping[str, Sequence[float]] | None = None,
     stop_when_solved: bool = True,
     params: Mapping[str, Any] | None = None,
+    initial_values: Sequence[float] | None = None,
 ) -> ReferenceRun:
     """Train as the contract says, in plain Python on ``gymnasium.make``.
 
@@ -1495,6 +1496,8 @@ def reference_train(
         stop_when_solved: ``train.stop_when_solved``.
         params: The algorithm's keys (``n``, ``lambda``, ``trace``, ``planning_steps``,
             ``kappa``, ``update``); missing ones take docs/algorithms.md's defaults.
+        initial_values: ``agent.initial_values`` (a prediction algorithm's ``V`` before
+            the first episode, one value per row); ``None``: every row at ``q_init``.
 
     Returns:
         The kept table, the visits, the returns and lengths, the solve episode.
@@ -1527,6 +1530,10 @@ def reference_train(
         n_states, n, weight_init, float(gamma), rng,
         {**defaults, **(params or {}), "tilings": tilings},
     )  # fmt: skip
+    if initial_values is not None:  # docs/algorithms.md, "Prediction": row x starts at entry x
+        agent.q = [
+            [float(value)] * len(row) for value, row in zip(initial_values, agent.q, strict=True)
+        ]
     if averaged:  # docs/algorithms.md, "Sample averages": one count per table entry
         agent.step_counts = [[0.0] * len(row) for row in agent.q]
     measured: list[Any] = []

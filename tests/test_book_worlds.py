@@ -87,6 +87,7 @@ def test_time_limits_and_spaces_are_as_documented() -> None:
         "cartpole_q/ShortCorridor-v0": (4, 2, None),  # the engines cut at 10,000 steps
         "cartpole_q/AccessControl-v0": (44, 2, None),  # continuing: nothing ends
         "cartpole_q/Racetrack-v0": (7300, 9, 100_000),  # the left track
+        "cartpole_q/DrivingHome-v0": (6, 1, None),  # every drive ends after five steps
     }
     assert set(expected) == set(IDS)
     for env_id, (states, actions, limit) in expected.items():

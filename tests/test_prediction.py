@@ -22,6 +22,7 @@ from cartpole_q.experiments.run import execute_run, prepare, start_run
 from cartpole_q.store import rundir
 from cartpole_q.training import train
 from tests.conftest import invoke, write_yaml
+from tests.test_cli import assert_refused
 
 WALK5 = {"env.id": "cartpole_q/RandomWalk5-v0", "discretization": None, "agent.gamma": 1.0}
 WALK19 = {"env.id": "cartpole_q/RandomWalk-v0", "discretization": None, "agent.gamma": 1.0}
@@ -730,3 +731,75 @@ def test_the_sample_averages_example_shows_what_its_comment_measures() -> None:
     td, td_averaged, mc, mc_averaged = errors
     assert td_averaged[9] < td[9]  # episode 10
     assert mc_averaged[99] < mc[99]  # episode 100
+
+
+DRIVING = {
+    "env.id": "cartpole_q/DrivingHome-v0", "discretization": None, "agent.gamma": 1.0,
+    "agent.alpha": 1.0, "train.episodes": 1, "train.eval_every": 0,
+    "train.checkpoint_every": 0, "eval.episodes": 1,
+}  # fmt: skip
+PREDICTED_TO_GO = [30.0, 35.0, 15.0, 10.0, 3.0, 0.0]
+"""Example 6.1's predicted minutes to go, leaving office to arriving home"""
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+@pytest.mark.parametrize(
+    ("algorithm", "after"),
+    [
+        # Monte Carlo: every prediction moves to the actual minutes to go (43 in total)
+        ("mc_prediction", [43.0, 38.0, 23.0, 13.0, 3.0, 0.0]),
+        # TD(0): each to the minutes the leg took plus the next situation's prediction
+        ("td", [40.0, 30.0, 20.0, 13.0, 3.0, 0.0]),
+    ],
+)
+def test_initial_values_start_v_state_by_state_as_example_6_1(
+    tmp_path: Path, engine: str, algorithm: str, after: list[float]
+) -> None:
+    """One drive with alpha 1 from the example's predictions: Figure 6.1's changes."""
+    config = tmp_path / "drive.yaml"
+    write_yaml(config, {})
+    sets = [f"{key}={json.dumps(value)}" for key, value in DRIVING.items()]
+    result = invoke(
+        "train", "-c", config, *[arg for item in sets for arg in ("--set", item)],
+        "--set", f"agent.algorithm={algorithm}",
+        "--set", f"agent.initial_values={json.dumps(PREDICTED_TO_GO)}",
+        "--engine", engine, "--out", tmp_path / "run", "-q",
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert np.load(tmp_path / "run" / rundir.V_TABLE_FILE).tolist() == after
+    written = (tmp_path / "run" / "config.yaml").read_text(encoding="utf-8")
+    assert "initial_values: [30.0, 35.0, 15.0, 10.0, 3.0, 0.0]" in written
+
+
+@pytest.mark.parametrize(
+    ("overrides", "words"),
+    [
+        ({"agent.algorithm": "q_learning"}, "q_learning learns action values"),
+        ({"agent.initial_values": [1.0, 2.0]}, "has 2 values but the table"),
+        ({"agent.initial_values": "fast"}, "must be a non-empty list of numbers"),
+        ({"agent.initial_values": [1.0, float("nan")]}, "must be a finite number"),
+    ],
+)
+def test_initial_values_are_refused_where_they_cannot_start_v(
+    tmp_path: Path, overrides: dict, words: str
+) -> None:
+    """In the file, the error names the file; nothing is written."""
+    config = tmp_path / "drive.yaml"
+    agent = {"algorithm": "td", "initial_values": PREDICTED_TO_GO}
+    agent.update({key.removeprefix("agent."): value for key, value in overrides.items()})
+    write_yaml(config, {"env": {"id": DRIVING["env.id"]}, "discretization": None, "agent": agent})
+    result = invoke("train", "-c", config, "--out", tmp_path / "run")
+    assert_refused(result, "agent.initial_values", words, str(config))
+    assert not (tmp_path / "run").exists()
+
+
+def test_initial_values_are_refused_on_tiles() -> None:
+    with pytest.raises(ConfigError, match=r"agent\.initial_values.*on tiles"):
+        load_config(
+            overrides={
+                "env.id": "MountainCar-v0", "discretization.tilings": 4,
+                "discretization.bins": [4, 4], "discretization.low": [-1.2, -0.07],
+                "discretization.high": [0.6, 0.07], "agent.algorithm": "td",
+                "agent.initial_values": [0.0] * 50,
+            }
+        )  # fmt: skip

@@ -203,7 +203,7 @@ ES_VARIANTS = [
     "monte_carlo-sample_average",
 ]
 """the variants run on the exploring-starts world (monte_carlo: its starts without ES)"""
-AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init"}
+AGENT_KEYS = {"alpha", "gamma", "epsilon", "q_init", "initial_values"}
 """keys a variant may give that are the agent's own, not its algorithm's"""
 # n = 150 on CartPole would make the plain re-derivation slow (O(n) per step).
 LONG_N = ("n_step_sarsa-n150", "n_step_tree_backup-n150")
@@ -609,6 +609,29 @@ def test_prediction(world: str, variant: str, engine: str) -> None:
     expected = _assert_same(world, variant, engine)
     assert expected.errors is not None and len(expected.errors) == CASES[world]["episodes"]
     assert expected.solved_episode is None
+
+
+# agent.initial_values: V's start per row of the 5-state walk (its two ends included).
+WALK5_STARTS = [0.25, 0.1, 0.3, 0.5, 0.7, 0.9, -0.5]
+INITIAL_VALUES_VARIANTS = {
+    f"{name}-initial_values": (name, {**params, "initial_values": WALK5_STARTS})
+    for name, params in (
+        ("td", {}), ("mc_prediction", {}), ("td_lambda", {"lambda": 0.8}),
+        ("batch_prediction", {"alpha": 0.002, "tolerance": 1e-3}),
+    )
+}  # fmt: skip
+ALL_VARIANTS.update(INITIAL_VALUES_VARIANTS)
+
+
+@pytest.mark.parametrize(
+    ("world", "variant", "engine"), _params(["walk5"], list(INITIAL_VALUES_VARIANTS))
+)
+def test_initial_values(world: str, variant: str, engine: str) -> None:
+    """V started state by state: the ends keep their start, every other value moved."""
+    expected = _assert_same(world, variant, engine)
+    values = expected.q_table.reshape(-1)
+    assert values[0] == WALK5_STARTS[0] and values[6] == WALK5_STARTS[6]
+    assert all(values[x] != WALK5_STARTS[x] for x in range(1, 6))
 
 
 NAMED_POLICY_VARIANTS = {

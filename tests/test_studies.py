@@ -475,3 +475,22 @@ def test_figure_7_4_sets_one_arrow_for_one_step_sarsa_and_the_last_ten_steps_for
     assert arrows["n 10, seed 4"] == {
         (4, 7): 3, (3, 7): 1, (4, 8): 0, (3, 8): 0, (2, 8): 0, (1, 8): 3,
     }  # fmt: skip
+
+
+def test_figure_6_1_moves_every_prediction_as_monte_carlo_and_td_recommend(
+    tmp_path: Path,
+) -> None:
+    """The shipped study: one drive from Example 6.1's predictions, alpha 1, arrows drawn."""
+    out = tmp_path / "f61"
+    study = Path(__file__).resolve().parents[1] / "examples/book/fig6_1_driving_home.yaml"
+    result = invoke("study", study, "--out", out, "-q")
+    assert result.exit_code == 0, result.output
+    rows = list(csv.DictReader((out / "fig6_1_driving_home.csv").open(encoding="utf-8")))
+    drawn: dict[tuple[str, str], list[float]] = {}
+    for row in rows:
+        drawn.setdefault((row["panel"], row["series"]), []).append(float(row["y"]))
+    for algorithm in ("mc_prediction", "td"):
+        assert drawn[(f"algorithm {algorithm}", "before the run")] == [30, 35, 15, 10, 3]
+        assert drawn[(f"algorithm {algorithm}", "true values")] == [43, 38, 23, 13, 3]
+    assert drawn[("algorithm mc_prediction", "after the run")] == [43, 38, 23, 13, 3]
+    assert drawn[("algorithm td", "after the run")] == [40, 30, 20, 13, 3]

@@ -337,6 +337,17 @@ class AgentConfig:
             choices=TIE_BREAKS,
         )
     )
+    initial_values: tuple[float, ...] | None = field(
+        default=None,
+        metadata=spec(
+            "floats",
+            "a prediction run's initial V, one number per state (per row of the table, in "
+            "the order of the observations; a terminal state's value is never read): Sutton "
+            "& Barto Example 6.1's predictions; `null`: every state starts at `agent.q_init`. "
+            "Not on tiles",
+            nullable=True,
+        ),
+    )
 
 
 @dataclass(frozen=True)

@@ -90,6 +90,7 @@ def read_config(raw: dict[str, Any], source: Provenance) -> Config:
     _check_epsilon_floor(reader, agent, train.episodes)
     env = _env(reader)
     _check_named_policy(reader, agent, env.id, tiled=tilings > 1)
+    _check_initial_values(reader, agent, tilings)
     return Config(
         name=name,
         **reader.fields(Config, "", skip=("name",)),
@@ -196,6 +197,30 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
             "agent.policy",
             f"{name} is not a rule {env_id} declares (it declares {rules}). Use random, "
             f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(str(name))}",
+        )
+
+
+def _check_initial_values(reader: _Reader, agent: AgentConfig, tilings: int) -> None:
+    """``agent.initial_values`` starts a prediction run's ``V`` state by state, never on tiles.
+
+    Its length is checked against the table once the world is made
+    (:func:`~cartpole_q.envs.gym.inspect_env`).
+    """
+    if agent.initial_values is None:
+        return
+    if not get_algorithm(agent.algorithm).predicts:
+        raise reader.error(
+            "agent.initial_values",
+            f"starts the values a prediction algorithm learns (V, one per state), and "
+            f"{agent.algorithm} learns action values; set it to null and give agent.q_init, "
+            "or use a prediction algorithm (td, mc_prediction, ...).",
+        )
+    if tilings > 1:
+        raise reader.error(
+            "agent.initial_values",
+            "gives one value per state, and on tiles (discretization.tilings > 1) a state's "
+            "value is the sum of its tiles' weights, shared with other states; set it to null "
+            "or use tilings: 1.",
         )
 
 

@@ -608,6 +608,19 @@ def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
     return distribution
 
 
+def initial_table(config: Config, n_states: int, columns: int, q_init: float) -> np.ndarray:
+    """The table before the first update: ``q_init`` everywhere, or ``agent.initial_values``.
+
+    >>> from cartpole_q.config import load_config
+    >>> initial_table(load_config(None), 2, 3, 1.5).tolist()
+    [[1.5, 1.5, 1.5], [1.5, 1.5, 1.5]]
+    """
+    starts = config.agent.initial_values
+    if starts is None:
+        return np.full((n_states, columns), q_init, dtype=np.float64)
+    return np.repeat(np.array(starts, dtype=np.float64)[:, None], columns, axis=1)
+
+
 @dataclass
 class TrainingState:
     """Everything that changes while training; an engine advances it episode by episode.
@@ -672,7 +685,7 @@ class TrainingState:
             memory += (np.zeros((n_states, columns), dtype=np.float64),)
         return cls(
             tables=Tables(
-                q=np.full((n_states, columns), q_init, dtype=np.float64),
+                q=initial_table(config, n_states, columns, q_init),
                 visits=np.zeros((n_states, env_info.n_actions), dtype=np.int64),
                 memory=memory,
             ),

@@ -357,6 +357,7 @@ def inspected_fields(config: Config) -> str:
             config.env,
             config.discretization,
             config.agent.max_q_table_bytes,
+            config.agent.initial_values,
             config.train.info_metric,
             config.train.reward_threshold,
         )
@@ -465,6 +466,14 @@ def inspect_env(config: Config, source: str | Provenance = "config") -> EnvInfo:
             f"{blame(source, field)}: {field}: the Q-table would hold {math.prod(state_shape):,} "
             f"states x {n_actions} actions = {memory_text(table_bytes)}, above the limit of "
             f"{memory_text(limit)} (agent.max_q_table_bytes); {fewer} or raise the limit."
+        )
+    starts = config.agent.initial_values
+    if starts is not None and len(starts) != math.prod(state_shape):
+        raise ConfigError(
+            f"{blame(source, 'agent.initial_values')}: agent.initial_values: has "
+            f"{len(starts)} values but the table of {env_id!r} has "
+            f"{math.prod(state_shape):,} states; give one value per state, in the order of "
+            "the observations (a terminal state's too, though it is never read)."
         )
     max_steps = config.env.kwargs.get("max_episode_steps", spec.max_episode_steps if spec else None)
     threshold = _threshold_of(config, spec)

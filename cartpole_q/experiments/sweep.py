@@ -50,9 +50,11 @@ from cartpole_q.experiments.workers import JobHandle, chunk_size, execute
 from cartpole_q.families import profile_for
 from cartpole_q.figures import (
     DataFigure,
+    ValueChanges,
     blackjack_optimal_figure,
     blackjack_values_figure,
     summary_line_figure,
+    value_changes_figure,
 )
 from cartpole_q.learning_curves import aggregate_band, metric_label, per_episode, record_column
 from cartpole_q.progress import NullSweepProgress, SweepProgress, Units
@@ -523,11 +525,7 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
         mu = prediction_distribution(first, info)
         second = ("on-policy distribution mu (shaded, right axis)", states, mu)
     rng = np.random.default_rng(0)
-    lines = []
-    starts = {point.config.agent.q_init for point in spec.points}
-    if len(starts) == 1:
-        start = np.full(len(states), starts.pop())
-        lines.append(("initial values", states, start, start, start))
+    learned, starts = [], []
     for point, label, path in zip(spec.points, labels, paths, strict=True):
         # Each point reads its own tables' rows (its discretization: tiles, groups).
         rows = prediction_truth(point.config, env_facts(point.config)).rows
@@ -539,13 +537,30 @@ def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], o
             )
         runs = load_run_set(path).runs
         per_seed = np.array([_state_values(run.q_table, rows) for run in runs])
-        centre, low, high = aggregate_band(per_seed, "mean", rng)
-        lines.append((label, states, centre, low, high))
-    lines.append(("true values", states, truth.values, truth.values, truth.values))
+        learned.append(aggregate_band(per_seed, "mean", rng))
+        starts.append(_initial_state_values(point.config, rows))
     from cartpole_q.envs.models import state_labels
 
     named = state_labels(first.env)  # where the world names every state drawn, by name
     names = {x: named[int(x)] for x in states} if all(int(x) in named for x in states) else None
+    if figure.arrows:
+        panels = [
+            ValueChanges(label, start, centre)
+            for label, start, (centre, _, _) in zip(labels, starts, learned, strict=True)
+        ]
+        drawn = value_changes_figure(
+            panels, states, truth.values, names, figure.y_label or "estimated value",
+            figure.title or spec.name,
+        )  # fmt: skip
+        return write_figure(out, drawn)
+    lines = []
+    if all(np.array_equal(start, starts[0]) for start in starts):
+        lines.append(("initial values", states, starts[0], starts[0], starts[0]))
+    lines += [
+        (label, states, centre, low, high)
+        for label, (centre, low, high) in zip(labels, learned, strict=True)
+    ]
+    lines.append(("true values", states, truth.values, truth.values, truth.values))
     drawn = summary_line_figure(
         lines, "state", figure.y_label or "estimated value", figure.title or spec.name,
         figure.log_y, (figure.y_min, figure.y_max), second, x_names=names,
@@ -937,6 +952,17 @@ def _threshold(spec: SweepSpec) -> float | None:
         return planned(spec.points[0].config).env_info.reward_threshold
     except ConfigError:
         return None
+
+
+def _initial_state_values(config: Config, rows: np.ndarray) -> np.ndarray:
+    """``V`` of each measured state before the run: ``agent.initial_values``, or ``q_init``.
+
+    (``agent.initial_values`` is never given on tiles, so each state is its row.)
+    """
+    if config.agent.initial_values is None:
+        return np.full(rows.shape[0], config.agent.q_init)
+    starts: np.ndarray = np.array(config.agent.initial_values)[rows[:, 0]]
+    return starts
 
 
 def _state_values(table: np.ndarray, rows: np.ndarray) -> np.ndarray:

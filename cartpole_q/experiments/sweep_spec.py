@@ -55,7 +55,7 @@ class Point:
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "log_x", "title", "y_label", "offset", "scale",
     "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
-    "distribution", "dashed",
+    "distribution", "dashed", "arrows",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -122,6 +122,10 @@ class FigureSpec:
     """with ``values``: also draw the evaluated policy's on-policy distribution ``mu`` (the
     fraction of time steps spent in each state, from the world's model) on a second y axis
     (Sutton & Barto Figure 9.1)"""
+    arrows: bool = False
+    """with ``values``: draw each point in a panel of its own, an arrow from each state's
+    value before the run to its value after (the change the run makes: Sutton & Barto
+    Figure 6.1)"""
     dashed: dict[str, Any] | None = None
     """with ``against``: ``{AXIS: VALUE}``, another axis and one of its values: the lines of
     the points at that value are dashed, and lines that differ only in that axis share a
@@ -416,6 +420,11 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
             )
     if problem is not None:
         raise ConfigError(f"{where}: figure.metric: {shown_value(metric)} is {problem}.")
+    if values.get("arrows") and metric != VALUES_FIGURE:
+        raise ConfigError(
+            f"{where}: figure.arrows: draws the change of each state's value as an arrow; it "
+            "needs metric: values."
+        )
     if values.get("distribution") and metric != VALUES_FIGURE:
         raise ConfigError(
             f"{where}: figure.distribution: draws the on-policy distribution beside the values "
@@ -432,7 +441,7 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
         "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),
-        "distribution": (bool,), "dashed": (Mapping,),
+        "distribution": (bool,), "dashed": (Mapping,), "arrows": (bool,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)

@@ -11,6 +11,7 @@ id                                         world
 ``cartpole_q/ShortcutMaze-v0``             Example 8.3, Figure 8.5 (``change_at=3000``)
 ``cartpole_q/MaximizationBias-v0``         Example 6.7, Figure 6.5 (:mod:`~cartpole_q.families.book_mdps`)
 ``cartpole_q/OneState-v0``                 Example 5.5, Figure 5.4 (:mod:`~cartpole_q.families.book_mdps`)
+``cartpole_q/DrivingHome-v0``              Example 6.1, Figure 6.1: driving home, six situations in a row
 ``cartpole_q/Baird-v0``                    Example 11.1, Figures 11.2, 11.5, 11.6: Baird's counterexample (continuing)
 ``cartpole_q/ShortCorridor-v0``            Example 13.1, Figures 13.1, 13.2: the short corridor with switched actions
 ``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.families.walks`)

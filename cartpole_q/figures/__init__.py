@@ -47,12 +47,14 @@ from cartpole_q.figures.curves import (
     Curve,
     MetricBand,
     SeedBand,
+    ValueChanges,
     bootstrap_band,
     draw_reward_curves,
     metric_curve_figure,
     moving_average,
     reward_curve_figure,
     summary_line_figure,
+    value_changes_figure,
 )
 from cartpole_q.figures.dp import (
     GridPanel,
@@ -125,6 +127,7 @@ __all__ = [
     "SeedBand",
     "SweepAxis",
     "TrajectoryCurve",
+    "ValueChanges",
     "WeightsPanel",
     "action_names",
     "blackjack_optimal_figure",
@@ -168,5 +171,6 @@ __all__ = [
     "trajectory_sampling_figure",
     "tune_history_figure",
     "until_optimal_figure",
+    "value_changes_figure",
     "weights_figure",
 ]

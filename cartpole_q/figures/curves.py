@@ -289,6 +289,60 @@ def summary_line_figure(
     return figure
 
 
+@dataclass(frozen=True)
+class ValueChanges:
+    """One panel of :func:`value_changes_figure`: a run's values before and after, by state."""
+
+    label: str
+    """the point's label (its algorithm, say)"""
+    before: np.ndarray
+    """``V`` before the run, one value per state drawn"""
+    after: np.ndarray
+    """``V`` after the run (the mean over seeds), one value per state drawn"""
+
+
+def value_changes_figure(
+    panels: Sequence[ValueChanges],
+    states: Sequence[float],
+    truth: np.ndarray,
+    names: Mapping[float, str] | None,
+    y_label: str,
+    title: str,
+) -> DataFigure:
+    """The change each run makes to each state's value, as arrows (Sutton & Barto Figure 6.1).
+
+    One panel per point, side by side: the values before the run joined by a line, an
+    arrow from each to its value after the run (none where it did not move), and the true
+    values dashed (driving home's actual times to go).
+    """
+    figure = DataFigure(figsize=(CURVE_SIZE[0] * 0.75 * len(panels), CURVE_SIZE[1]), dpi=DPI,
+                        layout="constrained")  # fmt: skip
+    grid = figure.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+    for axes, panel in zip(grid, panels, strict=True):
+        record = figure.data.panel(panel.label)
+        axes.plot(states, panel.before, color="0.25", marker="o", markersize=4, linewidth=1.5,
+                  label="before the run")  # fmt: skip
+        axes.plot(states, truth, color="0.5", linestyle="--", linewidth=1.2, label="true values")
+        for x, start, end in zip(states, panel.before, panel.after, strict=True):
+            if end != start:
+                axes.annotate("", xy=(x, end), xytext=(x, start),
+                              arrowprops={"arrowstyle": "-|>", "color": "tab:red", "lw": 1.8})  # fmt: skip
+        axes.plot(states, panel.after, linestyle="none", marker="_", markersize=12,
+                  color="tab:red", label="after the run")  # fmt: skip
+        record.line("before the run", states, panel.before)
+        record.line("after the run", states, panel.after)
+        record.line("true values", states, truth)
+        if names:
+            axes.set_xticks(list(names), list(names.values()), rotation=30, ha="right")
+        axes.set_title(panel.label, fontsize="medium")
+        axes.set_xlabel("state")
+        axes.grid(alpha=0.3)
+    grid[0].set_ylabel(y_label)
+    grid[0].legend(loc="best", fontsize="small")
+    figure.suptitle(title, fontsize="medium")
+    return figure
+
+
 def _return_label(curves: Sequence[Curve | SeedBand]) -> str:
     bands = sum(isinstance(item, SeedBand) for item in curves)
     average = f"{SOLVE_WINDOW}-episode average"

@@ -1,4 +1,4 @@
-"""The book's small MDPs: the one-state MDP (5.5), the maximization bias (6.7), Baird's (11.1), access control (10.2), the short corridor (13.1).
+"""The book's small MDPs: the one-state MDP (5.5), driving home (6.1), the maximization bias (6.7), Baird's (11.1), access control (10.2), the short corridor (13.1).
 
 Their worlds are :mod:`~cartpole_q.families.book_mdps.one_state`,
 :mod:`~cartpole_q.families.book_mdps.bias` and :mod:`~cartpole_q.families.book_mdps.baird`
@@ -24,6 +24,7 @@ _ONE_STATE = "cartpole_q.families.book_mdps.one_state"
 _CORRIDOR = "cartpole_q.families.book_mdps.short_corridor"
 _ACCESS = "cartpole_q.families.book_mdps.access_control"
 _RACETRACK = "cartpole_q.families.book_mdps.racetrack"
+_DRIVING = "cartpole_q.families.book_mdps.driving_home"
 ONE_STATE_TIME_LIMIT = 1_000
 """steps before an episode of the one-state MDP is truncated (left comes back with
 probability 0.9: ten steps on average)"""
@@ -117,7 +118,20 @@ RACETRACK = EnvProfile(
     policy_map="racetrack",
 )
 
-PROFILES = (MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR, ACCESS_CONTROL, RACETRACK)
+DRIVING_HOME = EnvProfile(
+    name="DrivingHome",
+    description="driving home: six situations from the office to home in a row, each step's "
+    "reward the minutes it took, undiscounted (Sutton & Barto's Example 6.1)",
+    ids=("cartpole_q/DrivingHome-v0",),
+    entry_points=(f"{_DRIVING}:DrivingHomeEnv",),
+    action_names=("drive",),
+    model="transition_table",
+    twin=load_table_twin,
+)
+
+PROFILES = (
+    MAXIMIZATION_BIAS, ONE_STATE, BAIRD, SHORT_CORRIDOR, ACCESS_CONTROL, RACETRACK, DRIVING_HOME,
+)  # fmt: skip
 """the family's profiles"""
 WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/MaximizationBias-v0", f"{_BIAS}:MaximizationBiasEnv", None),
@@ -126,5 +140,6 @@ WORLDS: tuple[World, ...] = (
     World(f"{NAMESPACE}/ShortCorridor-v0", f"{_CORRIDOR}:ShortCorridorEnv", None),
     World(f"{NAMESPACE}/AccessControl-v0", f"{_ACCESS}:AccessControlEnv", None),
     World(f"{NAMESPACE}/Racetrack-v0", f"{_RACETRACK}:RacetrackEnv", RACETRACK_TIME_LIMIT),
+    World(f"{NAMESPACE}/DrivingHome-v0", f"{_DRIVING}:DrivingHomeEnv", None),
 )
 """the worlds it registers"""

@@ -54,7 +54,17 @@ then prediction)"""
 _REGISTRY: dict[str, Algorithm] = {}
 
 RESERVED_KEYS = frozenset(
-    {"algorithm", "params", "gamma", "alpha", "epsilon", "q_init", "max_q_table_bytes", "tie_break"}
+    {
+        "algorithm",
+        "params",
+        "gamma",
+        "alpha",
+        "epsilon",
+        "q_init",
+        "max_q_table_bytes",
+        "tie_break",
+        "initial_values",
+    }
 )
 """the keys under ``agent`` every algorithm has (the fields of ``AgentConfig``; a test keeps
 the two the same): no algorithm may declare a parameter of one of these names"""
