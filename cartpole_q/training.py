@@ -22,7 +22,7 @@ import numpy as np
 
 from cartpole_q.config import Config
 from cartpole_q.engines import make_engine
-from cartpole_q.engines.base import Engine, EpisodeMetrics, Tables, TrainingState
+from cartpole_q.engines.base import NO_STEP_LIMIT, Engine, EpisodeMetrics, Tables, TrainingState
 from cartpole_q.engines.plan import Plan, env_facts, plan_run
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.errors import RunError
@@ -342,8 +342,11 @@ def _run(
         )
         return True
 
-    finished = state.episode >= total or (
-        state.solved_episode is not None and settings.stop_when_solved
+    step_limit = settings.max_env_steps or NO_STEP_LIMIT
+    finished = (
+        state.episode >= total
+        or (state.solved_episode is not None and settings.stop_when_solved)
+        or state.steps_spent(step_limit)
     )
     if resume is not None and _evaluation_missing(state, evaluate_every):
         interrupted = not periodic_evaluation()  # the one a stop cut short
@@ -365,7 +368,11 @@ def _run(
         evaluated = True
         if evaluate_every and state.episode % evaluate_every == 0:
             evaluated = periodic_evaluation()
-        finished = state.episode >= total or (solved is not None and settings.stop_when_solved)
+        finished = (
+            state.episode >= total
+            or (solved is not None and settings.stop_when_solved)
+            or state.steps_spent(step_limit)
+        )
         if on_snapshot is not None and snapshot_every and state.episode % snapshot_every == 0:
             on_snapshot(state.episode, state.policy_table().reshape(table_shape).copy())
         if (
@@ -383,7 +390,9 @@ def _run(
             break
 
     stopped_when_solved = state.solved_episode is not None and settings.stop_when_solved
-    checkpointed = on_checkpoint is not None and (interrupted or not stopped_when_solved)
+    # A run cut at train.max_env_steps is not extended: its last episode was cut.
+    stopped_early = stopped_when_solved or state.steps_spent(step_limit)
+    checkpointed = on_checkpoint is not None and (interrupted or not stopped_early)
     if checkpointed and on_checkpoint is not None:  # (checkpointed says so; mypy cannot see it)
         # Interrupted: for --resume. Reached train.episodes: to extend the run later.
         on_checkpoint(snapshot())

@@ -1474,6 +1474,7 @@ def reference_train(
     stop_when_solved: bool = True,
     params: Mapping[str, Any] | None = None,
     initial_values: Sequence[float] | None = None,
+    max_env_steps: int | None = None,
 ) -> ReferenceRun:
     """Train as the contract says, in plain Python on ``gymnasium.make``.
 
@@ -1498,6 +1499,8 @@ def reference_train(
             ``kappa``, ``update``); missing ones take docs/algorithms.md's defaults.
         initial_values: ``agent.initial_values`` (a prediction algorithm's ``V`` before
             the first episode, one value per row); ``None``: every row at ``q_init``.
+        max_env_steps: ``train.max_env_steps``: the episode whose step reaches it is
+            truncated there and is the last; ``None``: no limit.
 
     Returns:
         The kept table, the visits, the returns and lengths, the solve episode.
@@ -1561,6 +1564,7 @@ def reference_train(
     lengths: list[int] = []
     solved = None
     kept: list[list[float]] | None = None
+    steps = 0
     for episode in range(episodes):
         agent.epsilon, agent.alpha = epsilon_of(episode), alpha_of(episode)
         if randomize:
@@ -1582,10 +1586,13 @@ def reference_train(
                 visits[tile][a] += 1
             episode_return += r
             length += 1
+            if max_env_steps is not None and steps + length >= max_env_steps:
+                truncated = True  # docs/algorithms.md, "A budget of steps"
             a2 = agent.step(s, a, r, s2, bool(terminated), bool(truncated) and not terminated)
             s, a = s2, a2
         returns.append(episode_return)
         lengths.append(length)
+        steps += length
         if errors is not None:
             errors.append(rms_error(agent, measured, truth))
         if solved is None and threshold is not None and episode >= 99:
@@ -1597,6 +1604,8 @@ def reference_train(
                 kept = [list(values) for values in agent.kept_table()]
                 if stop_when_solved:
                     break
+        if max_env_steps is not None and steps >= max_env_steps:
+            break
     env.close()
     if kept is None:
         kept = agent.kept_table()

@@ -220,6 +220,8 @@ def _error(tmp_path: Path, text: str) -> str:
         ("agent:\n  alpha: {type: log, k: 25, end: 0}\n", "agent.alpha.end: must be in (0, 1]"),
         ("train:\n  episodes: 0\n", "train.episodes: must be at least 1"),
         ("train:\n  episodes: -5\n", "train.episodes: must be at least 1"),
+        ("train:\n  max_env_steps: 0\n", "train.max_env_steps: must be at least 1"),
+        ("train:\n  max_env_steps: 2.5\n", "train.max_env_steps: must be"),
         ("discretization:\n  bins: [1, 0, 6, 12]\n", "entry 1 must be at least 1"),
         ("discretization:\n  bins: 4\n", "discretization.bins: must be a non-empty list"),
         (

@@ -347,6 +347,19 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 120,
         "seed": 8,
     },
+    # train.max_env_steps: the 26th-30th episode is cut at step 4,321 in all (time limit 200).
+    "taxi_budget": {
+        "env": {"id": "Taxi-v4"},
+        "agent": {
+            "gamma": 0.95,
+            "alpha": {"type": "constant", "value": 0.5},
+            "epsilon": {"type": "exponential", "start": 1.0, "decay": 0.97, "end": 0.05},
+            "q_init": 0.0,
+        },
+        "episodes": 120,
+        "seed": 8,
+        "max_env_steps": 4_321,
+    },
     # No time limit: Monte Carlo's buffer is 10,000 steps long.
     "cliffwalking": {
         "env": {"id": "CliffWalking-v1"},
@@ -418,6 +431,7 @@ NUMBA_WORLDS |= {
     "lake",
     "lake_greedy",
     "taxi",
+    "taxi_budget",
     "cliffwalking",
     "blackjack",
     "blackjack_es",
@@ -492,6 +506,7 @@ def _config(case: dict[str, Any], algorithm: str, params: dict[str, Any], engine
             "reward_threshold": None,
             "eval_every": 0,
             "checkpoint_every": 0,
+            "max_env_steps": case.get("max_env_steps"),
         },
         "eval": {"episodes": 1},
     }
@@ -515,6 +530,7 @@ def _reference(world: str, variant: str, **overrides: Any) -> ReferenceRun:
         "randomize": case["env"].get("randomize"),
         "discretization": case.get("discretization"),
         "stop_when_solved": case.get("stop_when_solved", False),
+        "max_env_steps": case.get("max_env_steps"),
         **case["agent"],
     }
     # A variant may set the agent's own keys too (epsilon, q_init): they are not params.
@@ -632,6 +648,20 @@ def test_initial_values(world: str, variant: str, engine: str) -> None:
     values = expected.q_table.reshape(-1)
     assert values[0] == WALK5_STARTS[0] and values[6] == WALK5_STARTS[6]
     assert all(values[x] != WALK5_STARTS[x] for x in range(1, 6))
+
+
+BUDGET_VARIANTS = [
+    "q_learning", "expected_sarsa", "n_step_sarsa", "sarsa_lambda-replacing", "dyna_q",
+    "monte_carlo-constant_alpha", "actor_critic",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("world", "variant", "engine"), _params(["taxi_budget"], BUDGET_VARIANTS))
+def test_a_budget_of_steps_cuts_the_last_episode(world: str, variant: str, engine: str) -> None:
+    """train.max_env_steps: the run ends in the episode whose step reaches it, cut there."""
+    expected = _assert_same(world, variant, engine)
+    assert sum(expected.lengths) == 4_321
+    assert len(expected.lengths) < 120 and expected.lengths[-1] < 200  # cut mid-episode
 
 
 NAMED_POLICY_VARIANTS = {

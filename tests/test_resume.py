@@ -53,9 +53,9 @@ def _assert_same_results(run: Path, reference: Path) -> None:
         assert summary[key] == expected[key], key
     assert summary["interrupted"] is False
     # a run that reached train.episodes keeps its checkpoint, so that it can be extended
-    extendable = (
-        summary["solved_episode"] is None
-        or not load_config(run / "config.yaml").train.stop_when_solved
+    settings = load_config(run / "config.yaml").train
+    extendable = (summary["solved_episode"] is None or not settings.stop_when_solved) and (
+        settings.max_env_steps is None or summary["env_steps"] < settings.max_env_steps
     )
     assert (run / rundir.CHECKPOINT_FILE).exists() == extendable
 
@@ -585,3 +585,26 @@ def test_sigkill_at_random_instants_never_leaves_a_broken_file(tmp_path: Path) -
     )
     assert final.returncode in (0, 2), final.stderr  # 2: it had already finished
     _assert_same_results(run, _reference_of(config, tmp_path))
+
+
+@pytest.mark.parametrize("engine", ["numba", "gymnasium"])
+def test_a_run_with_a_budget_of_steps_resumes_byte_identically_and_is_not_extended(
+    tmp_path: Path, engine: str
+) -> None:
+    """train.max_env_steps: interrupted before it, the resumed run ends where one run ends."""
+    overrides = {
+        **INTERRUPTIBLE, "engine": engine, "train.episodes": 300, "train.checkpoint_every": 25,
+        "train.max_env_steps": 9_999,
+    }  # fmt: skip
+    reference = _reference(tmp_path, overrides)
+    summary = json.loads((reference / "summary.json").read_text())
+    assert summary["env_steps"] == 9_999 and summary["episodes"] < 300
+    assert not (reference / rundir.CHECKPOINT_FILE).exists()  # cut: nothing to extend
+    run = _interrupted(tmp_path, overrides, polls=3)
+    assert json.loads((run / "summary.json").read_text())["env_steps"] < 9_999
+    result = CliRunner().invoke(app, ["train", "--resume", str(run), "-q"], catch_exceptions=False)
+    assert result.exit_code == 0, result.output
+    _assert_same_results(run, reference)
+    refused = CliRunner().invoke(app, ["train", "--resume", str(reference), "--episodes", "400"])
+    assert refused.exit_code == 2
+    assert "it stopped at train.max_env_steps (9,999 env steps)" in refused.stderr

@@ -494,3 +494,27 @@ def test_figure_6_1_moves_every_prediction_as_monte_carlo_and_td_recommend(
         assert drawn[(f"algorithm {algorithm}", "true values")] == [43, 38, 23, 13, 3]
     assert drawn[("algorithm mc_prediction", "after the run")] == [43, 38, 23, 13, 3]
     assert drawn[("algorithm td", "after the run")] == [40, 30, 20, 13, 3]
+
+
+def test_figure_8_3_dyna_q_stops_halfway_through_its_second_episode(tmp_path: Path) -> None:
+    """The shipped study: n 0 has set one arrow, n 50 a policy over most of the maze."""
+    out = tmp_path / "f83"
+    study = Path(__file__).resolve().parents[1] / "examples/book/fig8_3_dyna_policies.yaml"
+    result = invoke("study", study, "--out", out, "-q")
+    assert result.exit_code == 0, result.output
+    # the first episode whole, the second cut at half its length (104 and 38 uncut)
+    lengths = {
+        point: np.load(out / "points" / point / "curves.npz")["seed-000.lengths"].tolist()
+        for point in ("000", "001")
+    }
+    assert lengths == {"000": [108, 52], "001": [294, 19]}
+    rows = (out / "fig8_3_dyna_policies.csv").read_text(encoding="utf-8").splitlines()[1:]
+    arrows: dict[str, int] = {}
+    for row in rows:
+        panel, series, _, _, _, _, value = row.rsplit(",", 6)
+        if series == "greedy action (empty: all values equal)" and value:
+            arrows[panel.strip('"')] = arrows.get(panel.strip('"'), 0) + 1
+    assert arrows == {
+        "planning_steps 0, max_env_steps 160, seed 0": 1,
+        "planning_steps 50, max_env_steps 313, seed 0": 23,
+    }

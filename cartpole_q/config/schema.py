@@ -418,6 +418,18 @@ class TrainConfig:
             nullable=True,
         ),
     )
+    max_env_steps: int | None = field(
+        default=None,
+        metadata=spec(
+            "int",
+            "stop training after this many env steps in all (`null`: no limit; "
+            "`train.episodes` still bounds the run): the episode that reaches it is cut "
+            "there, as a time limit cuts it, and is the run's last (Sutton & Barto Figure "
+            "8.3: halfway through the second episode)",
+            low=1,
+            nullable=True,
+        ),
+    )
 
 
 @dataclass(frozen=True)

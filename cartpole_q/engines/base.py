@@ -226,6 +226,10 @@ class Truth(NamedTuple):
         return bool(self.rows.shape[0])
 
 
+NO_STEP_LIMIT = 2**63 - 1
+"""a limit of steps never reached (the largest int64): no time limit, no ``train.max_env_steps``"""
+
+
 class AgentRecord(NamedTuple):
     """The hyperparameters every algorithm has, as the compiled code takes them."""
 
@@ -234,6 +238,9 @@ class AgentRecord(NamedTuple):
     epsilon: ScheduleRecord
     threshold: float
     """the solve threshold; ``inf`` when the environment has none (never solved)"""
+    max_env_steps: int
+    """``train.max_env_steps``: the run's training steps in all, the episode reaching it
+    cut there (:data:`NO_STEP_LIMIT` when there is none)"""
 
 
 class Grid(NamedTuple):
@@ -365,6 +372,7 @@ class AgentParams:
                 alpha=ScheduleRecord.of(config.agent.alpha),
                 epsilon=epsilon_record(config),
                 threshold=math.inf if threshold is None else float(threshold),
+                max_env_steps=config.train.max_env_steps or NO_STEP_LIMIT,
             ),
             params=algorithm.hook_params(config.agent.params, config.agent.tie_break),
             tilings=tilings,
@@ -654,6 +662,10 @@ class TrainingState:
     errors: np.ndarray | None = None
     """float64, one value per configured episode: a prediction run's RMS error of ``V``
     against the true values after the episode (``None`` when nothing is measured)"""
+
+    def steps_spent(self, max_env_steps: int) -> bool:
+        """Whether the run has taken its ``train.max_env_steps`` (never with :data:`NO_STEP_LIMIT`)."""
+        return self.env_steps >= max_env_steps
 
     @classmethod
     def fresh(

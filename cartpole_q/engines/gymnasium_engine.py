@@ -177,6 +177,7 @@ class GymnasiumEngine:
         scalar = values is not None and isinstance(self._env.observation_space, spaces.Discrete)
         info_key, info_sums, env_id = self._info_key, state.info, self._config.env.id
         truth, errors, measure = self._params.truth, state.errors, self._value_error
+        steps_left = agent.max_env_steps - state.env_steps  # (NO_STEP_LIMIT: never reached)
         for episode in range(state.episode, stop):
             epsilon, alpha = episode_rates(agent, episode)
             if randomize:  # one draw per key, in the config's (canonical) order
@@ -204,6 +205,7 @@ class GymnasiumEngine:
                         values[:] = observation
                     observation = values
                 length += 1
+                truncated = truncated or length >= steps_left  # train.max_env_steps cuts it
                 episode_return += reward
                 if info_key is not None:
                     info_sum += info_value(info, info_key, env_id)
@@ -218,8 +220,11 @@ class GymnasiumEngine:
                 errors[episode] = measure(state.tables.q, truth.rows, truth.values)
             state.episode = episode + 1
             state.env_steps += length
+            steps_left -= length
             if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
                 return episode
+            if steps_left <= 0:
+                return None
         return None
 
     def warm_up(self, state: TrainingState) -> None:

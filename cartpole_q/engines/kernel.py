@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from cartpole_q.engines.base import (
+    NO_STEP_LIMIT,
     AgentRecord,
     EpisodeMetrics,
     Grid,
@@ -202,14 +203,20 @@ def train_episodes(
 
     Returns:
         ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
-        right after the solve episode when ``check_solved``, and before an episode that
-        is the other loop's (then ``episodes finished < stop`` and no solve).
+        right after the solve episode when ``check_solved``, right after the episode that
+        reaches ``agent.max_env_steps`` (cut there: its time limit is the steps left), and
+        before an episode that is the other loop's (then ``episodes finished < stop`` and
+        no solve).
     """
     max_steps, env_state, observation, base_params = env
     keys, lows, highs = randomize
     low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
     gamma = agent.gamma
     env_steps = 0
+    steps_left = agent.max_env_steps  # (the steps of episodes before start: their lengths)
+    if steps_left < NO_STEP_LIMIT:
+        for earlier in range(start):
+            steps_left -= metrics.lengths[earlier]
     for episode in range(start, stop):
         epsilon, alpha = episode_rates(agent, episode)
         explores = epsilon > 0.0  # (NaN: a greedy episode)
@@ -218,9 +225,10 @@ def train_episodes(
         env_params = base_params
         if RANDOMIZED:  # compiled in only where env.randomize draws physics
             env_params = TWIN_RANDOMIZE(base_params, physics_rng, keys, lows, highs)
+        limit = min(max_steps, steps_left - env_steps)
         episode_return, length = EPISODE(
             q, visits, memory, params, low, high, bins, starts, gamma, alpha,
-            epsilon if explores else 0.0, agent_rng, env_rng, env_params, max_steps,
+            epsilon if explores else 0.0, agent_rng, env_rng, env_params, limit,
             env_state, observation,
         )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
@@ -229,6 +237,8 @@ def train_episodes(
         env_steps += length
         if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
             return episode + 1, env_steps, episode
+        if env_steps >= steps_left:
+            return episode + 1, env_steps, -1
     return stop, env_steps, -1
 
 

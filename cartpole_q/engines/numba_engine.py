@@ -111,7 +111,7 @@ class NumbaEngine:
         first = loops_played(self._params.agent.epsilon, state.episode, state.episode + 1)
         greedy = first == (True,)  # the loop of the first episode
         handed_back = False  # the last loop returned without playing an episode
-        while state.episode < stop:
+        while state.episode < stop and not state.steps_spent(self._params.agent.max_env_steps):
             started = state.episode
             solved = self._run_loop(greedy, state, stop, check_solved)
             if solved is not None:

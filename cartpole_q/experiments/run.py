@@ -324,6 +324,15 @@ def _check_extendable(
                 "a longer run from the start would have stopped there too; only a run that "
                 "ended by reaching train.episodes can be extended"
             )
+        elif (
+            config.train.max_env_steps is not None
+            and summary.env_steps >= config.train.max_env_steps
+        ):
+            reason = (
+                f"it stopped at train.max_env_steps ({config.train.max_env_steps:,} env "
+                "steps), cutting its last episode there, so it cannot go on as one run; "
+                "train it again with a larger train.max_env_steps"
+            )
         else:
             reason = f"it kept no {CHECKPOINT_FILE} to continue from"
         raise RunError(
