@@ -20,6 +20,7 @@ family                                    environments
 :mod:`~cartpole_q.families.book_mdps`     the one-state and maximization-bias MDPs
 :mod:`~cartpole_q.families.planning`      the worlds of dynamic programming (chapters 3-4)
 :mod:`~cartpole_q.families.bandit`        the k-armed testbed (chapter 2)
+:mod:`~cartpole_q.families.puddle`        the puddle world (Figure 12.14)
 ========================================  ==================================================
 
 :mod:`~cartpole_q.families.tables` holds what the worlds played from a transition table
@@ -46,6 +47,7 @@ from cartpole_q.families import (
     gridworlds,
     mountaincar,
     planning,
+    puddle,
     toy_text,
     walks,
 )
@@ -132,7 +134,7 @@ def _entry_point(env_id: str) -> str | None:
 
 FAMILIES = (
     cartpole, mountaincar, acrobot, toy_text, blackjack, gridworlds, walks, book_mdps,
-    planning, bandit,
+    planning, bandit, puddle,
 )  # fmt: skip
 """the package's environment families, in the order their profiles are registered"""
 

@@ -17,6 +17,7 @@ id                                         world
 ``cartpole_q/RandomWalk5-v0``              Example 6.2: 5 states, 0 and +1 ends (:mod:`~cartpole_q.families.walks`)
 ``cartpole_q/RandomWalk-v0``               Example 7.1, Figure 7.2: 19 states, -1 and +1 ends
 ``cartpole_q/RandomWalk1000-v0``           Example 9.1, Figures 9.1, 9.2: 1000 states, jumps of up to 100 (``groups``: state aggregation)
+``cartpole_q/PuddleWorld-v0``              Figure 12.14: the puddle world, a point in the unit square (:mod:`~cartpole_q.families.puddle`)
 =========================================  ==================================================
 
 The worlds of dynamic programming (chapters 3-4, ``cartpole-q dp``):
