@@ -231,6 +231,16 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "against": "agent.gamma"}, "figure.against: 'agent.gamma' is not"),
         ({"metric": "length", "y_min": 5, "y_max": 5}, "figure.y_min: must be below figure.y_max"),
         ({"metric": "length", "against": "agent.alpha", "first": 0}, "figure.first: must be"),
+        ({"metric": "length", "best": {"agent.alpha": "min"}}, "give figure.against too"),
+        ({"metric": "length", "total": True}, "figure.total: works on the points drawn"),
+        (
+            {"metric": "length", "against": "agent.alpha", "best": {"agent.alpha": "min"}},
+            "figure.best: 'agent.alpha' is not an axis other than figure.against",
+        ),
+        (
+            {"metric": "length", "against": "agent.alpha", "best": {"agent.gamma": "min"}},
+            "figure.best: 'agent.gamma' is not an axis",
+        ),
     ],
 )
 def test_a_bad_figure_section_is_refused_before_anything_runs(
@@ -298,3 +308,44 @@ def test_y_limits_end_the_axis_where_the_book_does() -> None:
     assert figure.axes[0].get_ylim() == (-100.0, 0.0)
     automatic = metric_curve_figure([band], "episode", "return", "t")
     assert automatic.axes[0].get_ylim()[0] < -1500
+
+
+def test_best_draws_each_value_at_its_best_point_and_total_sums(in_tmp: Path) -> None:
+    """Figure 12.14's shape: against one axis, each line through the best of another axis."""
+    from tests.conftest import write_yaml
+
+    study = write_yaml(in_tmp / "s.yaml", {
+        "name": "best",
+        "base": {
+            "engine": "gymnasium", "env": {"id": "Taxi-v4"}, "discretization": None,
+            "agent": {"epsilon": 0.1, "q_init": 0.0},
+            "train": {"episodes": 6, "stop_when_solved": False, "eval_every": 0},
+        },
+        "seeds": "0-2",
+        "grid": {"agent.gamma": [0.9, 0.99], "agent.alpha": [0.1, 0.3, 0.5]},
+        "figure": {
+            "metric": "length", "against": "agent.gamma", "best": {"agent.alpha": "max"},
+            "total": True, "file": "fig.png",
+        },
+    })  # fmt: skip
+    result = invoke("sweep", study, "--out", "sw", "--workers", "1", "-q")
+    assert result.exit_code == 0, result.output
+    from cartpole_q.experiments.sweep_spec import load_sweep
+
+    spec = load_sweep(Path("sw/sweep.yaml"))
+    totals: dict[tuple[float, float], float] = {}
+    for point in spec.points:
+        curves = np.load(Path("sw/points") / spec.point_id(point.index) / "curves.npz")
+        per_seed = [float(curves[f"seed-{s:03d}.lengths"].sum()) for s in (0, 1, 2)]
+        totals[(point.values["agent.gamma"], point.values["agent.alpha"])] = float(
+            np.mean(per_seed)
+        )
+    rows = Path("sw/fig.csv").read_text(encoding="utf-8").splitlines()[1:]
+    drawn = [row.split(",") for row in rows]
+    line = {float(r[2]): float(r[3]) for r in drawn if r[1] == "best"}
+    chosen = {float(r[2]): float(r[3]) for r in drawn if r[1] == "best alpha"}
+    for gamma in (0.9, 0.99):
+        best = max((totals[(gamma, a)], -i, a) for i, a in enumerate((0.1, 0.3, 0.5)))
+        assert chosen[gamma] == best[2]
+        assert line[gamma] == pytest.approx(best[0])
+    assert set(chosen.values()) != {0.1}  # not merely the first alpha: the choice is real

@@ -276,6 +276,10 @@ def _sweep_figure() -> Schema:
     properties["first"] = {**properties["first"], "minimum": 1}
     properties["x_max"] = {**properties["x_max"], "exclusiveMinimum": 0}
     properties["dashed"] = {**properties["dashed"], "minProperties": 1, "maxProperties": 1}
+    properties["best"] = {
+        **properties["best"], "minProperties": 1, "maxProperties": 1,
+        "additionalProperties": {"enum": ["min", "max"]},
+    }  # fmt: skip
     own = [name.rpartition(".")[0] for name in sweep_spec.SWEEP_OWN_FILES]
     properties["file"] = {
         **_figure_file(),

@@ -408,43 +408,53 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
     A sweep that keeps no curves (``curves: false``) draws the mean return over all
     episodes, each seed's from ``results.csv``'s ``mean_return``. With ``figure.dashed``
     the lines at its axis value are dashed, and lines that differ only in that axis share a
-    colour.
+    colour. With ``figure.best: {AXIS: min|max}`` the points that differ only in AXIS are
+    one line, drawn at each value of ``against`` through the best of them (by the mean over
+    seeds; the first in file order on a tie), and the figure's data says which.
     """
     figure = spec.figure
     assert figure is not None and figure.against is not None
     dashed = figure.dashed or {}
-    groups: dict[str, list[tuple[float, np.ndarray]]] = {}
+    best_axis, best_rule = next(iter((figure.best or {"": "min"}).items()))
+    groups: dict[str, list[tuple[float, np.ndarray, Any]]] = {}
     styles: dict[str, tuple[str, bool]] = {}
     for point, path in zip(spec.points, paths, strict=True):
         per_seed = [(value + figure.offset) * figure.scale for value in _seed_means(spec, path)]
         others = ", ".join(
             f"{key.rsplit('.', 1)[-1]} {axis_cell(value)}"
             for key, value in point.values.items()
-            if key != figure.against
+            if key not in (figure.against, best_axis)
         )
         groups.setdefault(others or spec.name, []).append(
-            (float(point.values[figure.against]), np.array(per_seed)[:, None])
+            (
+                float(point.values[figure.against]),
+                np.array(per_seed)[:, None],
+                point.values.get(best_axis),
+            )
         )
         colour_key = ", ".join(
             f"{key}={axis_cell(value)}"
             for key, value in point.values.items()
-            if key != figure.against and key not in dashed
+            if key not in (figure.against, best_axis) and key not in dashed
         )
         at_dashed = bool(dashed) and all(
             axis_cell(point.values[key]) == axis_cell(value) for key, value in dashed.items()
         )
         styles[others or spec.name] = (colour_key, at_dashed)
+    if figure.best is not None:
+        groups = {label: _best_members(members, best_rule) for label, members in groups.items()}
     lines = []
     rng = np.random.default_rng(0)
     for label, members in groups.items():
         members.sort(key=lambda member: member[0])
-        bands = [aggregate_band(values, "mean", rng) for _, values in members]
+        bands = [aggregate_band(values, "mean", rng) for _, values, _ in members]
         lines.append((
-            label, [x for x, _ in members], np.array([b[0][0] for b in bands]),
+            label, [x for x, _, _ in members], np.array([b[0][0] for b in bands]),
             np.array([b[1][0] for b in bands]), np.array([b[2][0] for b in bands]),
         ))  # fmt: skip
     first = f"first {figure.first} episodes" if figure.first is not None else "all episodes"
-    y_label = figure.y_label or f"{metric_label(figure.metric)}, mean over the {first}"
+    how = "sum" if figure.total else "mean"
+    y_label = figure.y_label or f"{metric_label(figure.metric)}, {how} over the {first}"
     title = figure.title or spec.name
     line_styles = None
     if figure.dashed is not None:
@@ -454,7 +464,39 @@ def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:
         lines, figure.against.rsplit(".", 1)[-1], y_label, title, figure.log_y,
         (figure.y_min, figure.y_max), line_styles=line_styles,
     )  # fmt: skip
+    if figure.best is not None:  # which value of the axis each drawn point is
+        record = drawn.data.panel("")
+        name = best_axis.rsplit(".", 1)[-1]
+        for label, members in groups.items():
+            record.line(
+                f"{label}: best {name} ({best_rule})" if label != spec.name else f"best {name}",
+                [x for x, _, _ in members], [float(value) for _, _, value in members],
+            )  # fmt: skip
     return write_figure(out, drawn)
+
+
+def _best_members(
+    members: list[tuple[float, np.ndarray, Any]], rule: str
+) -> list[tuple[float, np.ndarray, Any]]:
+    """Of the members at each x, the one whose mean over seeds is best (``min`` or ``max``).
+
+    On a tie the first in the points' order is kept.
+
+    >>> members = [(0.0, np.array([[3.0]]), 0.1), (0.0, np.array([[2.0]]), 0.2)]
+    >>> [(x, value) for x, _, value in _best_members(members, "min")]
+    [(0.0, 0.2)]
+    """
+    chosen: dict[float, tuple[float, np.ndarray, Any]] = {}
+    for member in members:
+        x, values, _ = member
+        mean = float(np.mean(values))
+        if x not in chosen:
+            chosen[x] = member
+            continue
+        held = float(np.mean(chosen[x][1]))
+        if (mean < held) if rule == "min" else (mean > held):
+            chosen[x] = member
+    return list(chosen.values())
 
 
 def _seed_means(spec: SweepSpec, path: Path) -> list[float]:
@@ -486,7 +528,7 @@ def _seed_means(spec: SweepSpec, path: Path) -> list[float]:
         record = None if column is None else run.record(column)
         values = per_episode(run.metrics.returns, run.metrics.lengths, figure.metric, record)
         values = values[: figure.first] if figure.first is not None else values
-        means.append(float(np.mean(values)))
+        means.append(float(np.sum(values)) if figure.total else float(np.mean(values)))
     return means
 
 

@@ -55,7 +55,7 @@ class Point:
 FIGURE_KEYS = (
     "metric", "x", "aggregate", "smooth", "log_y", "log_x", "title", "y_label", "offset", "scale",
     "reference", "reference_label", "x_max", "y_min", "y_max", "file", "against", "first",
-    "distribution", "dashed", "arrows",
+    "distribution", "dashed", "arrows", "best", "total",
 )  # fmt: skip
 """the keys of a sweep file's ``figure`` section"""
 
@@ -122,6 +122,16 @@ class FigureSpec:
     """with ``values``: also draw the evaluated policy's on-policy distribution ``mu`` (the
     fraction of time steps spent in each state, from the world's model) on a second y axis
     (Sutton & Barto Figure 9.1)"""
+    best: dict[str, Any] | None = None
+    """with ``against``: ``{AXIS: min}`` or ``{AXIS: max}``, another axis: at each value of
+    ``against``, of the points that differ only in that axis the one whose mean over seeds
+    is lowest (``min``) or highest (``max``) is drawn (the first in file order on a tie),
+    its value of the axis kept in the figure's data (Sutton & Barto Figure 12.14: each λ
+    at its best α)"""
+    total: bool = False
+    """with ``against``: a seed's value is the sum of the metric over its episodes (its
+    ``first``), not the mean (failures in a run of so many steps: CartPole's
+    ``sutton_barto_reward`` returns summed, Figure 12.14)"""
     arrows: bool = False
     """with ``values``: draw each point in a panel of its own, an arrow from each state's
     value before the run to its value after (the change the run makes: Sutton & Barto
@@ -278,6 +288,8 @@ def load_sweep(
         _check_against(figure.against, {**grid, **zipped}, where)
     if figure is not None and figure.dashed is not None:
         _check_dashed(figure, grid, where)
+    if figure is not None and (figure.best is not None or figure.total):
+        _check_best(figure, {**grid, **zipped}, curves, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
 
 
@@ -318,6 +330,48 @@ def _check_dashed(figure: FigureSpec, grid: Mapping[str, list[Any]], where: str)
         raise ConfigError(
             f"{where}: figure.dashed: {shown_value(value)} is not a value of the axis {key} "
             f"({', '.join(axis_cell(v) for v in grid[key])})."
+        )
+
+
+def _check_best(
+    figure: FigureSpec, axes: Mapping[str, list[Any]], curves: bool, where: str
+) -> None:
+    """``figure.best`` names one axis (not ``against``) and ``min`` or ``max``; both keys need
+    ``against``, and ``total`` the curves."""
+    key = "best" if figure.best is not None else "total"
+    if figure.against is None:
+        raise ConfigError(
+            f"{where}: figure.{key}: works on the points drawn against an axis; give "
+            "figure.against too."
+        )
+    if figure.total and not curves:
+        raise ConfigError(
+            f"{where}: figure.total: sums each run's curve, and curves: false keeps none; "
+            "keep the curves (curves: true)."
+        )
+    if figure.best is None:
+        return
+    if len(figure.best) != 1:
+        raise ConfigError(
+            f"{where}: figure.best: must be one axis and min or max, such as "
+            f"{{agent.alpha: min}}, got {shown_value(figure.best)}."
+        )
+    axis, rule = next(iter(figure.best.items()))
+    others = [name for name in axes if name != figure.against]
+    if axis not in others:
+        raise ConfigError(
+            f"{where}: figure.best: {shown(axis)} is not an axis other than figure.against "
+            f"({', '.join(others) or 'there is none'})."
+        )
+    if rule not in ("min", "max"):
+        raise ConfigError(
+            f"{where}: figure.best: {axis}: must be min (the lowest mean is best: steps, "
+            f"errors) or max (returns), got {shown_value(rule)}."
+        )
+    if figure.dashed is not None and axis in figure.dashed:
+        raise ConfigError(
+            f"{where}: figure.best: {axis} is figure.dashed's axis too; a line cannot both "
+            "pick its best value of an axis and be styled by one."
         )
 
 
@@ -441,7 +495,8 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
         "offset": (int, float), "scale": (int, float), "reference": (int, float),
         "reference_label": (str,), "x_max": (int, float), "file": (str,),
         "against": (str,), "first": (int,), "y_min": (int, float), "y_max": (int, float),
-        "distribution": (bool,), "dashed": (Mapping,), "arrows": (bool,),
+        "distribution": (bool,), "dashed": (Mapping,), "arrows": (bool,), "best": (Mapping,),
+        "total": (bool,),
     }  # fmt: skip
     for key, kind in kinds.items():
         value = values.get(key)
@@ -477,8 +532,9 @@ def _figure(raw: Any, curves: bool, where: str) -> FigureSpec | None:
     for key in ("offset", "scale", "reference", "x_max", "y_min", "y_max"):
         if values.get(key) is not None:
             values[key] = float(values[key])
-    if values.get("dashed") is not None:
-        values["dashed"] = dict(values["dashed"])
+    for key in ("dashed", "best"):
+        if values.get(key) is not None:
+            values[key] = dict(values[key])
     return FigureSpec(**values)
 
 
