@@ -126,8 +126,8 @@ class FigureSpec:
     """with ``against``: ``{AXIS: min}`` or ``{AXIS: max}``, another axis: at each value of
     ``against``, of the points that differ only in that axis the one whose mean over seeds
     is lowest (``min``) or highest (``max``) is drawn (the first in file order on a tie),
-    its value of the axis kept in the figure's data (Sutton & Barto Figure 12.14: each λ
-    at its best α)"""
+    its value of the axis kept in the figure's data (Sutton & Barto Figure 12.14: each
+    lambda at its best alpha)"""
     total: bool = False
     """with ``against``: a seed's value is the sum of the metric over its episodes (its
     ``first``), not the mean (failures in a run of so many steps: CartPole's
@@ -336,8 +336,10 @@ def _check_dashed(figure: FigureSpec, grid: Mapping[str, list[Any]], where: str)
 def _check_best(
     figure: FigureSpec, axes: Mapping[str, list[Any]], curves: bool, where: str
 ) -> None:
-    """``figure.best`` names one axis (not ``against``) and ``min`` or ``max``; both keys need
-    ``against``, and ``total`` the curves."""
+    """``figure.best`` names one axis (not ``against``) and ``min`` or ``max``.
+
+    Both keys need ``against``, and ``total`` the curves.
+    """
     key = "best" if figure.best is not None else "total"
     if figure.against is None:
         raise ConfigError(
