@@ -470,6 +470,11 @@ def test_figure_7_4_sets_one_arrow_for_one_step_sarsa_and_the_last_ten_steps_for
             arrows.setdefault(panel.strip('"'), {})[(int(y), int(x))] = int(value)
     # one-step SARSA: only the last action, up from (1, 8) into the goal at (0, 8)
     assert arrows["n 1, seed 4"] == {(1, 8): 0}
+    # the path: both points take the same 72 steps through the same 25 cells, shaded
+    for point in ("000", "001"):
+        visits = np.load(out / "points" / point / "visits.npz")["seed-004"]
+        assert visits.shape == (54, 4) and visits.sum() == 72
+        assert (visits.sum(axis=1) > 0).sum() == 25
     # 10-step: the last ten actions, from six cells up the right-hand column (up 0, down 1,
     # right 3: in (1, 8) the bumps to the right, each strengthened, outweigh the last step)
     assert arrows["n 10, seed 4"] == {
@@ -508,6 +513,9 @@ def test_figure_8_3_dyna_q_stops_halfway_through_its_second_episode(tmp_path: Pa
         for point in ("000", "001")
     }
     assert lengths == {"000": [108, 52], "001": [294, 19]}
+    for point, steps in (("000", 160), ("001", 313)):  # the path of each: every step taken
+        visits = np.load(out / "points" / point / "visits.npz")["seed-000"]
+        assert visits.sum() == steps
     rows = (out / "fig8_3_dyna_policies.csv").read_text(encoding="utf-8").splitlines()[1:]
     arrows: dict[str, int] = {}
     for row in rows:

@@ -46,7 +46,7 @@ def test_check_refuses_a_bad_file_naming_the_key(tmp_path: Path) -> None:
     path = write_yaml(tmp_path / "k.yaml", {**study, "kind": "bandits"})
     assert_refused(
         invoke("study", path, "--check"),
-        "kind: must be one of average_reward, bandit, dp, linear, policy_gradient, sweep",
+        "kind: must be one of average_reward, bandit, dp, linear, panels, policy_gradient, sweep",
     )
 
 
@@ -300,3 +300,90 @@ def test_a_signal_inside_a_long_maze_run_ends_the_study_within_two_seconds(
     assert invoke("study", "--resume", out, "-q").exit_code == 0
     assert invoke("study", path, "--out", tmp_path / "whole", "-q").exit_code == 0
     assert _files(out) == _files(tmp_path / "whole")
+
+
+def _panel_files(tmp_path: Path) -> Path:
+    """A panels file of two small sweeps (the 5-state walk, TD(0)) beside it."""
+    sweep = {
+        "kind": "sweep",
+        "base": {
+            "env": {"id": "cartpole_q/RandomWalk5-v0"},
+            "agent": {"algorithm": "td", "policy": "random", "gamma": 1.0, "q_init": 0.5},
+            "train": {"episodes": 5, "eval_every": 0, "checkpoint_every": 0},
+            "eval": {"episodes": 1},
+        },
+        "seeds": "0-1",
+    }
+    write_yaml(tmp_path / "a.yaml", {**sweep, "grid": {"agent.alpha": [0.1, 0.2]},
+                                     "figure": {"metric": "rms_error", "file": "a.png"}})  # fmt: skip
+    write_yaml(tmp_path / "b.yaml", {**sweep, "grid": {"agent.alpha": [0.3]},
+                                     "figure": {"metric": "rms_error", "file": "b.png"}})  # fmt: skip
+    return write_yaml(
+        tmp_path / "p.yaml", {"kind": "panels", "panels": ["a.yaml", "b.yaml"], "title": "two"}
+    )
+
+
+def test_a_panels_study_draws_its_sweeps_as_one_figure_and_resumes_to_the_same_bytes(
+    tmp_path: Path,
+) -> None:
+    """Figure 12.14's four tasks by one command: each panel a sweep, run in turn."""
+    from cartpole_q.experiments.study import Options, read_study_file
+    from cartpole_q.experiments.study_kinds import registered
+
+    path = _panel_files(tmp_path)
+    checked = invoke("study", path, "--check")
+    assert checked.exit_code == 0 and "a panels study of 2 sweeps, 6 runs in all" in checked.stdout
+    whole = tmp_path / "whole"
+    result = invoke("study", path, "--out", whole, "--workers", 1)
+    assert result.exit_code == 0, result.output
+    assert (
+        "panel a:" in result.stdout
+        and f"the figure of its 2 panels: {whole / 'p.png'}" in result.stdout
+    )
+    rows = (whole / "p.csv").read_text(encoding="utf-8").splitlines()
+    for name in ("a", "b"):  # each panel's own data, its panel column named
+        own = (whole / "panels" / name / f"{name}.csv").read_text(encoding="utf-8").splitlines()
+        assert [row.split(",", 1)[1] for row in rows if row.split(",", 1)[0] == name] == [
+            row.split(",", 1)[1] for row in own[1:]
+        ]
+    assert rows[0] == own[0]
+    # Stopped after its first panel, as a signal there leaves it; --resume runs the second.
+    kind = registered()["panels"]
+    study = read_study_file(path)
+    spec = kind.read(study)
+    part = tmp_path / "part"
+    with kind.start(spec, study, part) as directory:
+        stop = Options(
+            workers=1, quiet=True, should_stop=lambda: (part / "panels/a/a.png").exists()
+        )
+        stopped = kind.run(spec, directory, stop)
+    assert not stopped.complete and stopped.done_runs == 4 and stopped.total_runs == 6
+    assert not (part / "p.png").exists() and not (part / "panels/b/b.png").exists()
+    resumed = invoke("study", "--resume", part, "--workers", 1, "-q")
+    assert resumed.exit_code == 0, resumed.output
+    for name in ("p.png", "p.csv", "panels/a/a.csv", "panels/b/b.csv", "panels/b/b.png"):
+        assert (part / name).read_bytes() == (whole / name).read_bytes(), name
+
+
+@pytest.mark.parametrize(
+    ("change", "words"),
+    [
+        ({"panels": ["a.yaml", "c.yaml"]}, "panels: c.yaml: no such file beside it"),
+        ({"panels": []}, "panels: must be a non-empty list of sweep files"),
+        ({"panels": ["a.yaml", "bandit.yaml"]}, "panels: bandit.yaml: is a bandit study"),
+        ({"panels": ["a.yaml", "a.yaml"]}, "panels: two panels are named a"),
+        ({"columns": 0}, "columns: must be a whole number of at least 1"),
+        ({"colour": "red"}, "colour: is not a key of a panels file"),
+        ({"file": "../p.png"}, "file: '../p.png' must be a file name"),
+    ],
+)
+def test_a_bad_panels_file_is_refused_naming_the_key(
+    tmp_path: Path, change: dict, words: str
+) -> None:
+    path = _panel_files(tmp_path)
+    shutil.copy(BOOK / "fig2_2_epsilon_greedy.yaml", tmp_path / "bandit.yaml")
+    bad = write_yaml(tmp_path / "bad.yaml", {"kind": "panels", "panels": ["a.yaml"], **change})
+    assert path.is_file()
+    result = invoke("study", bad, "--out", tmp_path / "out")
+    assert_refused(result, f"{bad}: ", words)
+    assert not (tmp_path / "out").exists()

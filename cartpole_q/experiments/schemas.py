@@ -42,6 +42,7 @@ from cartpole_q.experiments import (
     average_reward,
     bandits,
     linear,
+    panels,
     planning,
     policy_gradient,
     study_kinds,
@@ -94,9 +95,9 @@ def study_schema() -> Schema:
 
     >>> schema = study_schema()
     >>> sorted(name for name in schema["$defs"] if "." not in name)
-    ['average_reward', 'bandit', 'config', 'dp', 'linear', 'policy_gradient', 'sweep', 'tune', 'updates']
+    ['average_reward', 'bandit', 'config', 'dp', 'linear', 'panels', 'policy_gradient', 'sweep', 'tune', 'updates']
     >>> schema["properties"]["kind"]["enum"]
-    ['average_reward', 'bandit', 'dp', 'linear', 'policy_gradient', 'sweep', 'updates']
+    ['average_reward', 'bandit', 'dp', 'linear', 'panels', 'policy_gradient', 'sweep', 'updates']
     """
     schemas = kind_schemas()
     kinds = sorted(schemas)
@@ -163,7 +164,7 @@ def kind_schemas() -> dict[str, Schema]:
     built = {
         "sweep": _sweep(), "bandit": _bandit(), "dp": _dp(), "updates": _updates(),
         "linear": _linear(), "policy_gradient": _policy_gradient(),
-        "average_reward": _average_reward(),
+        "average_reward": _average_reward(), "panels": _panels(),
     }  # fmt: skip
     missing = sorted(set(study_kinds.registered()) - set(built))
     if missing:
@@ -824,6 +825,22 @@ def _average_reward() -> Schema:
     }
     schema = _kind("average_reward", average_reward.STUDY_KEYS, properties, "Average-reward files")
     schema["required"] = ["world", "steps", "curves"]
+    return schema
+
+
+def _panels() -> Schema:
+    properties: dict[str, Schema] = {
+        "name": NAME,
+        "panels": {
+            "type": "array", "minItems": 1,
+            "items": {"type": "string", "description": "a sweep file with a figure, beside this file"},
+        },
+        "columns": {"type": "integer", "minimum": 1},
+        "title": TEXT,
+        "file": _figure_file(),
+    }  # fmt: skip
+    schema = _kind("panels", panels.STUDY_KEYS, properties, "Panels files")
+    schema["required"] = ["panels"]
     return schema
 
 

@@ -11,6 +11,7 @@ from cartpole_q.experiments import (
     average_reward,
     bandits,
     linear,
+    panels,
     planning,
     policy_gradient,
     sweep,
@@ -18,7 +19,7 @@ from cartpole_q.experiments import (
 )
 from cartpole_q.experiments.study import StudyKind, kinds
 
-MODULES = (sweep, bandits, planning, updates, linear, policy_gradient, average_reward)
+MODULES = (sweep, bandits, planning, updates, linear, policy_gradient, average_reward, panels)
 """the modules that register the kinds (imported for that)"""
 
 

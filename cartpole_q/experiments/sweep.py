@@ -101,6 +101,8 @@ class FinishedRun:
     records: Mapping[str, np.ndarray] = field(default_factory=dict)
     """its further ``metrics.csv`` columns by name: ``info_KEY`` (each episode's sum of
     ``info[train.info_metric]``), ``rms_error`` (a prediction run's errors)"""
+    visits: np.ndarray | None = None
+    """its visits (kept by a sweep whose figure is ``metric: policy``)"""
 
 
 class SweepInterrupted(KeyboardInterrupt):
@@ -157,7 +159,7 @@ def run_task(
                 records[ERRORS_COLUMN] = result.errors
             yield FinishedRun(
                 point, SeedResult.of_train(result), result.q_table, result.returns,
-                result.lengths, records,
+                result.lengths, records, result.visits,
             )  # fmt: skip
 
 
@@ -847,6 +849,10 @@ class _Book:
         self._curves: dict[int, dict[str, tuple[np.ndarray, np.ndarray]]] = {}
         self._records: dict[int, dict[str, dict[str, np.ndarray]]] = {}
         """by point and seed key, the runs' further columns (``FinishedRun.records``)"""
+        figure = spec.figure
+        self._keeps_visits = figure is not None and figure.metric == POLICY_FIGURE
+        self._visits: dict[int, dict[str, np.ndarray]] = {}
+        """by point and seed key, the runs' visits (a ``metric: policy`` figure's paths)"""
         self._dirty: set[int] = set()
         self._last_flush = -math.inf  # the first results are saved at once
         self.saved = len(self.rows)
@@ -886,7 +892,11 @@ class _Book:
                 if spec.curves:
                     self._curves[point] = sweepdir.read_curves(self._directory, point_id)
                     self._records[point] = sweepdir.read_records(self._directory, point_id)
+                if self._keeps_visits:
+                    self._visits[point] = sweepdir.read_visits(self._directory, point_id)
             self._tables[point][spec.seed_key(seed)] = run.q_table
+            if self._keeps_visits and run.visits is not None:
+                self._visits[point][spec.seed_key(seed)] = run.visits
             config = spec.points[point].config
             if config.train.tensorboard:
                 board = self._directory / TENSORBOARD_DIR / spec.point_id(point)
@@ -910,6 +920,9 @@ class _Book:
         for point in sorted(self._dirty):
             point_id = self._spec.point_id(point)
             sweepdir.write_tables(self._directory, point_id, self._tables[point])
+            if self._keeps_visits:
+                visits = self._visits[point]
+                sweepdir.write_tables(self._directory, point_id, visits, sweepdir.VISITS_FILE)
             if self._spec.curves:
                 sweepdir.write_curves(
                     self._directory, point_id, self._curves[point], self._records.get(point)
@@ -921,6 +934,7 @@ class _Book:
         for point in self._dirty:
             if self._per_point[point] == len(self._spec.seeds):
                 del self._tables[point]  # complete: its files hold every seed
+                self._visits.pop(point, None)
                 self._curves.pop(point, None)
                 self._records.pop(point, None)
         self._dirty.clear()

@@ -277,7 +277,7 @@ def grid_arrows_figure(
     A cell gets its greedy action's arrow (the lowest among the largest ``Q``) where its
     values are not all equal, and none where they are (nothing learned there yet); cells
     the run visited are shaded (the path it took) where its visits are known (a run
-    directory's; a sweep keeps none). The data: per panel, ``greedy action`` (empty: all
+    directory's, or a sweep's whose figure is ``metric: policy``). The data: per panel, ``greedy action`` (empty: all
     equal) and ``visits`` (the steps taken from the cell) per cell.
     """
     across = len(panels)

@@ -219,6 +219,7 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
     )
     curves = sweepdir.read_curves(sweep, point_dir.name)
     records = sweepdir.read_records(sweep, point_dir.name)
+    visits = sweepdir.read_visits(sweep, point_dir.name)
     info_column = f"{rundir.INFO_COLUMN_PREFIX}{config.train.info_metric}"
     predicts = get_algorithm(config.agent.algorithm).predicts
     threshold = rundir.config_threshold(config)
@@ -239,7 +240,7 @@ def _sweep_point(point_dir: Path, rows: list[sweepdir.ResultRow]) -> RunSet:
                 path=point_dir / key,
                 config=seed_config,
                 q_table=tables[key],
-                visits=None,
+                visits=visits.get(key),
                 metrics=_metrics(seed_config, returns, lengths),
                 result=dataclasses.replace(row.result, reward_threshold=threshold),
                 info=records.get(key, {}).get(info_column),

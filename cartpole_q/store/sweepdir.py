@@ -44,6 +44,9 @@ RESULTS_FILE = "results.csv"
 POINTS_FILE = "points.csv"
 POINTS_DIR = "points"
 TABLES_FILE = "q_tables.npz"
+VISITS_FILE = "visits.npz"
+"""a point's seeds' visits (``figure.metric: policy`` sweeps only: the path a grid world's
+figure shades)"""
 CURVES_FILE = "curves.npz"
 """a point's learning curves: ``seed-NNN.returns`` (float64) and ``seed-NNN.lengths``
 (int64) per finished seed, one value per training episode, compressed; with
@@ -381,12 +384,26 @@ def tables_path(directory: Path, point_id: str) -> Path:
     return directory / POINTS_DIR / point_id / TABLES_FILE
 
 
-def write_tables(directory: Path, point_id: str, tables: Mapping[str, np.ndarray]) -> None:
-    """Rewrite a point's ``q_tables.npz`` whole, keys in order (``seed-000``, ...)."""
+def write_tables(
+    directory: Path, point_id: str, tables: Mapping[str, np.ndarray], name: str = TABLES_FILE
+) -> None:
+    """Rewrite a point's ``q_tables.npz`` (or ``visits.npz``) whole, keys in order (``seed-000``, ...)."""
     buffer = io.BytesIO()
     arrays: dict[str, Any] = {key: tables[key] for key in sorted(tables)}
     np.savez(buffer, **arrays)
-    atomic_write_bytes(tables_path(directory, point_id), buffer.getvalue())
+    atomic_write_bytes(directory / POINTS_DIR / point_id / name, buffer.getvalue())
+
+
+def read_visits(directory: Path, point_id: str) -> dict[str, np.ndarray]:
+    """A point's saved visits by seed key (none if the sweep keeps none).
+
+    Raises:
+        RunError: the file is damaged.
+    """
+    path = directory / POINTS_DIR / point_id / VISITS_FILE
+    if not path.is_file():
+        return {}
+    return load_npz(path, str(path))
 
 
 def read_tables(
