@@ -317,7 +317,7 @@ def test_best_draws_each_value_at_its_best_point_and_total_sums(in_tmp: Path) ->
     study = write_yaml(in_tmp / "s.yaml", {
         "name": "best",
         "base": {
-            "engine": "gymnasium", "env": {"id": "Taxi-v4"}, "discretization": None,
+            "env": {"id": "Taxi-v4"}, "discretization": None,
             "agent": {"epsilon": 0.1, "q_init": 0.0},
             "train": {"episodes": 6, "stop_when_solved": False, "eval_every": 0},
         },

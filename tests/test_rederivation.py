@@ -381,14 +381,6 @@ CASES: dict[str, dict[str, Any]] = {
         "episodes": 6000,
         "seed": 11,
     },
-    # The puddle world as Figure 12.14 codes it: 5 tilings of a 5 x 5 grid.
-    "puddle_tiles": {
-        "env": {"id": "cartpole_q/PuddleWorld-v0"},
-        "discretization": {"bins": [5, 5], "low": [0.0, 0.0], "high": [1.0, 1.0], "tilings": 5},
-        "agent": {"gamma": 1.0, "alpha": 0.5, "epsilon": 0.0, "q_init": 0.0},
-        "episodes": 8,
-        "seed": 13,
-    },
     # Tile coding: 4 tilings of a 4 x 3 grid (docs/algorithms.md, "Tile coding").
     "mountaincar_tiles": {
         "env": {"id": "MountainCar-v0"},
@@ -427,7 +419,7 @@ CASES["lake_greedy"] = _frozenlake_with({"type": "log", "k": 20, "start": 1.0, "
 
 # Worlds with a compiled twin train on both engines.
 NUMBA_WORLDS = {"cartpole", "cartpole_solve", "cartpole_short", "cartpole_physics"}
-NUMBA_WORLDS |= {"cartpole_budget", "puddle_tiles"}
+NUMBA_WORLDS |= {"cartpole_budget"}
 NUMBA_WORLDS |= {"walk5", "walk19", "walk1000"}
 NUMBA_WORLDS |= {"cartpole_randomize"}
 NUMBA_WORLDS |= {"mountaincar", "acrobot", "mountaincar_tiles", "cartpole_tiles"}
@@ -468,7 +460,6 @@ OTHER_TWIN_VARIANTS = {
     "acrobot": {"q_learning"},
     "mountaincar_tiles": {"sarsa", "n_step_sarsa", "sarsa_lambda-replacing"},
     "cartpole_tiles": {"q_learning", "sarsa_lambda-dutch"},
-    "puddle_tiles": {"sarsa_lambda-replacing"},  # Figure 12.14's (its study compiles it)
     # test_twins_tabular.py trains several algorithms on FrozenLake and a multi-step one on
     # each world alike on both engines; here the tabular twins run Q-learning.
     **{world: {"q_learning"} for world in ("taxi", "cliffwalking")},
@@ -964,7 +955,6 @@ TILE_VARIANTS = [
     [
         *_params(["mountaincar_tiles"], TILE_VARIANTS, slow="beyond_one_step"),
         *_params(["cartpole_tiles"], ["q_learning", "sarsa_lambda-dutch"]),
-        *_params(["puddle_tiles"], ["sarsa_lambda-replacing"]),
     ],
 )
 def test_tile_coding(world: str, variant: str, engine: str) -> None:
