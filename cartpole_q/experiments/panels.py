@@ -41,6 +41,7 @@ from cartpole_q.experiments.study import (
     Options,
     Outcome,
     StudyFile,
+    directory_kind,
     kinds,
     read_study_file,
     register_kind,
@@ -181,15 +182,8 @@ class PanelsKind:
             yield claim.path
 
     def is_directory(self, directory: Path) -> bool:
-        """A study directory whose ``study.yaml`` names this kind."""
-        path = directory / studydir.STUDY_FILE
-        if not path.is_file():
-            return False
-        try:
-            raw, _ = studydir.read_start(directory)
-        except (ConfigError, RunError):
-            return False
-        return raw.get(KIND_KEY) == self.name
+        """A study directory whose ``study.yaml`` names this kind (read without its lock)."""
+        return directory_kind(directory) == self.name
 
     def load(self, directory: Path) -> PanelsSpec:
         """The study of ``directory``: its ``study.yaml`` and each panel's sweep directory."""

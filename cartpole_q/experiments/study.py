@@ -219,6 +219,22 @@ def study_of(
     return StudyFile(raw, inferred, where, stem, base_dir)
 
 
+def directory_kind(directory: Path) -> str | None:
+    """The ``kind`` a study directory's ``study.yaml`` names (``None``: none, or no such file).
+
+    Read without the directory's lock: nothing in it is changed.
+    """
+    path = directory / studydir.STUDY_FILE
+    if not path.is_file():
+        return None
+    try:
+        raw = read_yaml_mapping(path, "study file")
+    except ConfigError:
+        return None
+    kind = raw.get(KIND_KEY)
+    return kind if isinstance(kind, str) else None
+
+
 def kind_of_directory(directory: Path) -> StudyKind:
     """The kind whose directory ``directory`` is.
 
@@ -315,14 +331,7 @@ class RunsKind:
 
     def is_directory(self, directory: Path) -> bool:
         """A study directory whose ``study.yaml`` names this kind."""
-        path = directory / studydir.STUDY_FILE
-        if not path.is_file():
-            return False
-        try:
-            raw = read_yaml_mapping(path, "study file")
-        except ConfigError:
-            return False
-        return raw.get(KIND_KEY) == self.name
+        return directory_kind(directory) == self.name
 
     @contextlib.contextmanager
     def start(self, spec: Any, study: StudyFile, out: Path | None) -> Iterator[Path]:
