@@ -179,14 +179,18 @@ class TrainResult:
     def extendable(self) -> bool:
         """Whether more episodes would continue this run exactly as a longer run would go on.
 
-        True when the run ended by reaching ``train.episodes``: not interrupted, and not
-        stopped at its solve point (a longer run would have stopped there too).
+        True when the run ended by reaching ``train.episodes``: not interrupted, not
+        stopped at its solve point (a longer run would have stopped there too), and not at
+        ``train.max_env_steps`` (its last episode was cut there).
         """
-        stopped_when_solved = self.solved_episode is not None and self.config.train.stop_when_solved
+        settings = self.config.train
+        stopped_when_solved = self.solved_episode is not None and settings.stop_when_solved
+        budget = settings.max_env_steps
         return (
             not self.interrupted
-            and self.episodes >= self.config.train.episodes
+            and self.episodes >= settings.episodes
             and not stopped_when_solved
+            and not (budget is not None and self.env_steps >= budget)
         )
 
     @property

@@ -235,11 +235,11 @@ def test_a_sweep_draws_its_figure_when_it_completes(in_tmp: Path) -> None:
         ({"metric": "length", "total": True}, "figure.total: works on the points drawn"),
         (
             {"metric": "length", "against": "agent.alpha", "best": {"agent.alpha": "min"}},
-            "figure.best: 'agent.alpha' is not an axis other than figure.against",
+            "figure.best: 'agent.alpha' is not a grid axis other than figure.against",
         ),
         (
             {"metric": "length", "against": "agent.alpha", "best": {"agent.gamma": "min"}},
-            "figure.best: 'agent.gamma' is not an axis",
+            "figure.best: 'agent.gamma' is not a grid axis",
         ),
     ],
 )
@@ -349,3 +349,29 @@ def test_best_draws_each_value_at_its_best_point_and_total_sums(in_tmp: Path) ->
         assert chosen[gamma] == best[2]
         assert line[gamma] == pytest.approx(best[0])
     assert set(chosen.values()) != {0.1}  # not merely the first alpha: the choice is real
+
+
+@pytest.mark.parametrize(
+    ("axes", "words"),
+    [
+        ({"grid": {"agent.gamma": [0.9, 0.99], "agent.trace": ["accumulating", "replacing"]}},
+         "figure.best: the axis agent.trace must hold numbers"),
+        ({"grid": {"agent.gamma": [0.9, 0.99]}, "zip": {"agent.alpha": [0.1, 0.2],
+                                                      "agent.lambda": [0.5, 0.9]}},
+         "figure.best: 'agent.alpha' is not a grid axis other than figure.against"),
+    ],
+)  # fmt: skip
+def test_best_needs_a_grid_axis_of_numbers(in_tmp: Path, axes: dict, words: str) -> None:
+    """A zip axis moves with its partner (nothing to choose); a text axis has no value to draw."""
+    from tests.conftest import write_yaml
+
+    best = "agent.trace" if "agent.trace" in axes["grid"] else "agent.alpha"
+    study = write_yaml(in_tmp / "s.yaml", {
+        "name": "best", "seeds": 0,
+        "base": {"agent": {"algorithm": "sarsa_lambda"}, "train": {"episodes": 2}},
+        **axes,
+        "figure": {"metric": "length", "against": "agent.gamma", "best": {best: "min"}},
+    })  # fmt: skip
+    result = invoke("study", study, "--check")
+    assert result.exit_code == 2, result.output
+    assert words in result.output

@@ -608,3 +608,19 @@ def test_a_run_with_a_budget_of_steps_resumes_byte_identically_and_is_not_extend
     refused = CliRunner().invoke(app, ["train", "--resume", str(reference), "--episodes", "400"])
     assert refused.exit_code == 2
     assert "it stopped at train.max_env_steps (9,999 env steps)" in refused.stderr
+
+
+def test_a_budget_reached_with_the_last_episode_keeps_no_checkpoint(tmp_path: Path) -> None:
+    """Driving home: 5 steps an episode, 10 episodes, a budget of 50: nothing to extend."""
+    overrides = {
+        "env.id": "cartpole_q/DrivingHome-v0", "discretization": None, "agent.algorithm": "td",
+        "agent.gamma": 1.0, "train.episodes": 10, "train.checkpoint_every": 5,
+        "train.eval_every": 0, "train.max_env_steps": 50,
+    }  # fmt: skip
+    run = _reference(tmp_path, overrides)
+    assert json.loads((run / "summary.json").read_text())["env_steps"] == 50
+    assert not (run / rundir.CHECKPOINT_FILE).exists()  # the episode-5 checkpoint is gone
+    for extra in ([], ["--episodes", "20"]):
+        refused = CliRunner().invoke(app, ["train", "--resume", str(run), *extra])
+        assert refused.exit_code == 2
+        assert "it stopped at train.max_env_steps (50 env steps)" in refused.stderr

@@ -375,6 +375,7 @@ def test_a_panels_study_draws_its_sweeps_as_one_figure_and_resumes_to_the_same_b
         ({"columns": 0}, "columns: must be a whole number of at least 1"),
         ({"colour": "red"}, "colour: is not a key of a panels file"),
         ({"file": "../p.png"}, "file: '../p.png' must be a file name"),
+        ({"name": "../x"}, "name: must be letters, digits, '-' or '_'"),
     ],
 )
 def test_a_bad_panels_file_is_refused_naming_the_key(

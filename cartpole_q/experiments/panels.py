@@ -47,6 +47,7 @@ from cartpole_q.experiments.study import (
     register_kind,
     study_of,
 )
+from cartpole_q.experiments.sweep_spec import checked_name, safe_name
 from cartpole_q.store import studydir
 
 STUDY_KEYS = ("name", "panels", "columns", "title", "file")
@@ -123,10 +124,10 @@ class PanelsKind:
                 f"{where}: columns: must be a whole number of at least 1, got "
                 f"{shown_value(columns)}."
             )
-        name = body.get("name", study.stem)
+        name = checked_name(body, safe_name(study.stem), where)
         title = body.get("title", name)
         file = body.get("file", f"{name}.png")
-        for key, value in (("name", name), ("title", title), ("file", file)):
+        for key, value in (("title", title), ("file", file)):
             if not isinstance(value, str) or not value:
                 raise ConfigError(f"{where}: {key}: must be text, got {shown_value(value)}.")
         if "/" in file or Path(file).suffix.lower() not in (".png", ".svg", ".pdf"):
@@ -186,7 +187,13 @@ class PanelsKind:
         return directory_kind(directory) == self.name
 
     def load(self, directory: Path) -> PanelsSpec:
-        """The study of ``directory``: its ``study.yaml`` and each panel's sweep directory."""
+        """The study of ``directory``: its ``study.yaml`` and each panel's sweep directory.
+
+        The caller holds the study's lock; each panel is read under its own (reading a
+        sweep directory tidies its temporary files).
+        """
+        from cartpole_q.store.lock import directory_lock
+
         raw, _ = studydir.read_start(directory)
         sweep = kinds()[PANEL_KIND]
         names = raw.get("panels")
@@ -198,7 +205,8 @@ class PanelsKind:
             if not sweep.is_directory(where):
                 raise RunError(f"{where}: the panel {name} is no sweep directory.")
             stub = study_of({}, str(where), str(name), where, PANEL_KIND)
-            panels.append(Panel(str(name), stub, sweep.load(where)))
+            with directory_lock(where, "sweep"):
+                panels.append(Panel(str(name), stub, sweep.load(where)))
         return PanelsSpec(
             str(raw.get("name", directory.name)), tuple(panels), int(raw.get("columns", 2)),
             str(raw.get("title", "")), str(raw.get("file", f"{directory.name}.png")),
@@ -221,7 +229,11 @@ class PanelsKind:
             outcomes.append(outcome)
             if not outcome.complete:
                 break
-        done = sum(outcome.done_runs for outcome in outcomes)
+        # the panels not reached this time count what earlier sessions saved
+        done = sum(outcome.done_runs for outcome in outcomes) + sum(
+            _saved_runs(directory / PANELS_DIR / panel.name, panel.spec)
+            for panel in spec.panels[len(outcomes) :]
+        )
         runs = sum(sweep.describe(panel.spec)[0] for panel in spec.panels)
         complete = len(outcomes) == len(spec.panels) and all(o.complete for o in outcomes)
         result = Outcome(directory, runs, done, complete)
@@ -238,6 +250,13 @@ class PanelsKind:
         ]
         result.lines.append(f"the figure of its {len(spec.panels)} panels: {result.files[0]}")
         return result
+
+
+def _saved_runs(where: Path, spec: Any) -> int:
+    """How many runs a panel's sweep directory holds (its ``results.csv`` rows)."""
+    from cartpole_q.store import sweepdir
+
+    return len(sweepdir.read_results(where, spec.axes))
 
 
 def _panel_figure(panel: Panel, outcome: Outcome) -> Path:

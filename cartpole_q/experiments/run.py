@@ -315,6 +315,13 @@ def _check_extendable(
 ) -> None:
     """Refuse to resume a finished run unless it ended at ``train.episodes`` and more are asked."""
     done = summary.episodes
+    budget = config.train.max_env_steps
+    if budget is not None and summary.env_steps >= budget:
+        raise RunError(
+            f"{run_dir}: this run already finished; there is nothing to resume: it stopped at "
+            f"train.max_env_steps ({budget:,} env steps), cutting its last episode there, so "
+            "it cannot go on as one run; train it again with a larger train.max_env_steps."
+        )
     meta = read_checkpoint_meta(run_dir)
     if meta is None:
         solved = summary.solved_episode
@@ -323,15 +330,6 @@ def _check_extendable(
                 f"it stopped at episode {solved}, where it solved (train.stop_when_solved), so "
                 "a longer run from the start would have stopped there too; only a run that "
                 "ended by reaching train.episodes can be extended"
-            )
-        elif (
-            config.train.max_env_steps is not None
-            and summary.env_steps >= config.train.max_env_steps
-        ):
-            reason = (
-                f"it stopped at train.max_env_steps ({config.train.max_env_steps:,} env "
-                "steps), cutting its last episode there, so it cannot go on as one run; "
-                "train it again with a larger train.max_env_steps"
             )
         else:
             reason = f"it kept no {CHECKPOINT_FILE} to continue from"

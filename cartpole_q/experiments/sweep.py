@@ -482,21 +482,21 @@ def _best_members(
 ) -> list[tuple[float, np.ndarray, Any]]:
     """Of the members at each x, the one whose mean over seeds is best (``min`` or ``max``).
 
-    On a tie the first in the points' order is kept.
+    On a tie the first in the points' order is kept; a mean that is not a number (a seed
+    that diverged) is never chosen over one that is.
 
-    >>> members = [(0.0, np.array([[3.0]]), 0.1), (0.0, np.array([[2.0]]), 0.2)]
+    >>> members = [(0.0, np.array([[np.nan]]), 0.05), (0.0, np.array([[3.0]]), 0.1),
+    ...            (0.0, np.array([[2.0]]), 0.2)]
     >>> [(x, value) for x, _, value in _best_members(members, "min")]
     [(0.0, 0.2)]
     """
     chosen: dict[float, tuple[float, np.ndarray, Any]] = {}
+    sign = 1.0 if rule == "min" else -1.0
     for member in members:
         x, values, _ = member
-        mean = float(np.mean(values))
-        if x not in chosen:
-            chosen[x] = member
-            continue
-        held = float(np.mean(chosen[x][1]))
-        if (mean < held) if rule == "min" else (mean > held):
+        mean = sign * float(np.mean(values))
+        held = sign * float(np.mean(chosen[x][1])) if x in chosen else math.nan
+        if x not in chosen or (mean < held) or (math.isnan(held) and not math.isnan(mean)):
             chosen[x] = member
     return list(chosen.values())
 

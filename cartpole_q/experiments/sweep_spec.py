@@ -289,7 +289,7 @@ def load_sweep(
     if figure is not None and figure.dashed is not None:
         _check_dashed(figure, grid, where)
     if figure is not None and (figure.best is not None or figure.total):
-        _check_best(figure, {**grid, **zipped}, curves, where)
+        _check_best(figure, grid, curves, where)
     return SweepSpec(name, base_mapping, seeds, grid, zipped, points, curves, figure)
 
 
@@ -362,8 +362,13 @@ def _check_best(
     others = [name for name in axes if name != figure.against]
     if axis not in others:
         raise ConfigError(
-            f"{where}: figure.best: {shown(axis)} is not an axis other than figure.against "
-            f"({', '.join(others) or 'there is none'})."
+            f"{where}: figure.best: {shown(axis)} is not a grid axis other than "
+            f"figure.against ({', '.join(others) or 'there is none'})."
+        )
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in axes[axis]):
+        raise ConfigError(
+            f"{where}: figure.best: the axis {axis} must hold numbers (the figure's data names "
+            "the value chosen at each point)."
         )
     if rule not in ("min", "max"):
         raise ConfigError(
