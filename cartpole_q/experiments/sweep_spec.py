@@ -123,11 +123,11 @@ class FigureSpec:
     fraction of time steps spent in each state, from the world's model) on a second y axis
     (Sutton & Barto Figure 9.1)"""
     best: dict[str, Any] | None = None
-    """with ``against``: ``{AXIS: min}`` or ``{AXIS: max}``, another axis: at each value of
-    ``against``, of the points that differ only in that axis the one whose mean over seeds
-    is lowest (``min``) or highest (``max``) is drawn (the first in file order on a tie),
-    its value of the axis kept in the figure's data (Sutton & Barto Figure 12.14: each
-    lambda at its best alpha)"""
+    """with ``against``: ``{AXIS: min}`` or ``{AXIS: max}``, another grid axis of numbers:
+    at each value of ``against``, of the points that differ only in that axis the one whose
+    mean over seeds is lowest (``min``) or highest (``max``) is drawn (the first in file
+    order on a tie), its value of the axis kept in the figure's data (Sutton & Barto Figure
+    12.14: each lambda at its best alpha)"""
     total: bool = False
     """with ``against``: a seed's value is the sum of the metric over its episodes (its
     ``first``), not the mean (failures in a run of so many steps: CartPole's
