@@ -454,20 +454,32 @@ def test_compile_names_what_it_skipped_and_counts_it_apart(in_tmp: Path) -> None
     assert lines[-1].startswith("1 compiled or loaded, 1 skipped, in ")
 
 
-def test_figure_7_4_sets_one_arrow_for_one_step_sarsa_and_the_last_ten_steps_for_ten(
-    tmp_path: Path,
-) -> None:
-    """The shipped study: one episode on the Dyna maze, the same path for both n."""
-    out = tmp_path / "f74"
-    study = Path(__file__).resolve().parents[1] / "examples/book/fig7_4_n_step_sarsa_path.yaml"
+def _shipped_study(tmp_path: Path, name: str) -> Path:
+    """Run ``examples/book/<name>.yaml`` as a reader would; its study directory."""
+    out = tmp_path / name
+    study = Path(__file__).resolve().parents[1] / "examples" / "book" / f"{name}.yaml"
     result = invoke("study", study, "--out", out, "-q")
     assert result.exit_code == 0, result.output
-    rows = (out / "fig7_4_n_step_sarsa_path.csv").read_text(encoding="utf-8").splitlines()[1:]
+    return out
+
+
+def _grid_arrows(figure_data: Path) -> dict[str, dict[tuple[int, int], int]]:
+    """A grid-arrows figure's greedy actions by panel, as ``{(row, column): action}``."""
+    rows = figure_data.read_text(encoding="utf-8").splitlines()[1:]
     arrows: dict[str, dict[tuple[int, int], int]] = {}
     for row in rows:
         panel, series, x, y, _, _, value = row.rsplit(",", 6)
         if series == "greedy action (empty: all values equal)" and value:
             arrows.setdefault(panel.strip('"'), {})[(int(y), int(x))] = int(value)
+    return arrows
+
+
+def test_figure_7_4_sets_one_arrow_for_one_step_sarsa_and_the_last_ten_steps_for_ten(
+    tmp_path: Path,
+) -> None:
+    """The shipped study: one episode on the Dyna maze, the same path for both n."""
+    out = _shipped_study(tmp_path, "fig7_4_n_step_sarsa_path")
+    arrows = _grid_arrows(out / "fig7_4_n_step_sarsa_path.csv")
     # one-step SARSA: only the last action, up from (1, 8) into the goal at (0, 8)
     assert arrows["n 1, seed 4"] == {(1, 8): 0}
     # the path: both points take the same 72 steps through the same 25 cells, shaded
@@ -486,10 +498,7 @@ def test_figure_6_1_moves_every_prediction_as_monte_carlo_and_td_recommend(
     tmp_path: Path,
 ) -> None:
     """The shipped study: one drive from Example 6.1's predictions, alpha 1, arrows drawn."""
-    out = tmp_path / "f61"
-    study = Path(__file__).resolve().parents[1] / "examples/book/fig6_1_driving_home.yaml"
-    result = invoke("study", study, "--out", out, "-q")
-    assert result.exit_code == 0, result.output
+    out = _shipped_study(tmp_path, "fig6_1_driving_home")
     rows = list(csv.DictReader((out / "fig6_1_driving_home.csv").open(encoding="utf-8")))
     drawn: dict[tuple[str, str], list[float]] = {}
     for row in rows:
@@ -503,10 +512,7 @@ def test_figure_6_1_moves_every_prediction_as_monte_carlo_and_td_recommend(
 
 def test_figure_8_3_dyna_q_stops_halfway_through_its_second_episode(tmp_path: Path) -> None:
     """The shipped study: n 0 has set one arrow, n 50 a policy over most of the maze."""
-    out = tmp_path / "f83"
-    study = Path(__file__).resolve().parents[1] / "examples/book/fig8_3_dyna_policies.yaml"
-    result = invoke("study", study, "--out", out, "-q")
-    assert result.exit_code == 0, result.output
+    out = _shipped_study(tmp_path, "fig8_3_dyna_policies")
     # the first episode whole, the second cut at half its length (104 and 38 uncut)
     lengths = {
         point: np.load(out / "points" / point / "curves.npz")["seed-000.lengths"].tolist()
@@ -516,12 +522,9 @@ def test_figure_8_3_dyna_q_stops_halfway_through_its_second_episode(tmp_path: Pa
     for point, steps in (("000", 160), ("001", 313)):  # the path of each: every step taken
         visits = np.load(out / "points" / point / "visits.npz")["seed-000"]
         assert visits.sum() == steps
-    rows = (out / "fig8_3_dyna_policies.csv").read_text(encoding="utf-8").splitlines()[1:]
-    arrows: dict[str, int] = {}
-    for row in rows:
-        panel, series, _, _, _, _, value = row.rsplit(",", 6)
-        if series == "greedy action (empty: all values equal)" and value:
-            arrows[panel.strip('"')] = arrows.get(panel.strip('"'), 0) + 1
+    arrows = {
+        panel: len(cells) for panel, cells in _grid_arrows(out / "fig8_3_dyna_policies.csv").items()
+    }
     assert arrows == {
         "planning_steps 0, max_env_steps 160, seed 0": 1,
         "planning_steps 50, max_env_steps 313, seed 0": 23,
