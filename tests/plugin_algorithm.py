@@ -17,7 +17,14 @@ import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param
 from cartpole_q.rl.algorithms import register
-from cartpole_q.rl.tabular import ENDED, epsilon_greedy, expected_value, update
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Rates,
+    Transition,
+    epsilon_greedy,
+    expected_value,
+    update,
+)
 
 
 def start(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any) -> int:
@@ -25,17 +32,18 @@ def start(q: Any, memory: Any, params: Any, state: int, epsilon: float, rng: Any
     return epsilon_greedy(q, state, params[0], rng)
 
 
-def step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Any) -> int:  # fmt: skip
+def step(q: Any, memory: Any, params: Any, transition: Transition, rates: Rates, rng: Any) -> int:
     """Target: the scheduled policy's expectation; behaviour: the fixed rate."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     counts = memory[0]
     counts[state] += 1
     target = reward
     if not terminated:
         target = reward + gamma * expected_value(q, next_state, epsilon)
     update(q, state, action, target, alpha / counts[state])
-    if terminated or truncated:
+    if terminated or transition.truncated:
         return ENDED
     return epsilon_greedy(q, next_state, params[0], rng)
 

@@ -12,15 +12,22 @@ import pytest
 from cartpole_q.engines.compile import jit
 from cartpole_q.rl import tabular
 from cartpole_q.rl.algorithms import double_q_learning, get
-from cartpole_q.rl.tabular import ENDED
+from cartpole_q.rl.tabular import ENDED, Rates, Transition
 
 VARIANTS = ["python", "compiled"]
 
 
-def learn_step(algorithm: str, variant: str, q, memory, *transition):  # type: ignore[no-untyped-def]
-    """The algorithm's step hook, as it is or compiled."""
+def learn_step(algorithm: str, variant: str, q, memory, *values):  # type: ignore[no-untyped-def]
+    """The algorithm's step hook, as it is or compiled, on one transition and its rates.
+
+    ``values``: state, action, reward, next state, terminated, truncated, alpha, gamma,
+    epsilon and the generator.
+    """
     step = get(algorithm).step
-    return (step if variant == "python" else jit(step))(q, memory, (0.0,), *transition)
+    transition, rates = Transition(*values[:6]), Rates(*values[6:9])
+    return (step if variant == "python" else jit(step))(
+        q, memory, (0.0,), transition, rates, values[9]
+    )
 
 
 def _tables() -> np.ndarray:

@@ -19,6 +19,7 @@ from cartpole_q import load_config, train
 from cartpole_q.config import ConfigError
 from cartpole_q.rl.algorithm import MemoryContext
 from cartpole_q.rl.algorithms import get, names
+from cartpole_q.rl.tabular import Rates, Transition
 from tests.conftest import invoke
 
 NEW = (
@@ -134,9 +135,8 @@ def _last_step(name: str, *, terminated: bool, truncated: bool, **params: Any) -
     q = np.zeros((3, 2))
     q[1] = (2.0, 4.0)
     rng = np.random.default_rng(0)
-    ended = algorithm.step(
-        q, memory, hook_params, 0, 0, 1.0, 1, terminated, truncated, 0.5, 0.9, 0.0, rng
-    )
+    last = Transition(0, 0, 1.0, 1, terminated, truncated)
+    ended = algorithm.step(q, memory, hook_params, last, Rates(0.5, 0.9, 0.0), rng)
     assert ended == -1
     return q
 
@@ -177,8 +177,9 @@ def test_monte_carlo_cuts_an_episode_at_its_record_length_as_a_time_limit() -> N
     q = np.zeros((2, 2))
     q[1] = (2.0, 4.0)
     rng = np.random.default_rng(0)
+    one_step = Transition(0, 0, 1.0, 1, False, False)
     actions = [
-        algorithm.step(q, memory, hook_params, 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, rng)
+        algorithm.step(q, memory, hook_params, one_step, Rates(0.5, 1.0, 0.0), rng)
         for _ in range(3)
     ]
     assert actions[:2] == [1, 1] and actions[2] == -1
@@ -220,8 +221,8 @@ def test_sparse_traces_give_the_dense_traces_results(
     dense_q, z = np.zeros((4, 2)), np.zeros((4, 2))
     rng = np.random.default_rng(0)
     for s, a, r, s2, terminated, truncated in transitions:
-        algorithm.step(q, memory, hook_params, s, a, r, s2, terminated, truncated, alpha, gamma,
-                       epsilon, rng)  # fmt: skip
+        algorithm.step(q, memory, hook_params, Transition(s, a, r, s2, terminated, truncated),
+                       Rates(alpha, gamma, epsilon), rng)  # fmt: skip
         a2 = int(np.argmax(dense_q[s2]))
         y = r if terminated else r + gamma * dense_q[s2, a2]
         delta = y - dense_q[s, a]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -17,6 +18,7 @@ from cartpole_q.config import ConfigError, load_config
 from cartpole_q.config.schema import AgentConfig
 from cartpole_q.rl.algorithm import Param
 from cartpole_q.rl.algorithms import RESERVED_KEYS, register
+from cartpole_q.rl.tabular import ENDED, epsilon_greedy, expected_value, update
 from cartpole_q.store.checkpoint import load_checkpoint, write_checkpoint
 from cartpole_q.training import Checkpoint, train
 from tests import plugin_algorithm
@@ -72,6 +74,37 @@ def test_it_trains_on_both_engines_to_the_same_bytes_and_resumes(
     assert resumed.q_table.tobytes() == whole.q_table.tobytes()
     assert resumed.visits.tobytes() == whole.visits.tobytes()
     assert resumed.returns.tobytes() == whole.returns.tobytes()
+
+
+def positional_step(q: Any, memory: Any, params: Any, state: int, action: int, reward: float,
+                    next_state: int, terminated: bool, truncated: bool, alpha: float,
+                    gamma: float, epsilon: float, rng: Any) -> int:  # fmt: skip
+    """The plug-in's ``step`` as a plug-in wrote it before hooks took named records."""
+    counts = memory[0]
+    counts[state] += 1
+    target = reward
+    if not terminated:
+        target = reward + gamma * expected_value(q, next_state, epsilon)
+    update(q, state, action, target, alpha / counts[state])
+    if terminated or truncated:
+        return ENDED
+    return epsilon_greedy(q, next_state, params[0], rng)
+
+
+def test_a_plugin_written_for_positional_hooks_still_trains_to_the_same_bytes() -> None:
+    """A ``step`` of 13 positional arguments is adapted (with a warning), not refused."""
+    name = "positional_" + NAME
+    with pytest.warns(DeprecationWarning, match=r"13 positional arguments.*CHANGELOG"):
+        adapted = register(
+            dataclasses.replace(plugin_algorithm.ALGORITHM, name=name, step=positional_step)
+        )
+    assert adapted.step is not positional_step
+    settings = {**SETTINGS, "engine": "gymnasium", "train.episodes": 30}
+    old = train(load_config(overrides={**settings, "agent.algorithm": name}), final_eval=False)
+    new = train(load_config(overrides=settings), final_eval=False)
+    assert old.q_table.tobytes() == new.q_table.tobytes()
+    assert old.returns.tobytes() == new.returns.tobytes()
+    assert old.env_steps > 30
 
 
 @pytest.mark.parametrize("key", sorted(RESERVED_KEYS))

@@ -40,6 +40,7 @@ from cartpole_q.rl.algorithms.prioritized_sweeping import (
     take_first,
 )
 from cartpole_q.rl.model import remember
+from cartpole_q.rl.tabular import Rates, Transition
 
 BASE: dict[str, Any] = {
     "env": {"id": "cartpole_q/DynaMaze-v0"},
@@ -167,8 +168,8 @@ def played(memory: tuple[np.ndarray, ...], q: np.ndarray, seed: int, steps: int)
         if rng.random() < 0.2:  # the outcome changes now and then (a stochastic world)
             following = int(rng.integers(0, 5))
         ended = following == 4
-        ps.step(q, memory, params, state, action, float(ended), following, ended, False, 0.5,
-                0.9, 0.1, rng)  # fmt: skip
+        transition = Transition(state, action, float(ended), following, ended, False)
+        ps.step(q, memory, params, transition, Rates(0.5, 0.9, 0.1), rng)
         state = 0 if ended else following
 
 

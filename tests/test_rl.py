@@ -20,7 +20,7 @@ from cartpole_q.rl import tabular
 from cartpole_q.rl.algorithms import q_learning
 from cartpole_q.rl.schedules import CONSTANT, EXPONENTIAL, LOG, smallest_positive_value
 from cartpole_q.rl.schedules import schedule_value as python_schedule_value
-from cartpole_q.rl.tabular import ENDED
+from cartpole_q.rl.tabular import ENDED, Rates, Transition
 
 VARIANTS = ["python", "compiled"]
 
@@ -34,12 +34,14 @@ def way(function, variant: str):  # type: ignore[no-untyped-def]
 def test_q_learning_picks_the_next_action_from_the_updated_table(variant: str) -> None:
     step = way(q_learning.step, variant)
     q = np.array([[0.0, 0.0], [0.0, 0.1]])
+    rates = Rates(1.0, 0.0, 0.0)
     action = step(
-        q, (), (0.0,), 1, 1, 1.0, 1, False, False, 1.0, 0.0, 0.0, np.random.default_rng(0)
+        q, (), (0.0,), Transition(1, 1, 1.0, 1, False, False), rates, np.random.default_rng(0)
     )
     # Q(1, 1) becomes 1.0 before the greedy choice in state 1
     assert action == 1 and q[1, 1] == 1.0
-    ended = step(q, (), (0.0,), 1, 1, 1.0, 1, False, True, 1.0, 0.0, 0.0, np.random.default_rng(0))
+    cut = Transition(1, 1, 1.0, 1, False, True)
+    ended = step(q, (), (0.0,), cut, rates, np.random.default_rng(0))
     assert ended == ENDED  # truncated: the episode ended, no next action is drawn
 
 

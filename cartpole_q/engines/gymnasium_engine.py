@@ -30,7 +30,7 @@ from cartpole_q.envs.gym import info_value, make_env, set_physics
 from cartpole_q.numba_cache import configure as configure_numba_cache
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.prediction import value_error
-from cartpole_q.rl.tabular import ENDED, no_episode_end, visit
+from cartpole_q.rl.tabular import ENDED, Rates, Transition, no_episode_end, visit
 
 configure_numba_cache()  # before any cache=True function is defined
 
@@ -57,19 +57,18 @@ def next_step(
     """Learn from one step; the next row and the next action (or ``ENDED``)."""
     row = OBSERVATION_STATE(context.q, observation, context.grid, state)
     visit(context.visits, context.q, state, action)
+    transition = Transition(state, action, reward, row, terminated, truncated)
+    rates = Rates(STEP_SIZE(alpha, context.memory), context.gamma, epsilon)
     chosen = ALGORITHM_STEP(
-        context.q, context.memory, context.params, state, action, reward, row, terminated,
-        truncated, STEP_SIZE(alpha, context.memory), context.gamma, epsilon, context.rng,
-    )  # fmt: skip
+        context.q, context.memory, context.params, transition, rates, context.rng
+    )
     return row, chosen
 
 
 def end_episode(context: Any, alpha: float, epsilon: float) -> None:
     """Finish an episode (the algorithm's ``end``)."""
-    step_size = STEP_SIZE(alpha, context.memory)
-    ALGORITHM_END(
-        context.q, context.memory, context.params, step_size, context.gamma, epsilon, context.rng
-    )
+    rates = Rates(STEP_SIZE(alpha, context.memory), context.gamma, epsilon)
+    ALGORITHM_END(context.q, context.memory, context.params, rates, context.rng)
 
 
 @functools.cache

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -41,6 +41,7 @@ from cartpole_q.engines.base import (
     AgentRecord,
     EpisodeMetrics,
     Grid,
+    Tables,
     Truth,
     kernel_name,
     pair_name,
@@ -52,7 +53,7 @@ from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.prediction import value_error
 from cartpole_q.rl.schedules import schedule_value
 from cartpole_q.rl.solve import SOLVE_WINDOW
-from cartpole_q.rl.tabular import ENDED, best_action, compilable, visit
+from cartpole_q.rl.tabular import ENDED, Rates, Transition, best_action, compilable, visit
 
 # Placeholders, bound per (algorithm, twin) by specialise(); never called as they are.
 ALGORITHM_START: Any = None
@@ -125,25 +126,81 @@ def record_episode(
     metrics.alphas[episode] = alpha
 
 
+class Generators(NamedTuple):
+    """A run's three random generators, as the training loop takes them."""
+
+    agent: np.random.Generator
+    """exploration, and the algorithm's own draws"""
+    env: np.random.Generator
+    """the twin's resets, and the steps of a world that draws"""
+    physics: np.random.Generator
+    """the draws of ``env.randomize``"""
+
+
+class TwinEnv(NamedTuple):
+    """The twin as the loops take it: its time limit, scratch arrays and parameters.
+
+    ``state`` and ``observation`` are the twin's scratch arrays, which every reset
+    overwrites: made by the caller, so that no compiled loop compiles numba's array
+    allocation.
+    """
+
+    max_steps: int
+    """the episode's time limit (no time limit: the largest int64)"""
+    state: np.ndarray
+    observation: np.ndarray
+    params: Any
+    """the twin's parameters (its physics)"""
+    randomize: tuple[np.ndarray, np.ndarray, np.ndarray]
+    """``(keys, lows, highs)`` of ``env.randomize`` (empty arrays: none)"""
+
+
+class Turn(NamedTuple):
+    """One loop's turn: the episodes it may play, and what ends it early."""
+
+    start: int
+    """the first episode (0-based) to train"""
+    stop: int
+    """train up to this episode, excluded"""
+    check_solved: bool
+    """stop right after the first solving episode"""
+    plays_greedy: bool
+    """the exploring copy plays the greedy episodes too (the greedy copy ignores it)"""
+
+
+class Measure(NamedTuple):
+    """A prediction run's true values, and where each episode's RMS error of ``V`` goes."""
+
+    truth: Truth
+    """when it measures any state, each episode's error goes to ``errors``"""
+    errors: np.ndarray
+    """per-episode errors, at the episode's index (empty when nothing is measured)"""
+
+
 def twin_episode(
-    q: Any, visits: np.ndarray, memory: Any, params: Any, low: np.ndarray,
-    high: np.ndarray, bins: np.ndarray, starts: np.ndarray, gamma: float, alpha: float,
-    epsilon: float, rng: np.random.Generator, env_rng: np.random.Generator, env_params: Any,
-    max_steps: int, env_state: np.ndarray, observation: np.ndarray,
+    tables: Tables, params: Any, grid: Grid, rates: Rates, generators: Generators,
+    env: TwinEnv,
 ) -> tuple[float, int]:  # fmt: skip
     """Reset the twin, then play and learn one episode; return its return and length.
 
-    The arrays come unpacked: reading a record's array inside the loop would cost two
+    ``rates.alpha`` is the episode's value of the schedule (the hooks get the step size
+    :data:`STEP_SIZE` makes of it) and ``env.max_steps`` the episode's time limit. The
+    records are unpacked before the loop: reading a record's array inside it would cost two
     atomic reference-count updates per step. In the copy compiled with ``GREEDY`` bound to
     True, epsilon is the constant 0: the compiler removes the generator calls that greedy
     steps would skip anyway (a third faster).
     """
+    q, visits, memory = tables.q, tables.visits, tables.memory
+    low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
+    rng, env_rng = generators.agent, generators.env
+    env_state, observation, env_params = env.state, env.observation, env.params
+    max_steps, epsilon = env.max_steps, rates.epsilon
     if GREEDY:
         epsilon = 0.0
     TWIN_RESET(env_state, observation, env_rng, env_params)
     state = OBSERVATION_STATE(q, observation, low, high, bins, starts, -1)
     action = ALGORITHM_START(q, memory, params, state, epsilon, rng)
-    step_size = STEP_SIZE(alpha, memory)
+    step_rates = Rates(STEP_SIZE(rates.alpha, memory), rates.gamma, epsilon)
     episode_return, length = 0.0, 0
     while action != ENDED:
         reward, terminated = TWIN_STEP(env_state, action, observation, env_rng, env_params)
@@ -151,67 +208,49 @@ def twin_episode(
         episode_return += reward
         next_state = OBSERVATION_STATE(q, observation, low, high, bins, starts, state)
         visit(visits, q, state, action)
-        action = ALGORITHM_STEP(
-            q, memory, params, state, action, reward, next_state, terminated,
-            length >= max_steps, step_size, gamma, epsilon, rng,
-        )  # fmt: skip
+        transition = Transition(state, action, reward, next_state, terminated, length >= max_steps)
+        action = ALGORITHM_STEP(q, memory, params, transition, step_rates, rng)
         state = next_state
-    ALGORITHM_END(q, memory, params, step_size, gamma, epsilon, rng)
+    ALGORITHM_END(q, memory, params, step_rates, rng)
     return episode_return, length
 
 
 def train_episodes(
-    q: Any, visits: np.ndarray, memory: Any, params: Any, grid: Grid, agent: AgentRecord,
-    metrics: EpisodeMetrics, agent_rng: np.random.Generator, env_rng: np.random.Generator,
-    env: Any, start: int, stop: int, check_solved: bool, physics_rng: np.random.Generator,
-    randomize: tuple[np.ndarray, np.ndarray, np.ndarray], truth: Truth, errors: np.ndarray,
-    plays_greedy: bool,
+    tables: Tables, params: Any, grid: Grid, agent: AgentRecord, metrics: EpisodeMetrics,
+    generators: Generators, env: TwinEnv, turn: Turn, measure: Measure,
 ) -> tuple[int, int, int]:  # fmt: skip
-    """Train episodes ``start .. stop - 1`` on the twin, up to the first that is the other loop's.
+    """Train episodes ``turn.start .. turn.stop - 1`` on the twin, up to the first that is the other loop's.
 
     The exploring copy (``GREEDY`` False) plays the episodes whose epsilon is positive and
-    returns at the first whose epsilon is not, unless ``plays_greedy``: then it plays those
-    too, with epsilon 0. The greedy copy plays the episodes whose epsilon is not positive
-    and returns at the first that is (see the module docstring). An episode handed back is
-    untouched: nothing of it is drawn.
+    returns at the first whose epsilon is not, unless ``turn.plays_greedy``: then it plays
+    those too, with epsilon 0. The greedy copy plays the episodes whose epsilon is not
+    positive and returns at the first that is (see the module docstring). An episode handed
+    back is untouched: nothing of it is drawn.
 
     Args:
-        q: the learned table as ``(n_states, n_actions)``, updated in place (on tiles the
-            pair ``(weights, features)``: see :mod:`cartpole_q.rl.tiles`).
-        visits: how often each (state, action) was taken, updated in place.
-        memory: the algorithm's memory (a tuple of arrays), updated in place.
+        tables: the learned table as ``(n_states, n_actions)``, updated in place (on tiles
+            the pair ``(weights, features)``: see :mod:`cartpole_q.rl.tiles`); how often
+            each (state, action) was taken, and the algorithm's memory (a tuple of arrays),
+            both updated in place.
         params: the algorithm's parameters (a tuple of floats).
         grid: the binning grid.
         agent: the hyperparameters and the solve threshold.
         metrics: per-episode metrics, written at each episode's index.
-        agent_rng: the agent's generator (exploration, and the algorithm's own draws).
-        env_rng: the twin's generator (resets, and the steps of a world that draws).
-        env: ``(max_episode_steps, state, observation, params)`` of the twin (no time
-            limit: the largest int64; ``state`` and ``observation`` are the twin's scratch
-            arrays, which every reset overwrites: made by the caller, so that no compiled
-            loop compiles numba's array allocation).
-        start: the first episode (0-based) to train.
-        stop: train up to this episode, excluded.
-        check_solved: stop right after the first solving episode.
-        physics_rng: the generator of ``env.randomize``'s draws.
-        randomize: ``(keys, lows, highs)`` of ``env.randomize`` (empty arrays: none).
-        truth: a prediction run's true values; when it measures any, each episode's RMS
-            error of ``V`` goes to ``errors`` at the episode's index.
-        errors: per-episode errors (empty when nothing is measured).
-        plays_greedy: the exploring copy plays the greedy episodes too (the greedy copy
-            ignores it).
+        generators: the agent's, the twin's and ``env.randomize``'s generators.
+        env: the twin (see :class:`TwinEnv`).
+        turn: the episodes this turn may play (see :class:`Turn`).
+        measure: a prediction run's true values and its errors (see :class:`Measure`).
 
     Returns:
         ``(episodes finished, env steps taken, 0-based solve episode or -1)``; stops
-        right after the solve episode when ``check_solved``, right after the episode that
-        reaches ``agent.max_env_steps`` (cut there: its time limit is the steps left), and
-        before an episode that is the other loop's (then ``episodes finished < stop`` and
-        no solve).
+        right after the solve episode when ``turn.check_solved``, right after the episode
+        that reaches ``agent.max_env_steps`` (cut there: its time limit is the steps left),
+        and before an episode that is the other loop's (then ``episodes finished <
+        turn.stop`` and no solve).
     """
-    max_steps, env_state, observation, base_params = env
-    keys, lows, highs = randomize
-    low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
-    gamma = agent.gamma
+    keys, lows, highs = env.randomize
+    truth, errors = measure.truth, measure.errors
+    start, stop, plays_greedy = turn.start, turn.stop, turn.plays_greedy
     env_steps = 0
     steps_left = agent.max_env_steps  # (the steps of episodes before start: their lengths)
     if steps_left < NO_STEP_LIMIT:
@@ -222,20 +261,19 @@ def train_episodes(
         explores = epsilon > 0.0  # (NaN: a greedy episode)
         if explores == GREEDY and (GREEDY or not plays_greedy):  # the other loop's episode
             return episode, env_steps, -1
-        env_params = base_params
+        env_params = env.params
         if RANDOMIZED:  # compiled in only where env.randomize draws physics
-            env_params = TWIN_RANDOMIZE(base_params, physics_rng, keys, lows, highs)
-        limit = min(max_steps, steps_left - env_steps)
+            env_params = TWIN_RANDOMIZE(env.params, generators.physics, keys, lows, highs)
+        limit = min(env.max_steps, steps_left - env_steps)
         episode_return, length = EPISODE(
-            q, visits, memory, params, low, high, bins, starts, gamma, alpha,
-            epsilon if explores else 0.0, agent_rng, env_rng, env_params, limit,
-            env_state, observation,
+            tables, params, grid, Rates(alpha, agent.gamma, epsilon if explores else 0.0),
+            generators, TwinEnv(limit, env.state, env.observation, env_params, env.randomize),
         )  # fmt: skip
         record_episode(metrics, episode, episode_return, length, epsilon, alpha)
         if truth.rows.shape[0] > 0:
-            errors[episode] = value_error(q, truth.rows, truth.values)
+            errors[episode] = value_error(tables.q, truth.rows, truth.values)
         env_steps += length
-        if check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
+        if turn.check_solved and reaches_threshold(metrics.returns, episode, agent.threshold):
             return episode + 1, env_steps, episode
         if env_steps >= steps_left:
             return episode + 1, env_steps, -1
@@ -243,14 +281,19 @@ def train_episodes(
 
 
 def greedy_returns(
-    q: Any, grid: Grid, env_rng: np.random.Generator, env: Any, returns: np.ndarray
+    q: Any, grid: Grid, env_rng: np.random.Generator, env: TwinEnv, returns: np.ndarray
 ) -> np.ndarray:
     """The greedy policy's return in each of ``len(returns)`` twin episodes, into ``returns``.
 
     ``returns`` comes in zeroed; ``env`` as :func:`train_episodes` takes it, with the greedy
     step cap as the time limit of an environment that has none.
     """
-    max_steps, env_state, observation, params = env
+    max_steps, env_state, observation, params = (
+        env.max_steps,
+        env.state,
+        env.observation,
+        env.params,
+    )
     low, high, bins, starts = grid.low, grid.high, grid.bins, grid.starts
     for episode in range(returns.shape[0]):
         TWIN_RESET(env_state, observation, env_rng, params)

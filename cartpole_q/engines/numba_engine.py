@@ -17,12 +17,20 @@ from gymnasium.utils import seeding
 
 from cartpole_q.engines.base import (
     AgentParams,
+    Tables,
     TrainingState,
     exploring_plays_greedy,
     loops_played,
     played_until_stopped,
 )
-from cartpole_q.engines.kernel import greedy_kernel, training_kernel
+from cartpole_q.engines.kernel import (
+    Generators,
+    Measure,
+    Turn,
+    TwinEnv,
+    greedy_kernel,
+    training_kernel,
+)
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.envs.registry import TwinSettings
 from cartpole_q.families import profile_for
@@ -70,29 +78,26 @@ class NumbaEngine:
         )
         self._greedy_returns = greedy_kernel(settings.twin, params.tiled)
         limit = settings.max_episode_steps
-        self._env = (
-            NO_TIME_LIMIT if limit is None else limit,
-            *_scratch(settings),
-            settings.params,
-        )
-        # Greedy play stops at the step cap where the environment has no time limit, as
-        # the gymnasium engine's evaluations do (a greedy policy may walk in circles). Its
-        # own scratch arrays: an evaluation may come between two turns of training.
-        self._greedy_env = (
-            GREEDY_STEP_CAP if limit is None else limit,
-            *_scratch(settings),
-            settings.params,
-        )
-        self._params = params
-        self._hook_tables: tuple[Any, Any] = (None, None)  # (q, the hooks' view of it)
         ranges = randomize or {}
         physics = profile_for(settings.twin.env_ids[0]).physics
         drawn = physics.randomizable if physics is not None else ()
-        self._randomize = (
+        draws = (
             np.array([drawn.index(key) for key in ranges], dtype=np.int64),
             np.array([low for low, _ in ranges.values()], dtype=np.float64),
             np.array([high for _, high in ranges.values()], dtype=np.float64),
         )
+        self._env = TwinEnv(
+            NO_TIME_LIMIT if limit is None else limit, *_scratch(settings), settings.params, draws
+        )
+        # Greedy play stops at the step cap where the environment has no time limit, as
+        # the gymnasium engine's evaluations do (a greedy policy may walk in circles). Its
+        # own scratch arrays: an evaluation may come between two turns of training.
+        self._greedy_env = TwinEnv(
+            GREEDY_STEP_CAP if limit is None else limit, *_scratch(settings), settings.params,
+            draws,
+        )  # fmt: skip
+        self._params = params
+        self._hook_tables: tuple[Any, Any] = (None, None)  # (q, the hooks' view of it)
         # Seeded exactly as Gymnasium seeds env.np_random at reset(seed=env_seed).
         self._env_rng: np.random.Generator = seeding.np_random(env_seed)[0]
         if env_rng_state is not None:
@@ -136,9 +141,10 @@ class NumbaEngine:
         _, loop = self._kernel.loop(greedy)
         errors = _NO_ERRORS if state.errors is None else state.errors
         finished, env_steps, solved = loop(
-            self._hook_table(q), visits, memory, p.params, p.grid, p.agent, state.metrics, state.agent_rng,
-            self._env_rng, self._env, state.episode, stop, check_solved, state.physics_rng,
-            self._randomize, p.truth, errors, bool(self._exploring_alone),
+            Tables(self._hook_table(q), visits, memory), p.params, p.grid, p.agent,
+            state.metrics, Generators(state.agent_rng, self._env_rng, state.physics_rng),
+            self._env, Turn(state.episode, stop, check_solved, bool(self._exploring_alone)),
+            Measure(p.truth, errors),
         )  # fmt: skip
         state.episode = finished
         state.env_steps += env_steps

@@ -55,14 +55,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from cartpole_q.engines.compile import specialise
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms.dyna_q import PLANNING_STEPS_AT
-from cartpole_q.rl.tabular import ENDED, best_action, compilable
+from cartpole_q.rl.tabular import ENDED, Rates, Transition, best_action, compilable
 
 ALGORITHM_START: Any = None
 ALGORITHM_STEP: Any = None
@@ -131,18 +131,42 @@ def chunk_steps(planning_steps: int) -> int:
     return max(1, CHUNK_UPDATES // (1 + planning_steps))
 
 
+class MazeRecord(NamedTuple):
+    """A :class:`Maze`'s arrays and start, as the compiled loop takes them."""
+
+    next_states: np.ndarray
+    rewards: np.ndarray
+    terminals: np.ndarray
+    start: int
+
+
+class Limits(NamedTuple):
+    """When a run's episodes are cut and when the run stops (see :class:`Settings`)."""
+
+    most: int
+    """the greedy path counts as optimal at this many steps or fewer"""
+    limit: int
+    """an episode is truncated after this many steps"""
+    max_updates: int
+    """give up after the episode in which this many updates are made"""
+    max_steps: int
+    """give up after the episode in which this many real steps are taken in all"""
+
+
 def run_until_optimal(
-    q: Any, memory: Any, params: Any, next_states: np.ndarray, rewards: np.ndarray,
-    terminals: np.ndarray, start: int, most: int, limit: int, max_updates: int,
-    max_steps: int, alpha: float, gamma: float, epsilon: float, rng: np.random.Generator,
-    carry: np.ndarray, budget: int,
+    q: Any, memory: Any, params: Any, maze: MazeRecord, limits: Limits, rates: Rates,
+    rng: np.random.Generator, carry: np.ndarray, budget: int,
 ) -> int:  # fmt: skip
     """At most ``budget`` more real steps of a run from ``carry``; ``RUNNING``, ``REACHED`` or ``GAVE_UP``.
 
-    Episodes until the greedy path reaches the goal in at most ``most`` steps. A chunk may
-    end inside an episode: ``carry`` keeps where (the next chunk goes on with the same
-    draws, as if never paused), and ``carry[UPDATES]`` the updates made so far.
+    Episodes until the greedy path reaches the goal in at most ``limits.most`` steps. A
+    chunk may end inside an episode: ``carry`` keeps where (the next chunk goes on with the
+    same draws, as if never paused), and ``carry[UPDATES]`` the updates made so far.
     """
+    # Unpacked before the loop: reading a record's array inside it costs reference counts.
+    next_states, rewards, terminals = maze.next_states, maze.rewards, maze.terminals
+    start, most, limit = maze.start, limits.most, limits.limit
+    max_updates, max_steps, epsilon = limits.max_updates, limits.max_steps, rates.epsilon
     n_actions = q.shape[1]
     state, action, length = carry[STATE], carry[ACTION], carry[LENGTH]
     steps, episodes = carry[STEPS], carry[EPISODES]
@@ -162,12 +186,12 @@ def run_until_optimal(
             next_state = next_states[flat]
             length += 1
             taken += 1
-            action = ALGORITHM_STEP(
-                q, memory, params, state, action, rewards[flat], next_state,
-                terminals[flat] != 0, length >= limit, alpha, gamma, epsilon, rng,
-            )  # fmt: skip
+            transition = Transition(
+                state, action, rewards[flat], next_state, terminals[flat] != 0, length >= limit
+            )
+            action = ALGORITHM_STEP(q, memory, params, transition, rates, rng)
             state = next_state
-        ALGORITHM_END(q, memory, params, alpha, gamma, epsilon, rng)
+        ALGORITHM_END(q, memory, params, rates, rng)
         carry[IN_EPISODE] = 0
         steps += length
         episodes += 1
@@ -315,9 +339,10 @@ def until_optimal(
     rng = np.random.default_rng(seed)
     carry = np.zeros(CARRY_SLOTS, dtype=np.int64)
     arguments = (
-        q, memory, params, maze.next_states, maze.rewards, maze.terminals, maze.start,
-        settings.longest_path(maze.shortest), settings.limit, settings.max_updates,
-        settings.max_steps, settings.alpha, settings.gamma, settings.epsilon, rng, carry,
+        q, memory, params, MazeRecord(maze.next_states, maze.rewards, maze.terminals, maze.start),
+        Limits(settings.longest_path(maze.shortest), settings.limit, settings.max_updates,
+               settings.max_steps),
+        Rates(settings.alpha, settings.gamma, settings.epsilon), rng, carry,
         chunk_steps(settings.planning_steps),
     )  # fmt: skip
     if compiled:

@@ -7,15 +7,16 @@ learned model), and its hooks, plain functions the engines compile with numba:
 
 - ``start(q, memory, params, state, epsilon, rng) -> action``: an episode begins in
   ``state``; return its first action (default: epsilon-greedy on ``Q``);
-- ``step(q, memory, params, state, action, reward, next_state, terminated, truncated, alpha,
-  gamma, epsilon, rng) -> next action or ENDED``: learn from one transition; return the next
+- ``step(q, memory, params, transition, rates, rng) -> next action or ENDED``: learn from
+  one transition (a :class:`~cartpole_q.rl.tabular.Transition`: ``state``, ``action``,
+  ``reward``, ``next_state``, ``terminated``, ``truncated``) at the episode's
+  :class:`~cartpole_q.rl.tabular.Rates` (``alpha``, ``gamma``, ``epsilon``); return the next
   action, or :data:`~cartpole_q.rl.tabular.ENDED` when the episode ended;
-- ``end(q, memory, params, alpha, gamma, epsilon, rng)``: the episode has ended (default:
-  nothing).
+- ``end(q, memory, params, rates, rng)``: the episode has ended (default: nothing).
 
 ``q`` is the learned table as 2-D ``(n_states, n_actions)``; ``memory`` the tuple of arrays
 :attr:`Algorithm.memory` allocated (under ``agent.alpha: sample_average`` followed by the
-table of update counts, which is also what ``alpha`` then is: see
+table of update counts, which is also what ``rates.alpha`` then is: see
 :func:`~cartpole_q.rl.tabular.averaged_update`); ``params`` the algorithm's parameters as a tuple of
 floats in :attr:`Algorithm.params` order. The training loop counts ``visits[s, a] += 1``
 before every step, for every algorithm. :attr:`Algorithm.policy` says which table

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from cartpole_q.rl.algorithm import Param
-from cartpole_q.rl.tabular import Table, compilable, update, value
+from cartpole_q.rl.tabular import Rates, Table, compilable, update, value
 
 N = Param(
     "n", 4, "the number of rewards before bootstrapping (1: the one-step method)",
@@ -69,10 +69,10 @@ def oldest_is_due(counter: np.ndarray, n: int, ended: bool) -> bool:
 @compilable
 def settle_oldest(
     q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
-    counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, alpha: float,
-    gamma: float,
+    counter: np.ndarray, next_state: int, next_action: int, bootstrap: bool, rates: Rates,
 ) -> None:  # fmt: skip
     """Update the oldest pending step toward its return, and remove it from the queue."""
+    alpha, gamma = rates.alpha, rates.gamma
     n = states.shape[0]
     pending = counter[1]
     oldest = slot(counter, n, 0)

@@ -31,7 +31,7 @@ decides, then ``rng.integers(0, n_actions)`` when exploring.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 
@@ -50,6 +50,40 @@ TIE_BREAKS = ("lowest", "random")
 """``agent.tie_break``: which of equally valued best actions epsilon-greedy exploits"""
 RANDOM_TIES = 1.0
 """``agent.tie_break: random`` as the hooks get it (the last of their parameters)"""
+
+
+class Transition(NamedTuple):
+    """One step of an episode, as an algorithm's ``step`` hook gets it.
+
+    A named record, not six positional arguments: numba compiles it as a tuple that the
+    inlined hook reads field by field, which costs nothing at run time.
+    """
+
+    state: int
+    """the row the action was taken in"""
+    action: int
+    """the action taken"""
+    reward: float
+    """the reward of the step"""
+    next_state: int
+    """the row of the observation after it"""
+    terminated: bool
+    """the episode ended in a terminal state (no bootstrap)"""
+    truncated: bool
+    """the episode was cut by its time limit (a step that is only truncated bootstraps)"""
+
+
+class Rates(NamedTuple):
+    """The episode's step size, discount and exploration, as the ``step`` and ``end`` hooks get them."""
+
+    alpha: Any
+    """the step size (a float); under ``agent.alpha: sample_average`` the table of update
+    counts (see :func:`averaged_update`)"""
+    gamma: float
+    """the discount"""
+    epsilon: float
+    """the episode's exploration rate"""
+
 
 Function = TypeVar("Function", bound=Callable[..., Any])
 
@@ -319,7 +353,5 @@ def first_action(
 
 
 @compilable
-def no_episode_end(
-    q: Table, memory: Memory, params: Params, alpha: float, gamma: float, epsilon: float, rng: Rng
-) -> None:
+def no_episode_end(q: Table, memory: Memory, params: Params, rates: Rates, rng: Rng) -> None:
     """The default end of an episode: nothing (one-step methods learn as they go)."""

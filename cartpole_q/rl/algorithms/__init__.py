@@ -11,7 +11,10 @@ from __future__ import annotations
 
 import hashlib
 import inspect
+import types
+import warnings
 from collections.abc import Iterator
+from typing import Any
 
 from cartpole_q.rl.algorithm import Algorithm
 from cartpole_q.rl.algorithms import (
@@ -40,6 +43,7 @@ from cartpole_q.rl.algorithms import (
     true_online_td_lambda,
     watkins_q_lambda,
 )
+from cartpole_q.rl.tabular import Memory, Params, Rates, Rng, Table, Transition, compilable
 
 PACKAGE = (
     q_learning, sarsa, expected_sarsa, double_q_learning, n_step_sarsa, n_step_tree_backup,
@@ -90,7 +94,7 @@ def register(algorithm: Algorithm) -> Algorithm:
             f"algorithm {algorithm.name!r}: a prediction algorithm declares agent.policy "
             "(cartpole_q.rl.prediction.POLICY) as its first parameter"
         )
-    keyed = _with_key(algorithm)
+    keyed = _named_record_hooks(_with_key(algorithm))
     existing = _REGISTRY.get(algorithm.name)
     if existing is not None and existing.step.__module__ != algorithm.step.__module__:
         raise ValueError(f"an algorithm named {algorithm.name!r} is registered already")
@@ -109,6 +113,69 @@ def _with_key(algorithm: Algorithm) -> Algorithm:
         source = algorithm.name
     digest = hashlib.sha256(source.encode()).hexdigest()[:12]
     return replace(algorithm, key=f"{algorithm.name}_{digest}")
+
+
+POSITIONAL_STEP: Any = None
+"""bound to a plug-in's ``step`` written for the positional hooks (see :func:`positional_step`)"""
+POSITIONAL_END: Any = None
+"""bound to a plug-in's ``end`` written for the positional hooks (see :func:`positional_end`)"""
+
+
+def positional_step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
+    """A ``step`` written for the positional hooks (13 arguments), called as the records' one."""
+    t = transition
+    return POSITIONAL_STEP(  # type: ignore[no-any-return]
+        q, memory, params, t.state, t.action, t.reward, t.next_state, t.terminated,
+        t.truncated, rates.alpha, rates.gamma, rates.epsilon, rng,
+    )  # fmt: skip
+
+
+def positional_end(q: Table, memory: Memory, params: Params, rates: Rates, rng: Rng) -> None:
+    """An ``end`` written for the positional hooks (7 arguments), called as the records' one."""
+    POSITIONAL_END(q, memory, params, rates.alpha, rates.gamma, rates.epsilon, rng)
+
+
+POSITIONAL_ARGUMENTS = {"step": 13, "end": 7}
+"""how many arguments the hooks took before they took named records (version 0.x)"""
+
+
+def _named_record_hooks(algorithm: Algorithm) -> Algorithm:
+    """The algorithm with hooks that take named records, adapting a plug-in's positional ones.
+
+    Hooks take a :class:`~cartpole_q.rl.tabular.Transition` and
+    :class:`~cartpole_q.rl.tabular.Rates` since 0.x; a plug-in's ``step`` (or ``end``)
+    written for the 13 (7) positional arguments before still runs, through an adapter
+    compiled with it (numba inlines both: nothing is lost at run time), with a
+    ``DeprecationWarning``. The CHANGELOG says how to update one.
+    """
+    from dataclasses import replace
+
+    adapted: dict[str, Any] = {}
+    for hook, template, placeholder in (
+        ("step", positional_step, "POSITIONAL_STEP"),
+        ("end", positional_end, "POSITIONAL_END"),
+    ):
+        function = getattr(algorithm, hook)
+        try:
+            arguments = len(inspect.signature(function).parameters)
+        except (TypeError, ValueError):  # (a compiled dispatcher: taken as it is)
+            continue
+        if arguments != POSITIONAL_ARGUMENTS[hook]:
+            continue
+        warnings.warn(
+            f"algorithm {algorithm.name!r}: its {hook} hook takes the {arguments} positional "
+            f"arguments of before; hooks now take named records ({hook}(q, memory, params, "
+            f"{'transition, ' if hook == 'step' else ''}rates, rng)): see the CHANGELOG",
+            DeprecationWarning,
+            stacklevel=3,
+        )
+        namespace = {**template.__globals__, placeholder: compilable(function)}
+        wrapper = types.FunctionType(template.__code__, namespace, template.__name__)
+        wrapper.__module__ = function.__module__
+        adapted[hook] = compilable(wrapper)
+    return replace(algorithm, **adapted) if adapted else algorithm
 
 
 def get(name: str) -> Algorithm:

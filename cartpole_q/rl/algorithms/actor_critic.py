@@ -17,8 +17,8 @@ contract: docs/algorithms.md.
 >>> q = np.zeros((2, 2))
 >>> memory = actor_critic_memory(2, 2)
 >>> first = start(q, memory, (0.1, 0.0, 0.0, 0.0), 0, 0.0, np.random.default_rng(0))
->>> step(q, memory, (0.1, 0.0, 0.0, 0.0), 0, first, 1.0, 1, True, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (0.1, 0.0, 0.0, 0.0), Transition(0, first, 1.0, 1, True, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 -1
 >>> first, float(memory[0][0, 0]), q[0].tolist()  # v(0) = 0.1 * 1; theta(0, 1) by 0.5 * (1 - 0.5)
 (1, 0.1, [-0.25, 0.25])
@@ -31,7 +31,17 @@ import math
 import numpy as np
 
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, action_count, compilable
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rates,
+    Rng,
+    Table,
+    Transition,
+    action_count,
+    compilable,
+)
 from cartpole_q.rl.traces import apply_and_decay, apply_traces, clear_traces, trace_slot
 
 ALPHA_W = Param("alpha_w", 0.1, "the critic's step size alpha^w", low=0.0, low_open=True)
@@ -91,10 +101,14 @@ def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, 
 
 
 @compilable
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """The traces, then ``v`` and ``θ`` by ``δ``; the next action from ``π(· | s')``."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     v, discount, chances = memory[CRITIC], memory[DISCOUNT], memory[CHANCES]
     w_values, w_states, w_actions, w_slots, w_count = memory[3], memory[4], memory[5], memory[6], memory[7]  # fmt: skip
     t_values, t_states, t_actions, t_slots, t_count = memory[8], memory[9], memory[10], memory[11], memory[12]  # fmt: skip

@@ -16,9 +16,10 @@ sum to the episode's end, ``w = gamma ** (steps to the end)`` when a time limit 
 >>> memory = batch_memory(context)
 >>> rng = np.random.default_rng(0)
 >>> params = (0.0, 0.0, 1e-9, 100000.0)  # policy random, target td, tolerance, max_passes
->>> step(v, memory, params, 0, 0, 0.0, 1, False, False, 0.1, 1.0, 0.0, rng) in (0, 1)
+>>> step(v, memory, params, Transition(0, 0, 0.0, 1, False, False),
+...     Rates(0.1, 1.0, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, params, 1, 0, 1.0, 2, True, False, 0.1, 1.0, 0.0, rng)
+>>> step(v, memory, params, Transition(1, 0, 1.0, 2, True, False), Rates(0.1, 1.0, 0.0), rng)
 -1
 >>> [round(float(x), 6) for x in v[:, 0]]  # converged: V(1) = 1, V(0) = V(1); 2 is terminal
 [1.0, 1.0, 0.5]
@@ -38,16 +39,19 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rates, Rng, Table, Transition, shift, value
 
 TARGETS = ("td", "mc")
 """``agent.target`` values, in the order of their codes"""
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Keep the transition; at the episode's end, learn from the whole batch until it settles."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     policy, states, targets, bootstraps, weights = (
         memory[0],
         memory[1],

@@ -10,7 +10,8 @@ action, an episode's first included, is epsilon-greedy on ``A + B``. ``q_table.n
 
 >>> import numpy as np
 >>> a, b = np.zeros((2, 2)), np.array([[0.0, 0.0], [1.0, 3.0]])
->>> step(a, (b,), (0.0,), 0, 0, 1.0, 1, False, False, 1.0, 1.0, 0.0, np.random.default_rng(2))
+>>> step(a, (b,), (0.0,), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(1.0, 1.0, 0.0), np.random.default_rng(2))
 1
 >>> float(a[0, 0]), float(b[0, 0])  # the coin picked A: 1 + B(1, argmax A(1, .) = 0) = 2
 (2.0, 0.0)
@@ -25,8 +26,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     averaged_variant,
     best_action,
@@ -100,10 +103,14 @@ def start(q: Table, memory: Memory, params: Params, state: int, epsilon: float, 
     return epsilon_greedy_on_sum(q, with_weights(q, memory[0]), params, state, epsilon, rng)
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """A coin picks the table to update; the other one values the updated one's choice."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     q_b = with_weights(q, memory[0])
     # Two explicit branches rather than swapped names: an array alias costs reference
     # counting on every step.

@@ -9,7 +9,8 @@ remembered transition; the next action is drawn from the table after planning. W
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> memory = dyna_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (3.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+>>> step(q, memory, (3.0, 0.0), Transition(0, 1, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 0
 >>> float(q[0, 1])  # once for real, three times from the model: 1 - 0.5 ** 4
 0.9375
@@ -32,8 +33,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     best_value,
@@ -41,10 +44,14 @@ from cartpole_q.rl.tabular import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Learn from the real step, remember it, plan, then draw the next action."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     target = reward
     if not terminated:
         target = reward + gamma * best_value(q, next_state)

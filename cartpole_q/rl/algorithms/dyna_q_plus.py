@@ -9,8 +9,8 @@ contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> memory = dyna_plus_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (0.0, 0.1, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (0.0, 0.1, 0.0), Transition(0, 1, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 0
 >>> float(q[0, 1]), int(memory[6][1]), int(memory[7][1])
 (0.5, 1, 1)
@@ -34,8 +34,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     best_value,
@@ -69,10 +71,14 @@ def plan_with_bonus(
         update(q, state, action, target, alpha)
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Count the step, learn from it, remember it, plan with bonuses, then draw."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     n_actions = action_count(q)
     counters, last_tried = memory[6], memory[7]
     counters[1] += 1

@@ -6,7 +6,8 @@ terminated); update, then draw the next action from the updated table.
 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
->>> step(q, (), (0.0,), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5, np.random.default_rng(0)) in (0, 1)
+>>> step(q, (), (0.0,), Transition(0, 0, 0.0, 1, False, False),
+...     Rates(1.0, 1.0, 0.5), np.random.default_rng(0)) in (0, 1)
 True
 >>> float(q[0, 0])  # 0.5 * 4 + 0.25 * 6
 3.5
@@ -19,18 +20,24 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     behaviour_action,
     expected_value,
     update,
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Update toward the expected value of ``s'`` under epsilon-greedy, then draw."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     target = reward
     if not terminated:
         target = reward + gamma * expected_value(q, next_state, epsilon)

@@ -11,9 +11,11 @@ limit the tail is bootstrapped from ``V(s')``. The contract: docs/algorithms.md,
 >>> v = np.zeros((3, 1))
 >>> memory = mc_prediction_memory(MemoryContext(3, 2, 0.0, {"policy": "random"}, 5))
 >>> rng = np.random.default_rng(0)
->>> step(v, memory, (0.0, 0.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 0.5, 0.0, rng) in (0, 1)
+>>> step(v, memory, (0.0, 0.0, 0.0), Transition(0, 1, 1.0, 1, False, False),
+...     Rates(0.5, 0.5, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, (0.0, 0.0, 0.0), 1, 0, 2.0, 2, True, False, 0.5, 0.5, 0.0, rng)
+>>> step(v, memory, (0.0, 0.0, 0.0), Transition(1, 0, 2.0, 2, True, False),
+...     Rates(0.5, 0.5, 0.0), rng)
 -1
 >>> float(v[0, 0]), float(v[1, 0])  # returns 1 + 0.5 * 2 and 2, alpha 0.5 from 0
 (1.0, 1.0)
@@ -31,7 +33,18 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, update, value
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rates,
+    Rng,
+    Table,
+    Transition,
+    shift,
+    update,
+    value,
+)
 
 UPDATES = ("constant_alpha", "sample_average")
 """``agent.update`` values, in the order of their codes"""
@@ -39,10 +52,13 @@ VISITS = ("every", "first")
 """``agent.visits`` values, in the order of their codes"""
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Record the step; at the episode's end, learn from its returns backwards."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     policy, states, rewards, counts = memory[0], memory[1], memory[2], memory[3]
     first_visit, length = memory[4], memory[5]
     t = length[0]

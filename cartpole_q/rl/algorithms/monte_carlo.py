@@ -11,9 +11,9 @@ bootstrapped from ``Q`` with the epsilon-greedy policy's value of the last state
 >>> q = np.zeros((2, 2))
 >>> memory = mc_memory(MemoryContext(2, 2, 0.0, {}, 5))
 >>> rng = np.random.default_rng(0)
->>> step(q, memory, (0.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 0.5, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), Transition(0, 1, 1.0, 1, False, False), Rates(0.5, 0.5, 0.0), rng)
 0
->>> step(q, memory, (0.0, 0.0), 1, 0, 2.0, 0, True, False, 0.5, 0.5, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), Transition(1, 0, 2.0, 0, True, False), Rates(0.5, 0.5, 0.0), rng)
 -1
 >>> float(q[0, 1]), float(q[1, 0])  # returns 1 + 0.5 * 2 and 2, first visits, averaged
 (2.0, 2.0)
@@ -28,8 +28,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     expected_value,
@@ -42,10 +44,14 @@ UPDATES = ("sample_average", "constant_alpha")
 """``agent.update`` values, in the order of their codes"""
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Record the step; at the episode's end, learn from its first visits backwards."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     states, actions, rewards, counts, length = memory[0], memory[1], memory[2], memory[3], memory[4]
     first_visit = memory[5]
     n_actions = action_count(q)

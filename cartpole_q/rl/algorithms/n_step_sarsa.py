@@ -9,7 +9,8 @@ draws it). With ``n = 1`` this is SARSA, byte for byte. The contract: docs/algor
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = queue_memory(1)
->>> step(q, memory, (1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, np.random.default_rng(0))
+>>> step(q, memory, (1.0, 0.0), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 1
 >>> float(q[0, 0])  # as SARSA: 0 + 0.5 * (1 + 4 - 0)
 2.5
@@ -25,16 +26,22 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     behaviour_action,
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Queue the step, draw ``a'``, then settle what is due."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    epsilon = rates.epsilon
     states, actions, rewards, counter = memory[0], memory[1], memory[2], memory[3]
     push(states, actions, rewards, counter, state, action, reward)
     next_action = ENDED
@@ -43,7 +50,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     ended = terminated or truncated
     while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
         settle_oldest(q, states, actions, rewards, counter, next_state, next_action,
-                      not terminated, alpha, gamma)  # fmt: skip
+                      not terminated, rates)  # fmt: skip
     if ended:
         return ENDED
     return next_action

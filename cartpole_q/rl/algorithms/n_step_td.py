@@ -9,9 +9,10 @@ for byte. The contract: docs/algorithms.md, "Prediction".
 >>> v = np.array([[0.0], [0.0], [0.0]])
 >>> memory = n_step_memory(MemoryContext(3, 2, 0.0, {"policy": "random", "n": 2}, 10))
 >>> rng = np.random.default_rng(0)
->>> step(v, memory, (0.0, 2.0), 0, 0, 1.0, 1, False, False, 0.5, 0.5, 0.0, rng) in (0, 1)
+>>> step(v, memory, (0.0, 2.0), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 0.5, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, (0.0, 2.0), 1, 0, 2.0, 2, True, False, 0.5, 0.5, 0.0, rng)
+>>> step(v, memory, (0.0, 2.0), Transition(1, 0, 2.0, 2, True, False), Rates(0.5, 0.5, 0.0), rng)
 -1
 >>> float(v[0, 0]), float(v[1, 0])  # toward 1 + 0.5 * 2 and 2
 (1.0, 1.0)
@@ -30,13 +31,15 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rates, Rng, Table, Transition
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Queue the step, then settle what is due; the next action is the policy's."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
     policy, states, actions, rewards, counter = (
         memory[0],
         memory[1],
@@ -48,7 +51,7 @@ def step(q: Table, memory: Memory, params: Params, state: int, action: int, rewa
     ended = terminated or truncated
     while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
         settle_oldest(q, states, actions, rewards, counter, next_state, 0, not terminated,
-                      alpha, gamma)  # fmt: skip
+                      rates)  # fmt: skip
     if ended:
         return ENDED
     return policy_action(policy, next_state, params, rng)

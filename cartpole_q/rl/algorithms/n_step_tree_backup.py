@@ -9,8 +9,8 @@ action is drawn after the update, as Expected SARSA does. The contract: docs/alg
 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
->>> step(q, queue_memory(1), (1.0, 0.0), 0, 0, 0.0, 1, False, False, 1.0, 1.0, 0.5,
-...      np.random.default_rng(0)) in (0, 1)
+>>> step(q, queue_memory(1), (1.0, 0.0), Transition(0, 0, 0.0, 1, False, False),
+...     Rates(1.0, 1.0, 0.5), np.random.default_rng(0)) in (0, 1)
 True
 >>> float(q[0, 0])  # as Expected SARSA: 0.5 * 4 + 0.25 * 6
 3.5
@@ -26,8 +26,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     best_action,
@@ -42,10 +44,10 @@ from cartpole_q.rl.tabular import (
 @compilable
 def settle_oldest(
     q: Table, states: np.ndarray, actions: np.ndarray, rewards: np.ndarray,
-    counter: np.ndarray, next_state: int, terminated: bool, alpha: float, gamma: float,
-    epsilon: float,
+    counter: np.ndarray, next_state: int, terminated: bool, rates: Rates,
 ) -> None:  # fmt: skip
     """Update the oldest pending step toward its tree-backup return, and remove it."""
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     n = states.shape[0]
     n_actions = action_count(q)
     pending = counter[1]
@@ -69,16 +71,19 @@ def settle_oldest(
     drop_oldest(counter, n)
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Queue the step, settle what is due, then draw the next action."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    epsilon = rates.epsilon
     states, actions, rewards, counter = memory[0], memory[1], memory[2], memory[3]
     push(states, actions, rewards, counter, state, action, reward)
     ended = terminated or truncated
     while oldest_is_due(counter, states.shape[0], ended):  # terminated only if ended
-        settle_oldest(q, states, actions, rewards, counter, next_state, terminated, alpha,
-                      gamma, epsilon)  # fmt: skip
+        settle_oldest(q, states, actions, rewards, counter, next_state, terminated, rates)
     if ended:
         return ENDED
     return behaviour_action(q, params, next_state, epsilon, rng)

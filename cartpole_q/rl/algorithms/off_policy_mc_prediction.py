@@ -15,9 +15,10 @@ the book's box in 5.6). The contract: docs/algorithms.md, "Prediction".
 >>> memory = off_policy_memory(context)
 >>> rng = np.random.default_rng(0)
 >>> params = (1.0, 0.0, 0.0)  # a rule, ordinary sampling, every visit
->>> step(v, memory, params, 0, 0, 0.0, 1, False, False, 0.5, 1.0, 0.0, rng) in (0, 1)
+>>> step(v, memory, params, Transition(0, 0, 0.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, params, 1, 0, 1.0, 2, True, False, 0.5, 1.0, 0.0, rng)
+>>> step(v, memory, params, Transition(1, 0, 1.0, 2, True, False), Rates(0.5, 1.0, 0.0), rng)
 -1
 >>> float(v[1, 0]), float(v[0, 0])  # both took pi's action: W = 2, then 4; returns 1 and 1
 (2.0, 4.0)
@@ -30,7 +31,7 @@ import numpy as np
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext, Param, param_index
 from cartpole_q.rl.algorithms.mc_prediction import VISIT
 from cartpole_q.rl.prediction import POLICY, POLICY_SOURCE, policy_table
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, shift, value
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rates, Rng, Table, Transition, shift, value
 
 SAMPLINGS = ("ordinary", "weighted")
 """``agent.sampling`` values, in the order of their codes"""
@@ -43,10 +44,14 @@ def behaviour_action(
     return int(rng.integers(0, memory[0].shape[1]))
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Record the step; at the episode's end, learn from its weighted returns backwards."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    gamma = rates.gamma
     pi, states, actions, rewards = memory[0], memory[1], memory[2], memory[3]
     weights, first_visit, length = memory[4], memory[5], memory[6]
     t = length[0]

@@ -12,9 +12,9 @@ docs/algorithms.md.
 >>> q = np.zeros((2, 2))
 >>> memory = off_policy_memory(MemoryContext(2, 2, 0.0, {}, 5))
 >>> rng = np.random.default_rng(0)
->>> step(q, memory, (0.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), Transition(0, 0, 1.0, 1, False, False), Rates(0.5, 1.0, 0.0), rng)
 0
->>> step(q, memory, (0.0, 0.0), 1, 0, 2.0, 0, True, False, 0.5, 1.0, 0.0, rng)
+>>> step(q, memory, (0.0, 0.0), Transition(1, 0, 2.0, 0, True, False), Rates(0.5, 1.0, 0.0), rng)
 -1
 >>> float(q[0, 0]), float(q[1, 0])  # greedy all along: W stays 1
 (3.0, 2.0)
@@ -29,8 +29,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     behaviour_probability,
@@ -44,10 +46,14 @@ UPDATES = ("sample_average", "constant_alpha")
 """``agent.update`` values, in the order of their codes"""
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Record the step and its behaviour probability; at the end, learn backwards."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     states, actions, rewards, weights, length = (
         memory[0],
         memory[1],

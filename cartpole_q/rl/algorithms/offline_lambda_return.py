@@ -11,9 +11,10 @@ time limit cut it), and then each step in order moves ``V(S_t)`` toward its retu
 >>> memory = lambda_return_memory(MemoryContext(3, 2, 0.5, {"policy": "random"}, 5))
 >>> rng = np.random.default_rng(0)
 >>> params = (0.0, 0.5)  # policy random, lambda 0.5
->>> step(v, memory, params, 0, 0, 0.0, 1, False, False, 0.1, 1.0, 0.0, rng) in (0, 1)
+>>> step(v, memory, params, Transition(0, 0, 0.0, 1, False, False),
+...     Rates(0.1, 1.0, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, params, 1, 0, 1.0, 2, True, False, 0.1, 1.0, 0.0, rng)
+>>> step(v, memory, params, Transition(1, 0, 1.0, 2, True, False), Rates(0.1, 1.0, 0.0), rng)
 -1
 >>> float(v[1, 0])  # G_1 = 1: 0.5 + 0.1 * (1 - 0.5)
 0.55
@@ -33,14 +34,27 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, update, value
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rates,
+    Rng,
+    Table,
+    Transition,
+    update,
+    value,
+)
 from cartpole_q.rl.traces import LAMBDA
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Record the step; at the episode's end, move every visit toward its λ-return."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     policy, states, rewards, returns, length = memory[0], memory[1], memory[2], memory[3], memory[4]
     t = length[0]
     states[t], rewards[t] = state, reward

@@ -26,8 +26,8 @@ queueing keeps the larger priority and nothing else changes meanwhile.
 >>> import numpy as np
 >>> q = np.zeros((2, 2))
 >>> memory = sweeping_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (5.0, 0.0, 0.0), 0, 1, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (5.0, 0.0, 0.0), Transition(0, 1, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 0
 >>> float(q[0, 1])  # P = 1 queued (0, 1); planning: its update, nothing else queued
 0.5
@@ -55,8 +55,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     best_value,
@@ -231,10 +233,14 @@ def sweep(
             before = following[before]
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Remember the step, queue it by its priority, sweep, then draw the next action."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     n_actions = action_count(q)
     theta = params[THETA_AT]
     flat = state * n_actions + action

@@ -6,7 +6,8 @@ epsilon-greedily from the updated table (not at the episode's end).
 
 >>> import numpy as np
 >>> q = np.array([[1.0, 0.0], [2.0, 3.0]])
->>> step(q, (), (0.0,), 0, 0, 1.0, 1, False, True, 0.5, 0.9, 0.0, np.random.default_rng(0))
+>>> step(q, (), (0.0,), Transition(0, 0, 1.0, 1, False, True),
+...     Rates(0.5, 0.9, 0.0), np.random.default_rng(0))
 -1
 >>> float(q[0, 0])  # truncated, so it bootstraps: 1 + 0.5 * (1 + 0.9 * 3 - 1) = 2.35
 2.35
@@ -19,18 +20,24 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     behaviour_action,
     best_value,
     update,
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Update toward ``r + gamma * max_b Q(s', b)``, then draw the next action."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     target = reward
     if not terminated:
         target = reward + gamma * best_value(q, next_state)

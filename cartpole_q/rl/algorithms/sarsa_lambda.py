@@ -10,8 +10,8 @@ SARSA, byte for byte. The contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = trace_memory(2, 2)
->>> step(q, memory, (0.5, 1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (0.5, 1.0, 0.0), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 1
 >>> float(q[0, 0]), float(memory[0][0])  # as SARSA; the trace decayed to 0.5
 (2.5, 0.5)
@@ -26,8 +26,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     value,
@@ -43,10 +45,14 @@ from cartpole_q.rl.traces import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Draw ``a'``, give ``(s, a)`` its trace, move every traced pair, decay the traces."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     decay, kind = gamma * params[LAMBDA_AT], int(params[TRACE_AT])
     n_actions = action_count(q)

@@ -7,12 +7,13 @@ The contract: docs/algorithms.md, "Prediction".
 >>> import numpy as np
 >>> v = np.array([[0.5], [0.5], [0.0]])
 >>> memory = (policy_table(MemoryContext(3, 2, 0.5, {"policy": "random"}, 10)),)
->>> step(v, memory, (0.0,), 1, 0, 0.0, 0, False, False, 0.1, 1.0, 0.0,
-...      np.random.default_rng(0)) in (0, 1)
+>>> step(v, memory, (0.0,), Transition(1, 0, 0.0, 0, False, False),
+...     Rates(0.1, 1.0, 0.0), np.random.default_rng(0)) in (0, 1)
 True
 >>> float(v[1, 0])  # 0.5 + 0.1 * (0 + 0.5 - 0.5): unchanged
 0.5
->>> step(v, memory, (0.0,), 0, 0, 1.0, 2, True, False, 0.1, 1.0, 0.0, np.random.default_rng(0))
+>>> step(v, memory, (0.0,), Transition(0, 0, 1.0, 2, True, False),
+...     Rates(0.1, 1.0, 0.0), np.random.default_rng(0))
 -1
 >>> float(v[0, 0])  # 0.5 + 0.1 * (1 - 0.5)
 0.55
@@ -30,13 +31,26 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, update, value
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rates,
+    Rng,
+    Table,
+    Transition,
+    update,
+    value,
+)
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Move ``V(s)`` toward ``r + gamma * V(s')``; the next action is the policy's."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     target = reward
     if not terminated:
         target = reward + gamma * value(q, next_state, 0)

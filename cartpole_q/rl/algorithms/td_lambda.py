@@ -11,9 +11,11 @@ docs/algorithms.md, "Prediction".
 >>> v = np.zeros((3, 1))
 >>> memory = td_lambda_memory(MemoryContext(3, 2, 0.0, {"policy": "random"}, 10))
 >>> rng = np.random.default_rng(0)
->>> step(v, memory, (0.0, 1.0, 0.0), 0, 0, 0.0, 1, False, False, 0.5, 1.0, 0.0, rng) in (0, 1)
+>>> step(v, memory, (0.0, 1.0, 0.0), Transition(0, 0, 0.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), rng) in (0, 1)
 True
->>> step(v, memory, (0.0, 1.0, 0.0), 1, 0, 1.0, 2, True, False, 0.5, 1.0, 0.0, rng)
+>>> step(v, memory, (0.0, 1.0, 0.0), Transition(1, 0, 1.0, 2, True, False),
+...     Rates(0.5, 1.0, 0.0), rng)
 -1
 >>> float(v[0, 0]), float(v[1, 0])  # lambda 1, accumulating: both move by 0.5 * 1
 (0.5, 0.5)
@@ -31,7 +33,7 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, value
+from cartpole_q.rl.tabular import ENDED, Memory, Params, Rates, Rng, Table, Transition, value
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRACE,
@@ -43,10 +45,13 @@ from cartpole_q.rl.traces import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Give ``s`` its trace, move every traced state, decay the traces."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     policy = memory[0]
     values, states, actions, slots, count = memory[1], memory[2], memory[3], memory[4], memory[5]
     decay, kind = gamma * params[LAMBDA_AT], int(params[TRACE_AT])

@@ -9,8 +9,8 @@ Per step: ``a'`` drawn first (as SARSA); ``delta = r + gamma * Q(s', a') - Q(s, 
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = true_online_memory(MemoryContext(2, 2, 0.0, {}, 10))
->>> step(q, memory, (0.5, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (0.5, 0.0), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 1
 >>> float(q[0, 0]), float(memory[5][0])  # 0.5 * 5 * 1 - 0.5 * 0; q_old = Q(s', a') = 4
 (2.5, 4.0)
@@ -25,8 +25,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     feature_alpha,
@@ -45,10 +47,14 @@ from cartpole_q.rl.traces import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """The true online update with dutch traces and the ``q_old`` correction."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     q_old_cell = memory[5]
     lam = params[LAMBDA_AT]

@@ -9,8 +9,8 @@ with the action 0. The contract: docs/algorithms.md, "Prediction".
 >>> import numpy as np
 >>> v = np.array([[0.0], [4.0], [0.0]])
 >>> memory = true_online_memory(MemoryContext(3, 2, 0.0, {"policy": "random"}, 10))
->>> step(v, memory, (0.0, 0.5), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0)) in (0, 1)
+>>> step(v, memory, (0.0, 0.5), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0)) in (0, 1)
 True
 >>> float(v[0, 0]), float(memory[6][0])  # 0.5 * 5 * 1 - 0.5 * 0; v_old = V(s') = 4
 (2.5, 4.0)
@@ -28,7 +28,18 @@ from cartpole_q.rl.prediction import (
     policy_action,
     policy_table,
 )
-from cartpole_q.rl.tabular import ENDED, Memory, Params, Rng, Table, feature_alpha, shift, value
+from cartpole_q.rl.tabular import (
+    ENDED,
+    Memory,
+    Params,
+    Rates,
+    Rng,
+    Table,
+    Transition,
+    feature_alpha,
+    shift,
+    value,
+)
 from cartpole_q.rl.traces import (
     LAMBDA,
     TRUE_ONLINE_NOT_AVERAGED,
@@ -41,10 +52,13 @@ from cartpole_q.rl.traces import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """The true online update with dutch traces and the ``v_old`` correction."""
+    state, reward, next_state = transition.state, transition.reward, transition.next_state
+    terminated, truncated = transition.terminated, transition.truncated
+    alpha, gamma = rates.alpha, rates.gamma
     policy = memory[0]
     values, states, actions, slots, count = memory[1], memory[2], memory[3], memory[4], memory[5]
     v_old_cell = memory[6]

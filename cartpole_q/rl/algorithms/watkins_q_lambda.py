@@ -10,8 +10,8 @@ byte for byte. The contract: docs/algorithms.md.
 >>> import numpy as np
 >>> q = np.array([[0.0, 0.0], [2.0, 4.0]])
 >>> memory = trace_memory(2, 2)
->>> step(q, memory, (0.5, 1.0, 0.0), 0, 0, 1.0, 1, False, False, 0.5, 1.0, 0.0,
-...      np.random.default_rng(0))
+>>> step(q, memory, (0.5, 1.0, 0.0), Transition(0, 0, 1.0, 1, False, False),
+...     Rates(0.5, 1.0, 0.0), np.random.default_rng(0))
 1
 >>> float(q[0, 0]), int(memory[4][0])  # as Q-learning; a greedy a' keeps the trace
 (2.5, 1)
@@ -26,8 +26,10 @@ from cartpole_q.rl.tabular import (
     ENDED,
     Memory,
     Params,
+    Rates,
     Rng,
     Table,
+    Transition,
     action_count,
     behaviour_action,
     best_value,
@@ -44,10 +46,14 @@ from cartpole_q.rl.traces import (
 )
 
 
-def step(q: Table, memory: Memory, params: Params, state: int, action: int, reward: float,
-         next_state: int, terminated: bool, truncated: bool, alpha: float, gamma: float,
-         epsilon: float, rng: Rng) -> int:  # fmt: skip
+def step(
+    q: Table, memory: Memory, params: Params, transition: Transition, rates: Rates, rng: Rng
+) -> int:
     """Move every traced pair toward the greedy target; draw; decay or cut the traces."""
+    state, action, reward = transition.state, transition.action, transition.reward
+    next_state, terminated = transition.next_state, transition.terminated
+    truncated = transition.truncated
+    alpha, gamma, epsilon = rates.alpha, rates.gamma, rates.epsilon
     values, states, actions, slots, count = memory[0], memory[1], memory[2], memory[3], memory[4]
     decay, kind = gamma * params[LAMBDA_AT], int(params[TRACE_AT])
     n_actions = action_count(q)
