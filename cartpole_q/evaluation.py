@@ -21,7 +21,7 @@ from cartpole_q.config import MAX_EPISODES, Config, ConfigError, load_config
 from cartpole_q.engines.base import AgentParams
 from cartpole_q.engines.plan import env_facts
 from cartpole_q.engines.play import FrameCallback, play_greedy
-from cartpole_q.envs.gym import EnvInfo, make_env
+from cartpole_q.envs.gym import EnvInfo, config_time_limit, make_env
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.errors import RunError
 
@@ -109,7 +109,7 @@ def under_conditions(
     if max_steps is not None:
         overrides["env.kwargs.max_episode_steps"] = max_steps
         explicit = config.train.reward_threshold is not None
-        if explicit and max_steps != env_facts(config).max_episode_steps:
+        if explicit and max_steps != config_time_limit(config):
             overrides["train.reward_threshold"] = None
     if not overrides:
         return config

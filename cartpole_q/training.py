@@ -23,7 +23,7 @@ import numpy as np
 from cartpole_q.config import Config
 from cartpole_q.engines import make_engine
 from cartpole_q.engines.base import NO_STEP_LIMIT, Engine, EpisodeMetrics, Tables, TrainingState
-from cartpole_q.engines.plan import Plan, env_facts, plan_run
+from cartpole_q.engines.plan import Plan, plan_run
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.errors import RunError
 from cartpole_q.evaluation import EvalReport
@@ -252,7 +252,7 @@ def train(
             raise TypeError("train: give env_info with a config, not with a plan (it has one)")
         plan = config
     elif resume is not None:  # the checkpoint's engine runs: no other is chosen
-        plan = Plan(config, env_info or env_facts(config), resume.engine, "config")
+        plan = plan_run(config, env_info=env_info, engine=resume.engine)
     else:
         plan = plan_run(config, env_info=env_info)
     config, env_info = plan.config, plan.env_info

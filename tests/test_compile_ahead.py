@@ -14,9 +14,11 @@ from typing import Any
 import numpy as np
 import pytest
 
+import cartpole_q.engines.plan
 import cartpole_q.numba_cache
 from cartpole_q.config import Config, load_config
 from cartpole_q.engines import loop_names, resolve_engine
+from cartpole_q.engines.plan import plan_run
 from cartpole_q.envs.gym import inspect_env
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.numba_cache import is_cached
@@ -78,18 +80,23 @@ def test_compile_ahead_asks_once_per_distinct_loop_and_fills_the_cache(
         _config(**{"agent.algorithm": "sarsa"}),
         _config(**RANDOMIZE),
     ]
+    plans = [plan_run(config) for config in configs]  # the workers inspect nothing again
     asked: list[str] = []
 
     def never_cached(name: str) -> bool:
         asked.append(name)
         return False
 
+    def inspected(*args: Any) -> None:
+        raise AssertionError("a compile worker inspected an environment its plan carries")
+
     monkeypatch.setattr(cartpole_q.numba_cache, "is_cached", never_cached)
-    assert compile_ahead(configs, workers=2) == 3  # seed, alpha and physics are no new loop
+    monkeypatch.setattr(cartpole_q.engines.plan, "inspect_env", inspected)  # (workers fork)
+    assert compile_ahead(plans, workers=2) == 3  # seed, alpha and physics are no new loop
     assert len(asked) == len(set(asked)) == 3
     monkeypatch.undo()
     assert all(is_cached(name) for name in asked)
-    assert compile_ahead(configs, workers=2) == 0
+    assert compile_ahead(plans, workers=2) == 0
 
 
 def test_a_sweep_says_how_many_loops_it_compiles_first(

@@ -227,6 +227,45 @@ def test_optimum_prints_the_policy_s_exact_values() -> None:
     assert refused.exit_code == 2 and "no exact values" in refused.stderr
 
 
+def test_optimum_s_policy_values_are_a_prediction_run_s_truth() -> None:
+    """``optimum --policy`` evaluates the policy on the world, with no algorithm: its values
+    are exactly those a prediction run's RMS error is measured against."""
+    shown = invoke("optimum", "FrozenLake-v1", "--policy", "random", "--gamma", "0.9", "--json")
+    assert shown.exit_code == 0, shown.output
+    values = json.loads(shown.stdout)["values"]
+    config = load_config(
+        overrides={"env.id": "FrozenLake-v1", "agent.algorithm": "td", "agent.gamma": 0.9}
+    )
+    truth = prediction_truth(config, inspect_env(config))
+    assert [int(state) for state in values] == truth.states.tolist()
+    assert list(values.values()) == truth.values.tolist()
+
+
+@pytest.mark.parametrize(
+    ("arguments", "named", "why"),
+    [
+        (["--policy", "sideways"], "--policy sideways", "random, stick_20, left, greedy"),
+        (["--policy", "left"], "--policy", "left is not a rule FrozenLake-v1 declares"),
+        (["--policy", "greedy"], "--set agent.policy_run", "give its run directory"),
+        (
+            ["--policy", "random", "--set", "agent.policy_run=runs/x"],
+            "--set agent.policy_run",
+            "read only with agent.policy greedy or epsilon_greedy",
+        ),
+        (
+            ["--policy", "epsilon_greedy", "--set", "agent.policy_epsilon=2"],
+            "agent.policy_epsilon=2",
+            "in [0, 1]",
+        ),
+        (["--set", "agent.policy_run=runs/x"], "--set agent.policy_run", "without --policy"),
+    ],
+)
+def test_optimum_refuses_a_policy_as_a_prediction_config_would(
+    arguments: list[str], named: str, why: str
+) -> None:
+    assert_refused(invoke("optimum", "FrozenLake-v1", *arguments), named, why)
+
+
 def test_the_measured_states_are_those_an_episode_can_be_in() -> None:
     """Taxi's 100 states with the passenger at the destination are never occupied."""
     taxi = load_config(overrides={"env.id": "Taxi-v4", "agent.algorithm": "td", "agent.gamma": 0.9})

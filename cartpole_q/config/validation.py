@@ -172,32 +172,43 @@ def _check_named_policy(reader: _Reader, agent: AgentConfig, env_id: str, tiled:
     Either gives an action per table row (the worlds that declare a rule have Discrete
     observations: no grid, no tiles); ``agent.policy_run`` is read by a run's policy alone.
     """
-    from cartpole_q.families import profile_for
-
     if not get_algorithm(agent.algorithm).predicts:
         return
-    name = agent.params.get("policy", "random")
-    run = str(agent.params.get("policy_run", ""))
+    name = str(agent.params.get("policy", "random"))
+    problem = named_policy_problem(name, str(agent.params.get("policy_run", "")), env_id, tiled)
+    if problem is not None:
+        raise reader.error(*problem)
+
+
+def named_policy_problem(name: str, run: str, env_id: str, tiled: bool) -> tuple[str, str] | None:
+    """What is wrong with evaluating the policy ``name`` (from ``run``) on ``env_id``, if anything.
+
+    A prediction config's ``agent.policy`` and ``optimum --policy`` are checked alike.
+
+    Returns:
+        ``None``, or the key to blame (``agent.policy`` or ``agent.policy_run``) and why.
+    """
+    from cartpole_q.families import profile_for
+
     if name in ("greedy", "epsilon_greedy"):
-        _check_policy_run(reader, name, run, tiled)
-        return
+        return _policy_run_problem(name, run, tiled)
     if run:
-        raise reader.error(
+        return (
             "agent.policy_run",
             f"{run} is read only with agent.policy greedy or epsilon_greedy (agent.policy is "
-            f"{name}); "
-            "remove it, or set agent.policy: greedy.",
+            f"{name}); remove it, or set agent.policy: greedy.",
         )
     if name == "random":
-        return
+        return None
     declared = profile_for(env_id).policies
     if name not in declared:
         rules = ", ".join(declared) or "none"
-        raise reader.error(
+        return (
             "agent.policy",
             f"{name} is not a rule {env_id} declares (it declares {rules}). Use random, "
-            f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(str(name))}",
+            f"greedy or epsilon_greedy (a run's), or a rule of its world; {_rule_owners(name)}",
         )
+    return None
 
 
 def _check_initial_values(reader: _Reader, agent: AgentConfig, tilings: int) -> None:
@@ -239,7 +250,7 @@ def _rule_owners(name: str) -> str:
     return f"no world declares {name}; the worlds' rules: {', '.join(rules)}."
 
 
-def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None:
+def _policy_run_problem(name: str, run: str, tiled: bool) -> tuple[str, str] | None:
     """A run's policy needs the run's directory (a table policy: not on tiles).
 
     The directory itself is read and checked when a run is prepared, not here: a config
@@ -247,17 +258,18 @@ def _check_policy_run(reader: _Reader, name: str, run: str, tiled: bool) -> None
     run may have moved.
     """
     if tiled:
-        raise reader.error(
+        return (
             "agent.policy",
             f"{name} takes a run's table policy, one action per table row; on tiles there are "
             "no rows. Use discretization.tilings: 1.",
         )
     if not run:
-        raise reader.error(
+        return (
             "agent.policy_run",
             f"agent.policy {name} evaluates a control run's policy: give its run directory "
             "(agent.policy_run: runs/NAME).",
         )
+    return None
 
 
 def _check_epsilon_floor(reader: _Reader, agent: AgentConfig, episodes: int) -> None:

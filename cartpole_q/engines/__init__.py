@@ -14,6 +14,7 @@ from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
 if TYPE_CHECKING:  # the registry loads when an engine is made, not when this is imported
+    from cartpole_q.engines.plan import Plan
     from cartpole_q.envs.registry import TwinSettings
 
 
@@ -198,29 +199,22 @@ def compile_notice(
     )
 
 
-def precompile(config: Config, engine: str, greedy_loop: bool | None = None) -> None:
-    """Compile (or load from the cache) what training ``config`` on ``engine`` runs.
+def precompile(plan: Plan, greedy_loop: bool | None = None) -> None:
+    """Compile (or load from the cache) what training ``plan``'s config on its engine runs.
 
     Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up does;
     ``greedy_loop`` as :func:`make_engine` takes it (``True``: the greedy loop as well,
     wherever the run's epsilon reaches 0).
-
-    Raises:
-        ConfigError: the config does not fit its environment, or ``engine`` is ``numba`` and
-            the environment has no compiled twin.
     """
-    import dataclasses
-
     import numpy as np
 
     from cartpole_q.engines.base import TrainingState
-    from cartpole_q.envs.gym import inspect_env
 
-    config = dataclasses.replace(config, engine=engine)
-    info = inspect_env(config)
-    chosen, twin = engine_and_twin(config, info)
+    config, info = plan.config, plan.env_info
     state = TrainingState.fresh(config, info, np.random.default_rng(0))
-    made = make_engine(chosen, config, info, env_seed=0, twin=twin, greedy_loop=greedy_loop)
+    made = make_engine(
+        plan.engine, config, info, env_seed=0, twin=plan.twin, greedy_loop=greedy_loop
+    )
     try:
         made.warm_up(state)
     finally:

@@ -18,7 +18,7 @@ from typing import Any, NamedTuple, Protocol
 import numpy as np
 import yaml
 
-from cartpole_q.config import Config, ConfigError, Schedule
+from cartpole_q.config import Config, ConfigError, EnvConfig, Schedule
 from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.envs.models import GREEDY_STEP_CAP
 from cartpole_q.families import profile_for
@@ -395,12 +395,11 @@ def prediction_truth(config: Config, env_info: EnvInfo) -> Truth:
     """
     # A sweep's runs of one point ask for the same values: solved once per process. A run's
     # policy is keyed by its actions (the file may change between two calls).
-    from_run = config.agent.params.get("policy") in ("greedy", "epsilon_greedy")
+    policy = EvaluatedPolicy.of(config)
     key = (
         repr(config.env), env_info.max_episode_steps, env_info.state_shape, env_info.n_actions,
-        config.agent.gamma, config.agent.params.get("policy"),
-        config.agent.params.get("policy_epsilon"), repr(config.discretization),
-        tuple(run_greedy_actions(config, env_info)) if from_run else None,
+        config.agent.gamma, policy.name, policy.epsilon, repr(config.discretization),
+        tuple(run_greedy_actions(config.env, policy, env_info)) if policy.from_run else None,
     )  # fmt: skip
     found = _TRUTHS.get(key)
     if found is None:
@@ -415,21 +414,64 @@ _TRUTHS: dict[tuple[Any, ...], Truth] = {}
 """the true values solved in this process, by what decides them"""
 
 
-def named_policy(config: Config, env_info: EnvInfo) -> list[int] | None:
-    """A prediction run's named ``agent.policy`` (not ``random``): its action in every row.
+@dataclass(frozen=True)
+class EvaluatedPolicy:
+    """A fixed policy whose values are learnt or solved: ``agent.policy`` and its source.
+
+    A prediction run's (:meth:`of` its config), or ``optimum --policy``'s: the same policy
+    on a world needs no algorithm to be evaluated exactly.
+    """
+
+    name: str = "random"
+    """``agent.policy``: ``random``, a rule the world declares, ``greedy`` or ``epsilon_greedy``"""
+    run: str = ""
+    """``agent.policy_run``: the control run whose table gives a run's policy"""
+    epsilon: float = 0.1
+    """``agent.policy_epsilon``: ``epsilon_greedy``'s probability of a uniform action"""
+
+    @classmethod
+    def of(cls, config: Config) -> EvaluatedPolicy:
+        """The policy a (prediction) config evaluates; a control config's is ``random``."""
+        params = config.agent.params
+        return cls(
+            str(params.get("policy", cls.name)),
+            str(params.get("policy_run", cls.run)),
+            float(params.get("policy_epsilon", cls.epsilon)),
+        )
+
+    @property
+    def from_run(self) -> bool:
+        """Whether a run's table gives it (``greedy``, ``epsilon_greedy``)."""
+        return self.name in ("greedy", "epsilon_greedy")
+
+    def params(self) -> dict[str, Any]:
+        """Its keys as a prediction algorithm's parameters name them (for its policy table)."""
+        return {"policy": self.name, "policy_run": self.run, "policy_epsilon": self.epsilon}
+
+    def table(self, env: EnvConfig, env_info: EnvInfo) -> np.ndarray:
+        """``pi`` on the table's rows: each row's probability of each action."""
+        return policy_table(
+            MemoryContext(
+                math.prod(env_info.state_shape), env_info.n_actions, 0.0, self.params(), 0,
+                policy=named_policy(env, self, env_info),
+            )
+        )  # fmt: skip
+
+
+def named_policy(env: EnvConfig, policy: EvaluatedPolicy, env_info: EnvInfo) -> list[int] | None:
+    """A named policy (not ``random``): its action in every row.
 
     The rule is the world's (its profile's ``policies``); validation has checked it has it.
     """
-    name = config.agent.params.get("policy", "random")
-    if name == "random":
+    if policy.name == "random":
         return None
-    if name in ("greedy", "epsilon_greedy"):
-        return run_greedy_actions(config, env_info)
-    rule = profile_for(config.env.id).policies[str(name)]
+    if policy.from_run:
+        return run_greedy_actions(env, policy, env_info)
+    rule = profile_for(env.id).policies[policy.name]
     return rule(tuple(env_info.state_shape))
 
 
-def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
+def run_greedy_actions(env: EnvConfig, policy: EvaluatedPolicy, env_info: EnvInfo) -> list[int]:
     """The greedy action of every row of ``agent.policy_run``'s ``q_table.npy``.
 
     The lowest action of the largest value (design.md's argmax), in the table's C order.
@@ -442,7 +484,7 @@ def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
         ConfigError: naming ``agent.policy_run``: the table is unreadable, another world's,
             of another shape, or not finite.
     """
-    run = Path(str(config.agent.params["policy_run"]))
+    run = Path(policy.run)
     field = f"agent.policy_run: {run}"
     if not run.exists():
         raise ConfigError(
@@ -468,10 +510,10 @@ def run_greedy_actions(config: Config, env_info: EnvInfo) -> list[int]:
         ) from None
     section = raw.get("env") if isinstance(raw, dict) else None
     env_id = section.get("id") if isinstance(section, dict) else None
-    if env_id != config.env.id:
+    if env_id != env.id:
         raise ConfigError(
             f"{field}: its config.yaml's env.id is {env_id or 'missing'}, not this "
-            f"config's {config.env.id}; evaluate a run's policy on its own world."
+            f"config's {env.id}; evaluate a run's policy on its own world."
         )
     shape = (*env_info.state_shape, env_info.n_actions)
     if table.shape != shape or table.dtype != np.float64 or not np.isfinite(table).all():
@@ -487,7 +529,8 @@ def _solve_truth(config: Config, env_info: EnvInfo) -> Truth:
     """:func:`prediction_truth`, solved (see there)."""
     if config.discretization is not None and config.discretization.tilings > 1:
         return _tiled_truth(config, env_info)
-    return exact_values(config, env_info, measure_shared_rows=False)
+    policy = EvaluatedPolicy.of(config)
+    return exact_values(config.env, env_info, policy, config.agent.gamma, measure_shared_rows=False)
 
 
 def _tiled_truth(config: Config, env_info: EnvInfo) -> Truth:
@@ -505,7 +548,7 @@ def _tiled_truth(config: Config, env_info: EnvInfo) -> Truth:
         return Truth.none()
     tabular, points = found
     pi = np.full((tabular.n_states, env_info.n_actions), 1.0 / env_info.n_actions)
-    reachable, values = _policy_values(config, tabular, pi)
+    reachable, values = _policy_values(config.env.id, "random", tabular, pi, config.agent.gamma)
     measured = ~tabular.terminal_states()[reachable]
     states = reachable[measured]
     rows = np.zeros((len(states), d.tilings), dtype=np.int64)
@@ -516,8 +559,10 @@ def _tiled_truth(config: Config, env_info: EnvInfo) -> Truth:
     return Truth(rows, values[measured].astype(np.float64), states.astype(np.int64))
 
 
-def _policy_values(config: Config, tabular: Any, pi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The reachable states under ``pi`` and their values (``evaluate_policy``).
+def _policy_values(
+    env_id: str, name: str, tabular: Any, pi: np.ndarray, gamma: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The reachable states under ``pi`` (the policy ``name``) and their values (``evaluate_policy``).
 
     Raises:
         ConfigError: naming ``agent.policy``: the values are not defined (``gamma`` 1 and a
@@ -525,12 +570,11 @@ def _policy_values(config: Config, tabular: Any, pi: np.ndarray) -> tuple[np.nda
     """
     reachable = np.flatnonzero(reachable_states(tabular, pi))
     try:
-        values = evaluate_policy(tabular, pi, config.agent.gamma, reachable)
+        values = evaluate_policy(tabular, pi, gamma, reachable)
     except ValueError as error:
         raise UndefinedValuesError(
-            f"agent.policy: the {config.agent.params.get('policy')} policy's values on "
-            f"{config.env.id} are not defined at agent.gamma {config.agent.gamma:g} ({error}); "
-            "give agent.gamma below 1.",
+            f"agent.policy: the {name} policy's values on {env_id} are not defined at "
+            f"agent.gamma {gamma:g} ({error}); give agent.gamma below 1.",
             str(error),
         ) from None
     return reachable, values
@@ -545,8 +589,14 @@ class UndefinedValuesError(ConfigError):
         """why (the solver's words)"""
 
 
-def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = True) -> Truth:
-    """The evaluated policy's exact values on every reachable non-terminal model state.
+def exact_values(
+    env: EnvConfig,
+    env_info: EnvInfo,
+    policy: EvaluatedPolicy,
+    gamma: float,
+    measure_shared_rows: bool = True,
+) -> Truth:
+    """``policy``'s exact values (discounted by ``gamma``) on every reachable non-terminal model state.
 
     As :func:`prediction_truth` (``cartpole-q optimum --policy`` prints them), but Blackjack's
     too: its natural 21s are model states of their own, on the row of a 21 with a usable ace
@@ -555,18 +605,12 @@ def exact_values(config: Config, env_info: EnvInfo, measure_shared_rows: bool = 
     """
     from cartpole_q.envs.models import EnvModel, env_model
 
-    model = env_model(config.env, env_info.max_episode_steps)
+    model = env_model(env, env_info.max_episode_steps)
     if not isinstance(model, EnvModel):
         return Truth.none()
     tabular, row_of_state = model.model, model.row_of_state
-    rows_pi = policy_table(
-        MemoryContext(
-            math.prod(env_info.state_shape), env_info.n_actions, 0.0,
-            dict(config.agent.params), 0, policy=named_policy(config, env_info),
-        )
-    )  # fmt: skip
-    pi = rows_pi[row_of_state]
-    reachable, values = _policy_values(config, tabular, pi)
+    pi = policy.table(env, env_info)[row_of_state]
+    reachable, values = _policy_values(env.id, policy.name, tabular, pi, gamma)
     measured = ~tabular.terminal_states()[reachable]
     if model.measured is not None:  # the world measures these states only
         measured &= np.isin(reachable, model.measured)
@@ -599,13 +643,7 @@ def prediction_distribution(config: Config, env_info: EnvInfo) -> np.ndarray:
     model = env_model(config.env, env_info.max_episode_steps)
     if not truth.measured or not isinstance(model, EnvModel):
         raise ConfigError(f"{config.env.id}: no model to compute the on-policy distribution from.")
-    rows_pi = policy_table(
-        MemoryContext(
-            math.prod(env_info.state_shape), env_info.n_actions, 0.0,
-            dict(config.agent.params), 0, policy=named_policy(config, env_info),
-        )
-    )  # fmt: skip
-    pi = rows_pi[model.row_of_state]
+    pi = EvaluatedPolicy.of(config).table(config.env, env_info)[model.row_of_state]
     reachable = np.flatnonzero(reachable_states(model.model, pi))
     try:
         mu = on_policy_distribution(model.model, pi, reachable)
@@ -688,7 +726,11 @@ class TrainingState:
             params=dict(config.agent.params),
             max_steps=env_info.max_episode_steps or GREEDY_STEP_CAP,
             episodes=config.train.episodes,
-            policy=named_policy(config, env_info) if algorithm.predicts else None,
+            policy=(
+                named_policy(config.env, EvaluatedPolicy.of(config), env_info)
+                if algorithm.predicts
+                else None
+            ),
             averaged=config.agent.alpha.averages,
         )
         columns = algorithm.table_columns(env_info.n_actions)  # V: one column

@@ -14,7 +14,7 @@ import contextlib
 import dataclasses
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from cartpole_q.config import Config, Provenance
 from cartpole_q.envs.gym import EnvInfo, inspect_env, inspected_fields
@@ -41,6 +41,20 @@ class Plan:
         """The same plan for one seed of a multi-seed run (the facts do not depend on it)."""
         return dataclasses.replace(self, config=self.config.for_seed(seed))
 
+    def parts(self) -> tuple[dict[str, Any], EnvInfo, str, str, TwinSettings | None]:
+        """The plan as it travels to a worker process: a config does not pickle, its mapping does."""
+        return self.config.to_dict(), self.env_info, self.engine, self.source, self.twin
+
+    @classmethod
+    def from_parts(
+        cls, parts: tuple[dict[str, Any], EnvInfo, str, str, TwinSettings | None]
+    ) -> Plan:
+        """The plan :meth:`parts` sent, in a worker: its config read again, nothing inspected."""
+        from cartpole_q.config import load_config
+
+        mapping, env_info, engine, source, twin = parts
+        return cls(load_config(mapping), env_info, engine, source, twin)
+
     def loop_names(self) -> tuple[str, ...]:
         """The compiled loops the run calls, as numba's cache names them."""
         from cartpole_q.engines import loop_names
@@ -49,7 +63,10 @@ class Plan:
 
 
 def plan_run(
-    config: Config, source: str | Provenance = "config", env_info: EnvInfo | None = None
+    config: Config,
+    source: str | Provenance = "config",
+    env_info: EnvInfo | None = None,
+    engine: str | None = None,
 ) -> Plan:
     """Check a config against its environment and pick its engine (no files touched).
 
@@ -58,6 +75,8 @@ def plan_run(
         source: the config's file (or another label), for error messages.
         env_info: the environment's facts, when the caller has already checked them
             (otherwise :func:`env_facts`: inspected, or the planning scope's).
+        engine: the engine that runs it when it is not to be chosen: a resumed run's, its
+            checkpoint's (the plan then has no twin settings: the engine finds them).
 
     Raises:
         ConfigError: the config does not fit its environment or engine.
@@ -66,6 +85,8 @@ def plan_run(
 
     if env_info is None:
         env_info = env_facts(config, source)
+    if engine is not None:
+        return Plan(config, env_info, engine, str(source))
     engine, twin = engine_and_twin(config, env_info, source)
     check_prediction(config, env_info)
     return Plan(config, env_info, engine, str(source), twin)
@@ -141,12 +162,12 @@ def env_facts(config: Config, source: str | Provenance = "config") -> EnvInfo:
     Raises:
         ConfigError: the config does not fit its environment (nothing is kept).
     """
-    if not _SCOPES[0]:
-        return inspect_env(config, source)
-    key = inspected_fields(config)
-    facts = _FACTS.get(key)
+    key = inspected_fields(config) if _SCOPES[0] else None
+    facts = None if key is None else _FACTS.get(key)
     if facts is None:
-        facts = _FACTS[key] = inspect_env(config, source)
+        facts = inspect_env(config, source)
+        if key is not None:
+            _FACTS[key] = facts
     return facts
 
 

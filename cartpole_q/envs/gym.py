@@ -520,21 +520,62 @@ def _index_starts(space: Any) -> tuple[int, ...] | None:
     return None
 
 
+def registered_spec(env: EnvConfig, source: str | Provenance = "config") -> Any:
+    """The Gymnasium spec ``env.id`` is registered under; the world is not made.
+
+    A plug-in world's id (``module:Name-v0``) imports its module first, as ``gymnasium.make``
+    would, which registers it.
+
+    Raises:
+        ConfigError: naming ``env.id``: as :func:`check_env_id`, or its module registers no
+            such id.
+    """
+    import importlib
+
+    import gymnasium
+
+    module, _, name = env.id.rpartition(":")
+    spec = gymnasium.registry.get(name)
+    if spec is None:
+        check_env_id(env.id, source)
+        if module:
+            importlib.import_module(module)
+        spec = gymnasium.registry.get(name)
+    if spec is None:
+        raise ConfigError(
+            f"{blame(source, 'env.id')}: env.id: {env.id!r}: importing {module} registers no "
+            f"environment named {name!r}; give an id it registers."
+        )
+    return spec
+
+
+def config_time_limit(config: Config) -> int | None:
+    """The time limit a config's episodes have (``None``: none), from the registry.
+
+    ``env.kwargs.max_episode_steps``, else the id's registered one, as
+    :attr:`EnvInfo.max_episode_steps` has it; the world is not made.
+
+    Raises:
+        ConfigError: as :func:`registered_spec`.
+    """
+    limit = config.env.kwargs.get(
+        "max_episode_steps", registered_spec(config.env).max_episode_steps
+    )
+    return None if limit is None else int(limit)
+
+
 def config_threshold(config: Config) -> float | None:
     """The reward threshold a config's runs are judged by (``None`` without one).
 
     From the config and Gymnasium's registry (the id's registered threshold and time limit):
-    a registered world is not made, so a run directory's reader can ask cheaply. A plug-in
-    world not yet registered is made once, which imports the module that registers it.
-    """
-    import gymnasium
+    the world is not made, so a run directory's reader can ask cheaply.
 
+    Raises:
+        ConfigError: as :func:`registered_spec`.
+    """
     if config.train.reward_threshold is not None:
         return config.train.reward_threshold
-    spec = gymnasium.registry.get(config.env.id.rpartition(":")[2])
-    if spec is None:
-        return inspect_env(config).reward_threshold
-    return _threshold_of(config, spec)
+    return _threshold_of(config, registered_spec(config.env))
 
 
 def _threshold_of(config: Config, spec: Any) -> float | None:

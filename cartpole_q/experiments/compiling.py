@@ -123,6 +123,7 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
     """
     from cartpole_q.config import ConfigError
     from cartpole_q.engines import precompile
+    from cartpole_q.engines.plan import plan_run
 
     if handle.should_stop():
         return ""
@@ -130,10 +131,10 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
         STUDY_LOOPS[job.algorithm][1]()
         return f"compiled {job.algorithm} ({job.label}, a study's loop)"
     config = load_config(mapping if mapping is not None else (job.config or None))
-    config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm})
+    config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm, "engine": job.engine})
     try:
         # (the greedy loop too: a run that finds it cached plays its greedy episodes on it)
-        precompile(config, job.engine, greedy_loop=True)
+        precompile(plan_run(config), greedy_loop=True)
     except ConfigError as error:  # e.g. an algorithm's parameters a config cannot give
         return f"{SKIPPED} {job.describe()}: {error}"
     return f"compiled {job.describe()}"
@@ -177,7 +178,7 @@ def compile_all(
 
 
 def compile_ahead(
-    configs: Sequence[Config | Plan],
+    plans: Sequence[Plan],
     workers: int,
     should_stop: Callable[[], bool] | None = None,
     on_start: Callable[[int], None] | None = None,
@@ -189,8 +190,8 @@ def compile_ahead(
     the cache.
 
     Args:
-        configs: the configs of the runs about to start (validated), or their plans
-            (then their environments are not inspected again).
+        plans: the plans of the runs about to start (their environments are not
+            inspected again, here or in the workers).
         workers: the worker processes the runs will use.
         should_stop: polled about ten times a second; once true, the loops being compiled
             are abandoned (their processes killed) and this returns at once.
@@ -199,33 +200,24 @@ def compile_ahead(
     Returns:
         How many loops were compiled.
     """
-    from cartpole_q.engines import engine_and_twin, loop_names
-    from cartpole_q.engines.plan import Plan, env_facts
     from cartpole_q.numba_cache import is_cached
 
     # A config's loops are compiled by one job (the numba engine's two side by side); a
     # loop another config's job compiles already is not counted again.
-    jobs: list[tuple[dict[str, Any], str]] = []
+    jobs: list[tuple[Any, ...]] = []
     counted: set[str] = set()
     seen: set[tuple[Any, ...]] = set()
-    for given in configs:
-        config = given.config if isinstance(given, Plan) else given
-        signature = _loop_signature(config)
+    for plan in plans:
+        signature = _loop_signature(plan.config)
         if signature in seen:
             continue
         seen.add(signature)
-        if isinstance(given, Plan):
-            info, engine, twin = given.env_info, given.engine, given.twin
-        else:
-            info = env_facts(config)
-            engine, twin = engine_and_twin(config, info)
         missing = [
-            name for name in loop_names(config, info, engine, twin)
-            if name not in counted and not is_cached(name)
-        ]  # fmt: skip
+            name for name in plan.loop_names() if name not in counted and not is_cached(name)
+        ]
         if missing:
             counted.update(missing)
-            jobs.append((config.to_dict(), engine))
+            jobs.append((plan.parts(),))
     if not jobs:
         return 0
     if on_start is not None:
@@ -254,10 +246,12 @@ def _loop_signature(config: Config) -> tuple[Any, ...]:
     )
 
 
-def _compile_loop(handle: JobHandle, mapping: dict[str, Any], engine: str) -> str:
-    """Job: compile (or load) the loops of one config on one engine."""
+def _compile_loop(handle: JobHandle, parts: tuple[Any, ...]) -> str:
+    """Job: compile (or load) the loops of one plan (as :meth:`Plan.parts` sent it)."""
     from cartpole_q.engines import precompile
+    from cartpole_q.engines.plan import Plan
 
+    plan = Plan.from_parts(parts)
     if not handle.should_stop():
-        precompile(load_config(mapping), engine)
-    return engine
+        precompile(plan)
+    return plan.engine

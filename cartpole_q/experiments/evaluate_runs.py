@@ -13,7 +13,7 @@ import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,10 @@ from cartpole_q.experiments.workers import JobHandle, default_workers, map_jobs
 from cartpole_q.results import is_success
 from cartpole_q.store.rundir import Run
 from cartpole_q.store.runsets import RunSet
+
+if TYPE_CHECKING:
+    from cartpole_q.engines.base import EvaluatedPolicy
+    from cartpole_q.engines.plan import Plan
 
 
 @dataclass(frozen=True)
@@ -317,24 +321,19 @@ def optimum(env_id: str, assignments: list[tuple[str, Any]], gamma: float | None
         UserError: ``gamma`` is 1, a key is not an env key, or the environment has no model.
         ConfigError: the id or an argument is unknown.
     """
-    from cartpole_q.engines.plan import env_facts
-
     if gamma is not None and gamma >= 1.0:
         raise UserError(
             "--gamma 1: the discounted optimum needs a discount below 1 (with no time limit, "
             "undiscounted returns may not converge); the undiscounted optimum within the "
             "time limit is printed without --gamma."
         )
-    overrides: dict[str, Any] = {"env.id": env_id}
-    for key, value in assignments:
-        if key not in RUN_POLICY_KEYS and key != "env" and not key.startswith("env."):
-            raise UserError(
-                f"--set {key}: optimum takes env keys (env.kwargs.KEY=VALUE) and, for --policy "
-                "greedy or epsilon_greedy, agent.policy_run=RUN_DIR and agent.policy_epsilon=E."
-            )
-        overrides[key] = value
-    config = load_config(overrides=overrides, override_source=COMMAND_LINE)
-    env_facts(config)  # an unknown id or argument: a config error naming it
+    plan, policy_keys = _world(env_id, assignments)
+    if policy_keys:
+        raise UserError(
+            f"--set {next(iter(policy_keys))}: a run's policy is evaluated with --policy greedy "
+            "or epsilon_greedy; without --policy, optimum takes env keys alone."
+        )
+    config = plan.config
     exact = exact_report(config, gamma=1.0 if gamma is None else gamma)
     if isinstance(exact, str):
         continuing = _continuing_optimum(config, gamma)
@@ -400,6 +399,56 @@ RUN_POLICY_KEYS = ("agent.policy_run", "agent.policy_epsilon")
 """the agent keys ``optimum --policy`` takes: a run's policy's"""
 
 
+def _world(env_id: str, assignments: list[tuple[str, Any]]) -> tuple[Plan, dict[str, Any]]:
+    """The plan of the world ``optimum`` is asked about, and the policy keys given with it.
+
+    Raises:
+        UserError: a key is neither an env key nor one of :data:`RUN_POLICY_KEYS`.
+        ConfigError: the id or an argument is unknown (naming it).
+    """
+    from cartpole_q.engines.plan import planned
+
+    overrides: dict[str, Any] = {"env.id": env_id}
+    policy_keys: dict[str, Any] = {}
+    for key, value in assignments:
+        if key in RUN_POLICY_KEYS:
+            policy_keys[key] = value
+        elif key == "env" or key.startswith("env."):
+            overrides[key] = value
+        else:
+            raise UserError(
+                f"--set {key}: optimum takes env keys (env.kwargs.KEY=VALUE) and, for --policy "
+                "greedy or epsilon_greedy, agent.policy_run=RUN_DIR and agent.policy_epsilon=E."
+            )
+    return planned(load_config(overrides=overrides, override_source=COMMAND_LINE)), policy_keys
+
+
+def _evaluated_policy(name: str, keys: Mapping[str, Any], env_id: str) -> EvaluatedPolicy:
+    """``optimum --policy``'s policy, checked as a prediction config's ``agent.policy`` is.
+
+    Raises:
+        UserError: an unknown policy, an epsilon outside [0, 1], or what
+            :func:`~cartpole_q.config.validation.named_policy_problem` finds (naming the
+            option or ``--set`` key).
+    """
+    from cartpole_q.config.validation import named_policy_problem
+    from cartpole_q.engines.base import EvaluatedPolicy
+    from cartpole_q.rl.prediction import POLICIES
+
+    if name not in POLICIES:
+        raise UserError(f"--policy {name}: not a policy; give one of {', '.join(POLICIES)}.")
+    epsilon = keys.get("agent.policy_epsilon", EvaluatedPolicy.epsilon)
+    if isinstance(epsilon, bool) or not isinstance(epsilon, int | float) or not 0 <= epsilon <= 1:
+        raise UserError(f"--set agent.policy_epsilon={epsilon}: give a number in [0, 1].")
+    run = str(keys.get("agent.policy_run", ""))
+    problem = named_policy_problem(name, run, env_id, tiled=False)
+    if problem is not None:
+        key, why = problem
+        option = "--policy" if key == "agent.policy" else f"--set {key}"
+        raise UserError(f"{option}: {why}")
+    return EvaluatedPolicy(name, run, float(epsilon))
+
+
 def policy_values(
     env_id: str, assignments: list[tuple[str, Any]], policy: str, gamma: float
 ) -> PolicyValues:
@@ -411,21 +460,12 @@ def policy_values(
         ConfigError: the id, an argument or the policy is unknown.
     """
     from cartpole_q.engines.base import UndefinedValuesError, exact_values
-    from cartpole_q.engines.plan import env_facts
 
-    overrides: dict[str, Any] = {"env.id": env_id}
-    for key, value in assignments:
-        if key not in RUN_POLICY_KEYS and key != "env" and not key.startswith("env."):
-            raise UserError(
-                f"--set {key}: optimum takes env keys (env.kwargs.KEY=VALUE) and, for --policy "
-                "greedy or epsilon_greedy, agent.policy_run=RUN_DIR and agent.policy_epsilon=E."
-            )
-        overrides[key] = value
-    overrides |= {"agent.algorithm": "td", "agent.policy": policy, "agent.gamma": gamma}
-    config = load_config(overrides=overrides, override_source=COMMAND_LINE)
-    info = env_facts(config)
+    plan, policy_keys = _world(env_id, assignments)
+    evaluated = _evaluated_policy(policy, policy_keys, plan.config.env.id)
+    config = plan.config
     try:
-        truth = exact_values(config, info)
+        truth = exact_values(config.env, plan.env_info, evaluated, gamma)
     except UndefinedValuesError as error:
         raise UserError(
             f"{env_id}: the {policy} policy's values are not defined at --gamma {gamma:g} "
