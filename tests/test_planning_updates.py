@@ -19,6 +19,8 @@ import yaml
 from cartpole_q.engines.trajectory import task_curves
 from cartpole_q.experiments import updates
 from cartpole_q.rl.planning_updates import (
+    Curve,
+    Task,
     problem_draws,
     rms_over_problems,
     sample_update_errors,
@@ -63,7 +65,7 @@ def test_figure_8_8_curves_are_the_re_derivations_byte_for_byte(
 ) -> None:
     for seed in (0, 5):
         uniform, on_policy = task_curves(
-            seed, states, 2, branching, 240, 20, 0.1, 0.1, 1e-9, compiled=compiled
+            seed, Task(states, 2, branching, 0.1), Curve(240, 20, 0.1, 1e-9), compiled=compiled
         )
         settings = (seed, states, 2, branching, 240, 20, 0.1, 0.1, 1e-9)
         assert uniform.tolist() == start_values(*settings, on_policy=False)
@@ -74,7 +76,8 @@ def test_figure_8_8_curves_are_the_re_derivations_byte_for_byte(
 def test_figure_8_8_in_small_chunks_is_figure_8_8_in_one(compiled: bool, monkeypatch: Any) -> None:
     from cartpole_q.engines import trajectory
 
-    whole = task_curves(2, 15, 2, 3, 240, 20, 0.1, 0.1, 1e-9, compiled=compiled)
+    task, curve = Task(15, 2, 3, 0.1), Curve(240, 20, 0.1, 1e-9)
+    whole = task_curves(2, task, curve, compiled=compiled)
     asked: list[int] = []
 
     def never() -> bool:
@@ -82,8 +85,7 @@ def test_figure_8_8_in_small_chunks_is_figure_8_8_in_one(compiled: bool, monkeyp
         return False
 
     monkeypatch.setattr(trajectory, "CHUNK_WORK", 4)  # two updates (b = 3) a chunk
-    chunked = task_curves(2, 15, 2, 3, 240, 20, 0.1, 0.1, 1e-9, compiled=compiled,
-                          should_stop=never)  # fmt: skip
+    chunked = task_curves(2, task, curve, compiled=compiled, should_stop=never)
     assert chunked is not None
     assert [curve.tolist() for curve in chunked] == [curve.tolist() for curve in whole]
     assert len(asked) >= 2 * 240 // 2  # two updates a chunk, in both runs
@@ -96,12 +98,13 @@ def test_figure_8_8_stops_between_chunks_with_none() -> None:
         asked.append(1)
         return len(asked) > 1
 
-    assert task_curves(0, 2000, 2, 1, 10**7, 1000, 0.1, 0.1, 1e-9, should_stop=stop) is None
+    huge = Curve(10**7, 1000, 0.1, 1e-9)
+    assert task_curves(0, Task(2000, 2, 1, 0.1), huge, should_stop=stop) is None
     assert len(asked) == 2  # one chunk, not ten million updates
 
 
 def test_a_task_valued_at_the_start_is_the_policy_of_action_0() -> None:
-    uniform, on_policy = task_curves(3, 10, 2, 2, 20, 10, 0.1, 0.1, 1e-9)
+    uniform, on_policy = task_curves(3, Task(10, 2, 2, 0.1), Curve(20, 10, 0.1, 1e-9))
     assert uniform[0] == on_policy[0]  # Q = 0: the greedy policy takes action 0 everywhere
 
 

@@ -24,6 +24,7 @@ import pytest
 import yaml
 
 from cartpole_q.config import ConfigError, load_config
+from cartpole_q.engines.plan import plan_run
 from cartpole_q.experiments import sweep as sweeping
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.sweep_spec import load_sweep
@@ -424,7 +425,7 @@ def _stopped_sweep(tmp_path: Path, data: dict[str, Any], after: int = 5) -> Path
     path = write_yaml(tmp_path / "s.yaml", data)
     spec = load_sweep(path)
     # Compiled first: the stop request counts runs, not the polls of a cold cache's compiling.
-    compile_ahead([point.config for point in spec.points], workers=1)
+    compile_ahead([plan_run(point.config) for point in spec.points], workers=1)
     directory = sweeping.start_sweep(spec, tmp_path / "stopped")
     calls = iter(range(10_000))
     outcome = sweeping.run_sweep(

@@ -17,6 +17,8 @@ import numpy as np
 from cartpole_q.engines.compile import specialise
 from cartpole_q.rl.planning_updates import (
     TRAJECTORY_CARRY,
+    Curve,
+    Task,
     task_draws,
     trajectory_run,
     trajectory_tables,
@@ -47,54 +49,44 @@ def _loop() -> Any:
 
 @overload
 def task_curves(
-    seed: int, states: int, actions: int, branching: int, updates: int, every: int,
-    termination: float, epsilon: float, tolerance: float, compiled: bool = True, *,
-    should_stop: None = None,
-) -> tuple[np.ndarray, np.ndarray]: ...  # fmt: skip
+    seed: int, task: Task, curve: Curve, compiled: bool = True, *, should_stop: None = None
+) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 @overload
 def task_curves(
-    seed: int, states: int, actions: int, branching: int, updates: int, every: int,
-    termination: float, epsilon: float, tolerance: float, compiled: bool = True, *,
+    seed: int, task: Task, curve: Curve, compiled: bool = True, *,
     should_stop: Callable[[], bool],
 ) -> tuple[np.ndarray, np.ndarray] | None: ...  # fmt: skip
 
 
 def task_curves(
     seed: int,
-    states: int,
-    actions: int,
-    branching: int,
-    updates: int,
-    every: int,
-    termination: float,
-    epsilon: float,
-    tolerance: float,
+    task: Task,
+    curve: Curve,
     compiled: bool = True,
     *,
     should_stop: Callable[[], bool] | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
-    """Task ``seed``'s two curves, ``(uniform, on_policy)``, each ``updates // every + 1`` values.
+    """Task ``seed``'s two curves, ``(uniform, on_policy)``, each ``curve.updates // curve.every + 1`` values.
 
     Both run on the same task (:func:`~cartpole_q.rl.planning_updates.task_draws`); the
     on-policy run draws from the task's run generator. ``should_stop`` is asked before
     each chunk; when it says stop, ``None`` is returned at once.
     """
-    next_states, rewards, rng = task_draws(seed, states, actions, branching)
+    next_states, rewards, rng = task_draws(seed, task.states, task.actions, task.branching)
     run = _loop() if compiled else trajectory_run
     curves = []
     for on_policy in (False, True):
-        out = np.empty(updates // every + 1)
-        tables = trajectory_tables(states, actions)
+        out = np.empty(curve.updates // curve.every + 1)
+        tables = trajectory_tables(task.states, task.actions)
         carry = np.zeros(TRAJECTORY_CARRY, dtype=np.int64)
         complete = False
         while not complete:
             if should_stop is not None and should_stop():
                 return None
             complete = run(
-                next_states, rewards, termination, epsilon, on_policy, every, tolerance, rng,
-                out, tables, carry, CHUNK_WORK,
-            )  # fmt: skip
+                next_states, rewards, task, curve, on_policy, rng, out, tables, carry, CHUNK_WORK
+            )
         curves.append(out)
     return curves[0], curves[1]

@@ -515,13 +515,12 @@ def run_one(
              "reached": result.reached}
         )  # fmt: skip
     from cartpole_q.engines.trajectory import task_curves
+    from cartpole_q.rl.planning_updates import Curve, Task
 
     panel = study.panels[int(key["panel"] or 0)]
-    curves = task_curves(
-        int(key["seed"] or 0), panel.states, study.actions, int(key["branching"] or 1),
-        panel.updates, panel.every, study.termination, study.epsilon, study.tolerance,
-        should_stop=stop,
-    )  # fmt: skip
+    task = Task(panel.states, study.actions, int(key["branching"] or 1), study.termination)
+    curve = Curve(panel.updates, panel.every, study.epsilon, study.tolerance)
+    curves = task_curves(int(key["seed"] or 0), task, curve, should_stop=stop)
     if curves is None:
         return None
     uniform, on_policy = curves

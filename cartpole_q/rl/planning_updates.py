@@ -29,6 +29,8 @@ The Figure 8.8 functions are plain Python that numba compiles (:func:`compilable
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from cartpole_q.rl.tabular import Rng, compilable
@@ -200,14 +202,36 @@ def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
 
 
 @compilable
+class Task(NamedTuple):
+    """One of Figure 8.8's random tasks: its size and how episodes end."""
+
+    states: int
+    actions: int
+    branching: int
+    """``b``: the next states each pair may lead to, equally likely"""
+    termination: float
+    """the probability that a transition ends the episode"""
+
+
+class Curve(NamedTuple):
+    """How a task's curve is drawn: its updates, how often it is valued, and how."""
+
+    updates: int
+    """the updates in all"""
+    every: int
+    """the start state's greedy value is computed after every this many updates"""
+    epsilon: float
+    """the on-policy updates' exploration"""
+    tolerance: float
+    """policy evaluation of the greedy policy stops at this largest change"""
+
+
 def trajectory_run(
     next_states: np.ndarray,
     rewards: np.ndarray,
-    termination: float,
-    epsilon: float,
+    task: Task,
+    curve: Curve,
     on_policy: bool,
-    every: int,
-    tolerance: float,
     rng: Rng,
     out: np.ndarray,
     tables: tuple[np.ndarray, ...],
@@ -230,6 +254,8 @@ def trajectory_run(
     """
     q, values, fresh, policy = tables
     states, actions, branching = next_states.shape
+    termination, epsilon = task.termination, curve.epsilon
+    every, tolerance = curve.every, curve.tolerance
     continuing = 1.0 - termination
     if carry[NEXT_UPDATE] == 0:
         out[0] = greedy_value(q, next_states, rewards, continuing, tolerance, values, fresh, policy)
