@@ -93,7 +93,8 @@ def shrink_study(path: Path, axes: bool = False) -> None:
 
     Two seeds, a few trials, and with ``axes`` each sweep axis cut to its first and last
     values (a zip's axes, and an ``until_optimal`` study's ``scales``, to their first two)
-    and runs of over :data:`MOST_EPISODES` episodes to a hundredth (:func:`fewer_episodes`):
+    and runs of over :data:`MOST_EPISODES` episodes (or env steps, ``train.max_env_steps``) to
+    a hundredth (:func:`fewer_episodes`):
     the study keeps its shape and its figure, on fewer points and shorter runs (for studies
     whose points no page names by number: the book's).
     """
@@ -114,12 +115,13 @@ def shrink_study(path: Path, axes: bool = False) -> None:
         if isinstance(data.get("scales"), list):  # an until_optimal study's maze sizes
             data["scales"] = data["scales"][:2]
         train = (data.get("base") or {}).get("train") or {}
-        if isinstance(train.get("episodes"), int):
-            train["episodes"] = fewer_episodes(train["episodes"])
-        for axis in ("grid", "zip"):
-            values = (data.get(axis) or {}).get("train.episodes")
-            if isinstance(values, list):
-                data[axis]["train.episodes"] = [fewer_episodes(value) for value in values]
+        for key in ("episodes", "max_env_steps"):
+            if isinstance(train.get(key), int):
+                train[key] = fewer_episodes(train[key])
+            for axis in ("grid", "zip"):
+                values = (data.get(axis) or {}).get(f"train.{key}")
+                if isinstance(values, list):
+                    data[axis][f"train.{key}"] = [fewer_episodes(value) for value in values]
     path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
 
 
@@ -155,7 +157,8 @@ def test_shrink_study_keeps_two_seeds_a_few_trials_two_values_per_axis_and_short
 ) -> None:
     study = tmp_path / "s.yaml"
     study.write_text(
-        "# a comment\nbase:\n  train:\n    episodes: 100000\nseeds: 0-99\ntrials: 40\n"
+        "# a comment\nbase:\n  train:\n    episodes: 100000\n    max_env_steps: 100000\n"
+        "seeds: 0-99\ntrials: 40\n"
         "grid:\n  agent.alpha: [0.1, 0.2, 0.5]\n  agent.n: [1, 2]\n"
         "  train.episodes: [500, 50000, 5000000]\n"
         "zip:\n  agent.lambda: [0, 0.5, 0.9]\n  agent.gamma: [1, 0.9, 0.8]\n",
@@ -163,7 +166,7 @@ def test_shrink_study_keeps_two_seeds_a_few_trials_two_values_per_axis_and_short
     )
     shrink_study(study, axes=True)
     assert yaml.safe_load(study.read_text(encoding="utf-8")) == {
-        "base": {"train": {"episodes": 1000}},
+        "base": {"train": {"episodes": 1000, "max_env_steps": 1000}},
         "seeds": "0-1",
         "trials": STUDY_TRIALS,
         "grid": {"agent.alpha": [0.1, 0.5], "agent.n": [1, 2], "train.episodes": [500, 50000]},
