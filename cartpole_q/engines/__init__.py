@@ -14,7 +14,6 @@ from cartpole_q.engines.base import AgentParams, Engine
 from cartpole_q.envs.gym import EnvInfo
 
 if TYPE_CHECKING:  # the registry loads when an engine is made, not when this is imported
-    from cartpole_q.engines.plan import Plan
     from cartpole_q.envs.registry import TwinSettings
 
 
@@ -197,25 +196,3 @@ def compile_notice(
         f"compiling the training loop for {config.agent.algorithm} on {config.env.id} "
         f"({engine} engine): {when}..."
     )
-
-
-def precompile(plan: Plan, greedy_loop: bool | None = None) -> None:
-    """Compile (or load from the cache) what training ``plan``'s config on its engine runs.
-
-    Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up does;
-    ``greedy_loop`` as :func:`make_engine` takes it (``True``: the greedy loop as well,
-    wherever the run's epsilon reaches 0).
-    """
-    import numpy as np
-
-    from cartpole_q.engines.base import TrainingState
-
-    config, info = plan.config, plan.env_info
-    state = TrainingState.fresh(config, info, np.random.default_rng(0))
-    made = make_engine(
-        plan.engine, config, info, env_seed=0, twin=plan.twin, greedy_loop=greedy_loop
-    )
-    try:
-        made.warm_up(state)
-    finally:
-        made.close()

@@ -55,6 +55,28 @@ class Plan:
         mapping, env_info, engine, source, twin = parts
         return cls(load_config(mapping), env_info, engine, source, twin)
 
+    def precompile(self, greedy_loop: bool | None = None) -> None:
+        """Compile (or load from the cache) what training this plan runs.
+
+        Nothing is trained: the loops are compiled on a fresh state, as a run's warm-up
+        does; ``greedy_loop`` as :func:`~cartpole_q.engines.make_engine` takes it
+        (``True``: the greedy loop as well, wherever the run's epsilon reaches 0).
+        """
+        import numpy as np
+
+        from cartpole_q.engines import make_engine
+        from cartpole_q.engines.base import TrainingState
+
+        state = TrainingState.fresh(self.config, self.env_info, np.random.default_rng(0))
+        made = make_engine(
+            self.engine, self.config, self.env_info, env_seed=0, twin=self.twin,
+            greedy_loop=greedy_loop,
+        )  # fmt: skip
+        try:
+            made.warm_up(state)
+        finally:
+            made.close()
+
     def loop_names(self) -> tuple[str, ...]:
         """The compiled loops the run calls, as numba's cache names them."""
         from cartpole_q.engines import loop_names

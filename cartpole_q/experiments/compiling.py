@@ -122,7 +122,6 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
         engine)``, ``skipped ...: why``, or ``""`` when stopped before it started.
     """
     from cartpole_q.config import ConfigError
-    from cartpole_q.engines import precompile
     from cartpole_q.engines.plan import plan_run
 
     if handle.should_stop():
@@ -134,7 +133,7 @@ def _compile(handle: JobHandle, job: CompileJob, mapping: dict[str, Any] | None)
     config = load_config(config.to_dict(), {"agent.algorithm": job.algorithm, "engine": job.engine})
     try:
         # (the greedy loop too: a run that finds it cached plays its greedy episodes on it)
-        precompile(plan_run(config), greedy_loop=True)
+        plan_run(config).precompile(greedy_loop=True)
     except ConfigError as error:  # e.g. an algorithm's parameters a config cannot give
         return f"{SKIPPED} {job.describe()}: {error}"
     return f"compiled {job.describe()}"
@@ -248,10 +247,9 @@ def _loop_signature(config: Config) -> tuple[Any, ...]:
 
 def _compile_loop(handle: JobHandle, parts: tuple[Any, ...]) -> str:
     """Job: compile (or load) the loops of one plan (as :meth:`Plan.parts` sent it)."""
-    from cartpole_q.engines import precompile
     from cartpole_q.engines.plan import Plan
 
     plan = Plan.from_parts(parts)
     if not handle.should_stop():
-        precompile(plan)
+        plan.precompile()
     return plan.engine
