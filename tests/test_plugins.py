@@ -100,7 +100,7 @@ def test_a_plugin_written_for_positional_hooks_still_trains_to_the_same_bytes(
     # registered for this test alone: other tests list every algorithm (the schema's names)
     monkeypatch.setattr(algorithms, "_REGISTRY", dict(algorithms._REGISTRY))
     name = "positional_" + NAME
-    with pytest.warns(DeprecationWarning, match=r"13 positional arguments.*CHANGELOG"):
+    with pytest.warns(FutureWarning, match=r"13 positional arguments.*CHANGELOG"):
         adapted = register(
             dataclasses.replace(plugin_algorithm.ALGORITHM, name=name, step=positional_step)
         )
@@ -111,6 +111,20 @@ def test_a_plugin_written_for_positional_hooks_still_trains_to_the_same_bytes(
     assert old.q_table.tobytes() == new.q_table.tobytes()
     assert old.returns.tobytes() == new.returns.tobytes()
     assert old.env_steps > 30
+
+
+def test_a_plugin_module_that_cannot_be_imported_is_a_config_error_naming_env_id() -> None:
+    """Reading a threshold imports a plug-in world's module, as making the world would."""
+    from cartpole_q.envs.gym import config_threshold
+
+    config = load_config()
+    missing = dataclasses.replace(
+        config, env=dataclasses.replace(config.env, id="tests.gone:Gone-v0")
+    )
+    with pytest.raises(
+        ConfigError, match=r"env\.id: cannot make 'tests\.gone:Gone-v0': the module"
+    ):
+        config_threshold(missing)
 
 
 @pytest.mark.parametrize("key", sorted(RESERVED_KEYS))

@@ -733,7 +733,9 @@ def test_the_true_values_on_tiles_follow_the_discretization() -> None:
     assert rows == [[2, 8, 15, 21], [1, 7, 13, 20]]
 
 
-def test_optimum_evaluates_a_runs_greedy_policy(tmp_path: Path) -> None:
+def test_optimum_evaluates_a_runs_greedy_policy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from cartpole_q.envs.models import EnvModel, env_model
     from cartpole_q.rl.solvers import value_iteration
 
@@ -748,6 +750,14 @@ def test_optimum_evaluates_a_runs_greedy_policy(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     values = json.loads(result.stdout)["values"]
     assert values["0"] == pytest.approx(float(optimum.values[0]), abs=1e-12)
+    # the run's directory is read as a config's agent.policy_run is: ~ expanded
+    monkeypatch.setenv("HOME", str(tmp_path))
+    home = invoke(
+        "optimum", "FrozenLake-v1", "--policy", "greedy", "--gamma", "0.95",
+        "--set", "agent.policy_run=~/lake", "--json",
+    )  # fmt: skip
+    assert home.exit_code == 0, home.output
+    assert json.loads(home.stdout)["values"] == values
     refused = invoke("optimum", "FrozenLake-v1", "--policy", "greedy", "--set", "agent.alpha=0.1")
     assert refused.exit_code == 2 and "agent.policy_run=RUN_DIR" in refused.stderr
 

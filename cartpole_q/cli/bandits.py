@@ -14,6 +14,7 @@ from cartpole_q.cli.studies import (
     Resume,
     StudyFileArgument,
     StudyOut,
+    StudyRequest,
     run_study_command,
 )
 
@@ -42,5 +43,7 @@ def bandit_command(
 ) -> None:
     """`study` for bandit studies (the k-armed testbed, chapter 2); the last line is its directory."""
     overrides: dict[str, object] | None = None if engine is None else {"engine": engine}
-    run_study_command("bandit", "bandit", study_file, resume, out, workers, backend, address,
-                      max_runs, yes, quiet, check, overrides)  # fmt: skip
+    request = StudyRequest(
+        study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
+    )
+    run_study_command("bandit", "bandit", request, overrides)

@@ -10,6 +10,7 @@ from cartpole_q.cli.studies import (
     Resume,
     StudyFileArgument,
     StudyOut,
+    StudyRequest,
     run_study_command,
 )
 
@@ -28,5 +29,7 @@ def dp_command(
     check: Check = False,
 ) -> None:
     """`study` for dynamic-programming studies (chapters 3-4); the last line is its directory."""
-    run_study_command("dp", "dp", study_file, resume, out, workers, backend, address,
-                      max_runs, yes, quiet, check)  # fmt: skip
+    request = StudyRequest(
+        study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
+    )
+    run_study_command("dp", "dp", request)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -78,8 +79,10 @@ def study_command(
     check: Check = False,
 ) -> None:
     """Run any study file (a sweep, bandits, dynamic programming, planning updates); the last line is its directory."""
-    run_study_command("study", None, study_file, resume, out, workers, backend, address,
-                      max_runs, yes, quiet, check)  # fmt: skip
+    request = StudyRequest(
+        study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
+    )
+    run_study_command("study", None, request)
 
 
 @app.command("sweep", cls=Command)
@@ -99,23 +102,42 @@ def sweep_command(
     check: Check = False,
 ) -> None:
     """Train and evaluate every point of a sweep on every seed (`study` under its first name); the last line is its directory."""
-    run_study_command("sweep", None, sweep_file, resume, out, workers, backend, address,
-                      max_runs, yes, quiet, check)  # fmt: skip
+    request = StudyRequest(
+        sweep_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
+    )
+    run_study_command("sweep", None, request)
+
+
+@dataclass(frozen=True)
+class StudyRequest:
+    """What ``study`` (or an alias) was asked: the options every study command has."""
+
+    study_file: Path | None
+    """the study file (``None`` with ``resume``)"""
+    resume: Path | None
+    """the directory to finish"""
+    out: Path | None
+    """the new directory"""
+    workers: int | None
+    """worker processes (``None``: one per core)"""
+    backend: BackendChoice
+    """local processes or Ray"""
+    address: str | None
+    """a running Ray cluster"""
+    max_runs: int
+    """the size guard (more runs need ``yes``)"""
+    yes: bool
+    """go ahead however large"""
+    quiet: bool
+    """print only the directory"""
+    check: bool
+    """read and check, run nothing"""
 
 
 def run_study_command(
     command: str,
     required: str | None,
-    study_file: Path | None,
-    resume: Path | None,
-    out: Path | None,
-    workers: int | None,
-    backend: BackendChoice,
-    address: str | None,
-    max_runs: int,
-    yes: bool,
-    quiet: bool,
-    check: bool,
+    request: StudyRequest,
     overrides: dict[str, object] | None = None,
 ) -> None:
     """``study`` and its aliases: read (or take up) a study, run it, print, exit.
@@ -123,18 +145,12 @@ def run_study_command(
     Args:
         command: the command's name, for messages (``cartpole-q sweep --resume ...``).
         required: the kind an alias runs (``bandit``), or ``None``: any.
-        study_file: the study file (``None`` with ``resume``).
-        resume: the directory to finish.
-        out: the new directory.
-        workers: worker processes (``None``: one per core).
-        backend: local processes or Ray.
-        address: a running Ray cluster.
-        max_runs: the size guard (more runs need ``yes``).
-        yes: go ahead however large.
-        quiet: print only the directory.
-        check: read and check, run nothing.
+        request: the command's options.
         overrides: study file keys an alias's options set (``bandit --engine``).
     """
+    study_file, resume, out, check = request.study_file, request.resume, request.out, request.check
+    workers, backend, address = request.workers, request.backend, request.address
+    quiet = request.quiet
     # Connected (or refused) before the study directory is created.
     with exit_codes(), backend_connection(backend, workers, address):
         from cartpole_q.experiments import study as studies
@@ -172,7 +188,7 @@ def run_study_command(
             if check:
                 typer.echo(f"{study_file}: {what}; nothing was run (--check).")
                 return
-            _check_size(runs, max_runs, yes, str(study_file), what)
+            _check_size(runs, request.max_runs, request.yes, str(study_file), what)
             # A signal from the moment the directory exists is a request to stop that the
             # study answers (saying what it saved), however early it comes.
             with stoppable(hint, STOP_POINT) as stop, kind.start(spec, study, out) as directory:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from contextlib import nullcontext
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -116,6 +117,7 @@ def train(
     ] = False,
 ) -> None:
     """Train a Q-table and write a run directory; the last line printed is its path."""
+    options = TrainOptions(workers, backend, address, quiet, watch, video_every, seed_plots)
     with exit_codes():
         from cartpole_q.experiments import run as runner
         from cartpole_q.store.lock import directory_lock
@@ -137,10 +139,7 @@ def train(
                 _check_options(prepared.config.train.seeds, watch, video_every, backend)
                 _check_outputs(prepared.config, tensorboard, video_every, watch)
                 with backend_connection(backend, workers, address):
-                    _train_into(
-                        resume, prepared, True, workers, backend, address, quiet, watch,
-                        video_every, seed_plots,
-                    )  # fmt: skip
+                    _train_into(resume, prepared, True, options)
             return
         if seed is not None and seeds is not None:
             raise UserError("give either --seed (one run) or --seeds (several), not both.")
@@ -156,10 +155,7 @@ def train(
             backend_connection(backend, workers, address),
             runner.new_run(prepared, out) as run_dir,
         ):
-            _train_into(
-                run_dir, prepared, False, workers, backend, address, quiet, watch,
-                video_every, seed_plots,
-            )  # fmt: skip
+            _train_into(run_dir, prepared, False, options)
 
 
 def _check_options(seeds: Any, watch: int, video_every: int, backend: BackendChoice) -> None:
@@ -207,18 +203,30 @@ def _check_outputs(config: Any, tensorboard: bool, video_every: int, watch: int)
         check_renderer(config.env.id, "--video-every")
 
 
-def _train_into(
-    run_dir: Path,
-    prepared: Any,
-    resume: bool,
-    workers: int | None,
-    backend: BackendChoice,
-    address: str | None,
-    quiet: bool,
-    watch: int,
-    video_every: int,
-    seed_plots: bool,
-) -> None:
+@dataclass(frozen=True)
+class TrainOptions:
+    """How ``train`` runs and shows a run: none of them changes its results."""
+
+    workers: int | None
+    """a multi-seed run's worker processes (``None``: one per core)"""
+    backend: BackendChoice
+    """local processes or Ray, for the seeds"""
+    address: str | None
+    """a running Ray cluster"""
+    quiet: bool
+    """print only the run directory"""
+    watch: int
+    """show the greedy policy every this many episodes (0: never)"""
+    video_every: int
+    """record the greedy policy every this many episodes (0: never)"""
+    seed_plots: bool
+    """draw each seed's curves too"""
+
+
+def _train_into(run_dir: Path, prepared: Any, resume: bool, options: TrainOptions) -> None:
+    workers, backend, address = options.workers, options.backend, options.address
+    quiet, watch, video_every = options.quiet, options.watch, options.video_every
+    seed_plots = options.seed_plots
     from cartpole_q.cli.report import print_multi_summary, print_single_summary
     from cartpole_q.experiments import run as runner
     from cartpole_q.progress import make_reporter

@@ -10,6 +10,7 @@ from cartpole_q.cli.studies import (
     Resume,
     StudyFileArgument,
     StudyOut,
+    StudyRequest,
     run_study_command,
 )
 
@@ -28,5 +29,7 @@ def updates_command(
     check: Check = False,
 ) -> None:
     """`study` for planning-update studies (chapter 8: figure kinds expected_vs_sample, trajectory_sampling, until_optimal); the last line is its directory."""
-    run_study_command("updates", "updates", study_file, resume, out, workers, backend, address,
-                      max_runs, yes, quiet, check)  # fmt: skip
+    request = StudyRequest(
+        study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
+    )
+    run_study_command("updates", "updates", request)

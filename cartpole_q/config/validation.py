@@ -45,6 +45,7 @@ from cartpole_q.learning_curves import INFO_KEY_PATTERN
 from cartpole_q.rl.algorithm import Param, ParamValue
 from cartpole_q.rl.algorithms import get as get_algorithm
 from cartpole_q.rl.algorithms import names as algorithm_names
+from cartpole_q.rl.prediction import RUN_POLICIES
 from cartpole_q.rl.schedules import SCHEDULE_KINDS, smallest_positive_value
 
 _NAME_PATTERN = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
@@ -190,7 +191,7 @@ def named_policy_problem(name: str, run: str, env_id: str, tiled: bool) -> tuple
     """
     from cartpole_q.families import profile_for
 
-    if name in ("greedy", "epsilon_greedy"):
+    if name in RUN_POLICIES:
         return _policy_run_problem(name, run, tiled)
     if run:
         return (

@@ -25,7 +25,13 @@ from cartpole_q.families import profile_for
 from cartpole_q.numba_cache import is_cached
 from cartpole_q.rl.algorithm import Algorithm, MemoryContext
 from cartpole_q.rl.algorithms import get as get_algorithm
-from cartpole_q.rl.prediction import policy_table
+from cartpole_q.rl.prediction import (
+    POLICY,
+    POLICY_EPSILON,
+    POLICY_RUN,
+    RUN_POLICIES,
+    policy_table,
+)
 from cartpole_q.rl.schedules import SAMPLE_AVERAGE, SCHEDULE_KINDS, schedule_value
 from cartpole_q.rl.solvers import (
     evaluate_policy,
@@ -422,11 +428,11 @@ class EvaluatedPolicy:
     on a world needs no algorithm to be evaluated exactly.
     """
 
-    name: str = "random"
+    name: str = str(POLICY.default)
     """``agent.policy``: ``random``, a rule the world declares, ``greedy`` or ``epsilon_greedy``"""
-    run: str = ""
-    """``agent.policy_run``: the control run whose table gives a run's policy"""
-    epsilon: float = 0.1
+    run: str = str(POLICY_RUN.default)
+    """``agent.policy_run``: the control run whose table gives a run's policy (absolute)"""
+    epsilon: float = float(POLICY_EPSILON.default)
     """``agent.policy_epsilon``: ``epsilon_greedy``'s probability of a uniform action"""
 
     @classmethod
@@ -434,19 +440,19 @@ class EvaluatedPolicy:
         """The policy a (prediction) config evaluates; a control config's is ``random``."""
         params = config.agent.params
         return cls(
-            str(params.get("policy", cls.name)),
-            str(params.get("policy_run", cls.run)),
-            float(params.get("policy_epsilon", cls.epsilon)),
+            str(params.get(POLICY.key, cls.name)),
+            str(params.get(POLICY_RUN.key, cls.run)),
+            float(params.get(POLICY_EPSILON.key, cls.epsilon)),
         )
 
     @property
     def from_run(self) -> bool:
         """Whether a run's table gives it (``greedy``, ``epsilon_greedy``)."""
-        return self.name in ("greedy", "epsilon_greedy")
+        return self.name in RUN_POLICIES
 
     def params(self) -> dict[str, Any]:
         """Its keys as a prediction algorithm's parameters name them (for its policy table)."""
-        return {"policy": self.name, "policy_run": self.run, "policy_epsilon": self.epsilon}
+        return {POLICY.key: self.name, POLICY_RUN.key: self.run, POLICY_EPSILON.key: self.epsilon}
 
     def table(self, env: EnvConfig, env_info: EnvInfo) -> np.ndarray:
         """``pi`` on the table's rows: each row's probability of each action."""

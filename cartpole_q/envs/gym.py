@@ -527,8 +527,8 @@ def registered_spec(env: EnvConfig, source: str | Provenance = "config") -> Any:
     would, which registers it.
 
     Raises:
-        ConfigError: naming ``env.id``: as :func:`check_env_id`, or its module registers no
-            such id.
+        ConfigError: naming ``env.id``: as :func:`check_env_id`, its module cannot be
+            imported, or it registers no such id.
     """
     import importlib
 
@@ -539,7 +539,15 @@ def registered_spec(env: EnvConfig, source: str | Provenance = "config") -> Any:
     if spec is None:
         check_env_id(env.id, source)
         if module:
-            importlib.import_module(module)
+            try:
+                importlib.import_module(module)
+            except Exception as error:  # (a module's own code runs: anything may fail)
+                detail = shorten(str(error).split(". ")[0], 200)
+                raise ConfigError(
+                    f"{blame(source, 'env.id')}: env.id: cannot make {env.id!r}: the module "
+                    f"{module!r} cannot be imported ({type(error).__name__}: {detail}); "
+                    "install it, or check the part of env.id before ':'."
+                ) from None
         spec = gymnasium.registry.get(name)
     if spec is None:
         raise ConfigError(

@@ -10,6 +10,7 @@ optimum without a run.
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -433,15 +434,20 @@ def _evaluated_policy(name: str, keys: Mapping[str, Any], env_id: str) -> Evalua
     """
     from cartpole_q.config.validation import named_policy_problem
     from cartpole_q.engines.base import EvaluatedPolicy
-    from cartpole_q.rl.prediction import POLICIES
+    from cartpole_q.rl.prediction import POLICIES, POLICY_EPSILON
 
     if name not in POLICIES:
         raise UserError(f"--policy {name}: not a policy; give one of {', '.join(POLICIES)}.")
-    epsilon = keys.get("agent.policy_epsilon", EvaluatedPolicy.epsilon)
-    if isinstance(epsilon, bool) or not isinstance(epsilon, int | float) or not 0 <= epsilon <= 1:
-        raise UserError(f"--set agent.policy_epsilon={epsilon}: give a number in [0, 1].")
+    epsilon = keys.get("agent.policy_epsilon", POLICY_EPSILON.default)
+    number = isinstance(epsilon, int | float) and not isinstance(epsilon, bool)
+    if not number or not POLICY_EPSILON.low <= epsilon <= POLICY_EPSILON.high:
+        raise UserError(
+            f"--set agent.policy_epsilon={epsilon}: give a number in {POLICY_EPSILON.interval}."
+        )
     run = str(keys.get("agent.policy_run", ""))
     problem = named_policy_problem(name, run, env_id, tiled=False)
+    if run:  # as a config's agent.policy_run is read: from here, ~ expanded
+        run = os.path.abspath(os.path.expanduser(run))
     if problem is not None:
         key, why = problem
         option = "--policy" if key == "agent.policy" else f"--set {key}"

@@ -29,7 +29,6 @@ from cartpole_q.config import (
     shown_value,
 )
 from cartpole_q.engines.plan import planned, planning
-from cartpole_q.envs.gym import EnvInfo
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
@@ -392,11 +391,10 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     if figure.against is not None:
         return plot_against(spec, paths, directory / figure.file)
-    if figure.metric in (VALUES_FIGURE, POLICY_FIGURE):
-        # each point's plan: made when it ran, in this command's planning scope
-        facts = [planned(point.config).env_info for point in spec.points]
-        plot = plot_values if figure.metric == VALUES_FIGURE else plot_policy
-        return plot(spec, facts, paths, labels, directory / figure.file)
+    if figure.metric == VALUES_FIGURE:
+        return plot_values(spec, paths, labels, directory / figure.file)
+    if figure.metric == POLICY_FIGURE:
+        return plot_policy(spec, paths, labels, directory / figure.file)
     return plot_metric(
         paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
         figure.smooth, figure.log_y, force=True, style=style,
@@ -536,13 +534,7 @@ def _seed_means(spec: SweepSpec, path: Path) -> list[float]:
     return means
 
 
-def plot_values(
-    spec: SweepSpec,
-    facts: Sequence[EnvInfo],
-    paths: Sequence[Path],
-    labels: Sequence[str],
-    out: Path,
-) -> Path:
+def plot_values(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path) -> Path:
     """The ``figure.metric: values`` figure: each point's learned ``V`` against the state.
 
     One line per point (the mean of its seeds' ``V`` on the measured states, a 95% bootstrap
@@ -551,11 +543,14 @@ def plot_values(
     left panel. The x axis is the world's true state (:attr:`Truth.states`): where the world
     aggregates states, each state shows ``V`` of its group (Figures 9.1, 9.2), a staircase.
     With ``figure.distribution`` the on-policy distribution is shaded on a second axis.
+    Each point's environment facts are its plan's (the one it ran with, in this command's
+    planning scope, or made here).
     """
     from cartpole_q.engines.base import prediction_distribution, prediction_truth
 
     figure = spec.figure
     assert figure is not None
+    facts = [planned(point.config).env_info for point in spec.points]
     first, info = spec.points[0].config, facts[0]
     if profile_for(first.env.id).policy_map == "blackjack":  # Figure 5.1's value surfaces
         maps = []
@@ -682,13 +677,7 @@ def policy_match(q_table: np.ndarray, q_star: np.ndarray) -> PolicyMatch:
     return PolicyMatch(200, matching, indifferent, tuple(differing), error)
 
 
-def plot_policy(
-    spec: SweepSpec,
-    facts: Sequence[EnvInfo],
-    paths: Sequence[Path],
-    labels: Sequence[str],
-    out: Path,
-) -> Path:
+def plot_policy(spec: SweepSpec, paths: Sequence[Path], labels: Sequence[str], out: Path) -> Path:
     """The ``figure.metric: policy`` figure: greedy policies and ``max_b Q`` beside the optimum.
 
     Each point's table is the mean of its seeds' ``Q``; its greedy policy (lowest action on
@@ -703,7 +692,7 @@ def plot_policy(
         return _plot_racetrack(spec, paths, labels, out)
     if profile_for(first.env.id).grid is not None:
         return _plot_grid_arrows(spec, paths, labels, out)
-    info = facts[0]
+    info = planned(first).env_info
     q_star, optimal, v_star = blackjack_optimum(first)
     maps = []
     for label, path in zip(labels, paths, strict=True):

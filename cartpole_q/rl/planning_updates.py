@@ -201,7 +201,6 @@ def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
     )
 
 
-@compilable
 class Task(NamedTuple):
     """One of Figure 8.8's random tasks: its size and how episodes end."""
 
@@ -226,6 +225,7 @@ class Curve(NamedTuple):
     """policy evaluation of the greedy policy stops at this largest change"""
 
 
+@compilable
 def trajectory_run(
     next_states: np.ndarray,
     rewards: np.ndarray,

@@ -36,6 +36,9 @@ the one-state MDP's "always left" (Example 5.5); ``greedy`` and ``epsilon_greedy
 control run's policy (``agent.policy_run``: its ``q_table.npy``), greedy or epsilon-greedy
 with ``agent.policy_epsilon``"""
 
+RUN_POLICIES = ("greedy", "epsilon_greedy")
+"""the policies a control run's table gives (``agent.policy_run``)"""
+
 DRAWN = POLICIES.index("epsilon_greedy")
 """the code of the one policy whose actions are drawn from its table's probabilities"""
 

@@ -148,7 +148,7 @@ def _named_record_hooks(algorithm: Algorithm) -> Algorithm:
     :class:`~cartpole_q.rl.tabular.Rates` since 0.x; a plug-in's ``step`` (or ``end``)
     written for the 13 (7) positional arguments before still runs, through an adapter
     compiled with it (numba inlines both: nothing is lost at run time), with a
-    ``DeprecationWarning``. The CHANGELOG says how to update one.
+    ``FutureWarning``. The CHANGELOG says how to update one.
     """
     from dataclasses import replace
 
@@ -168,7 +168,7 @@ def _named_record_hooks(algorithm: Algorithm) -> Algorithm:
             f"algorithm {algorithm.name!r}: its {hook} hook takes the {arguments} positional "
             f"arguments of before; hooks now take named records ({hook}(q, memory, params, "
             f"{'transition, ' if hook == 'step' else ''}rates, rng)): see the CHANGELOG",
-            DeprecationWarning,
+            FutureWarning,  # (shown by default: a plug-in is imported, never __main__)
             stacklevel=3,
         )
         namespace = {**template.__globals__, placeholder: compilable(function)}
