@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 
 import cartpole_q.figures as figures
 from cartpole_q.errors import WriteError
-from cartpole_q.figures import DATA_COLUMNS, DataFigure, policy_figure
+from cartpole_q.figures import DATA_COLUMNS, DataFigure, MapDimensions, policy_figure
 from cartpole_q.store.atomic import atomic_write_together
 from tests.conftest import invoke, write_yaml
 
@@ -172,7 +172,7 @@ def test_a_policy_map_writes_each_cell_at_its_centre() -> None:
     visits = np.ones_like(q, dtype=np.int64)
     visits[0, 0, 1, 2] = 0  # never visited: blank on the map, empty in the data
     figure = policy_figure(
-        q, visits, (2, 3), [-2.4, -3, -0.2, -2], [2.4, 3, 0.2, 2], ["a", "b", "c", "d"], "t"
+        q, visits, MapDimensions((2, 3), [-2.4, -3, -0.2, -2], [2.4, 3, 0.2, 2], list("abcd")), "t"
     )
     rows = list(csv.DictReader(figure.data.csv_text().splitlines()))
     actions = series(rows, "greedy action")["action"]
@@ -187,7 +187,7 @@ def test_a_policy_map_writes_each_cell_at_its_centre() -> None:
     visits_rows = series(rows, "training visits (log scale)")["visits"]
     assert [row["value"] for row in visits_rows] == ["2", "2", "2", "2", "2", ""]
     # a table without visit counts (tiles) draws a blank visits panel: no rows for it
-    blank = policy_figure(q, None, (2, 3), [0] * 4, [1] * 4, list("abcd"), "t")
+    blank = policy_figure(q, None, MapDimensions((2, 3), [0] * 4, [1] * 4, list("abcd")), "t")
     panels = {row["panel"] for row in csv.DictReader(blank.data.csv_text().splitlines())}
     assert panels == {"greedy action", "state value max_a Q"}
 

@@ -13,6 +13,7 @@ from rich.console import Console
 
 from cartpole_q.figures import (
     Curve,
+    MapDimensions,
     SeedBand,
     action_names,
     bootstrap_band,
@@ -49,7 +50,7 @@ def test_policy_map_shows_the_argmax_of_a_hand_made_table() -> None:
     q[0, 0, 1] = [[0.0, 3.0], [7.0, 1.0], [0.5, 0.6]]
     visits = np.ones_like(q, dtype=np.int64)
     figure = policy_figure(
-        q, visits, (2, 3), [-2.4, -3, -0.2, -2], [2.4, 3, 0.2, 2], ["a", "b", "c", "d"], "t"
+        q, visits, MapDimensions((2, 3), [-2.4, -3, -0.2, -2], [2.4, 3, 0.2, 2], list("abcd")), "t"
     )
     shown = np.asarray(figure.axes[0].images[0].get_array())
     assert shown.tolist() == np.argmax(q[0, 0], axis=-1).tolist() == [[0, 1, 0], [1, 0, 1]]
@@ -78,7 +79,7 @@ def test_unvisited_states_are_blank_in_the_policy_map() -> None:
     q = np.arange(8, dtype=float).reshape(1, 1, 2, 2, 2)
     visits = np.zeros_like(q, dtype=np.int64)
     visits[0, 0, 1, 1, 0] = 3
-    figure = policy_figure(q, visits, (2, 3), [0] * 4, [1] * 4, list("abcd"), "t")
+    figure = policy_figure(q, visits, MapDimensions((2, 3), [0] * 4, [1] * 4, list("abcd")), "t")
     shown = figure.axes[0].images[0].get_array()
     assert np.ma.getmaskarray(shown).tolist() == [[True, True], [True, False]]
 
@@ -111,7 +112,9 @@ def test_reward_curve_with_seed_band_decodes() -> None:
 def test_policy_map_has_one_labelled_colour_per_action() -> None:
     q = np.random.default_rng(0).normal(size=(1, 1, 4, 5, 3))
     names = action_names("MountainCar-v0", 3)
-    figure = policy_figure(q, None, (2, 3), [0] * 4, [1] * 4, list("abcd"), "t", names)
+    figure = policy_figure(
+        q, None, MapDimensions((2, 3), [0] * 4, [1] * 4, list("abcd")), "t", names
+    )
     image = figure.axes[0].images[0]
     assert image.cmap.N == 3 and image.norm(np.array([0, 1, 2])).tolist() == [0, 1, 2]
     bar = figure.axes[3]  # the colour bar next to the first panel

@@ -151,8 +151,9 @@ def test_the_eligibility_vector_is_the_gradient_of_log_pi(
     index = np.arange(8, dtype=np.int64).reshape(4, 2) % 4
     value = np.array([[1.0, 0.5], [0.0, 2.0], [1.5, 0.0], [0.3, 0.7]])
     agent = methods.new_agent(
-        "reinforce", 0.1, 0.0, 1.0, 0.0, 2, (index, value), np.asarray(theta),
-        (np.zeros((2, 1), dtype=np.int64), np.ones((2, 1))), np.zeros(1),
+        "reinforce", methods.Settings(0.1, 0.0, 1.0), 2,
+        methods.Layer(index, value, np.asarray(theta)),
+        methods.Layer(np.zeros((2, 1), dtype=np.int64), np.ones((2, 1)), np.zeros(1)),
     )  # fmt: skip
 
     def log_pi(weights: np.ndarray) -> float:
@@ -173,8 +174,9 @@ def test_the_eligibility_vector_is_the_gradient_of_log_pi(
 def test_the_floor_keeps_either_action_at_least_as_likely_as_it_says() -> None:
     index, value = np.array([[0], [1]]), np.ones((2, 1))
     agent = methods.new_agent(
-        "reinforce", 0.1, 0.0, 1.0, 0.05, 2, (index, value), np.array([-9.0, 9.0]),
-        (np.zeros((1, 1), dtype=np.int64), np.ones((1, 1))), np.zeros(1),
+        "reinforce", methods.Settings(0.1, 0.0, 1.0, floor=0.05), 2,
+        methods.Layer(index, value, np.array([-9.0, 9.0])),
+        methods.Layer(np.zeros((1, 1), dtype=np.int64), np.ones((1, 1)), np.zeros(1)),
     )  # fmt: skip
     methods.policy(agent, 0)
     assert agent.probabilities.tolist() == [0.05, 0.95]

@@ -2,34 +2,11 @@
 
 from __future__ import annotations
 
-from cartpole_q.cli.base import BackendChoice, Command, app
-from cartpole_q.cli.options import Address, Backend, Quiet, Workers, Yes
-from cartpole_q.cli.studies import (
-    Check,
-    MaxRuns,
-    Resume,
-    StudyFileArgument,
-    StudyOut,
-    StudyRequest,
-    run_study_command,
-)
+from cartpole_q.cli.base import Command, app
+from cartpole_q.cli.studies import study_command
 
-
-@app.command("dp", cls=Command)
-def dp_command(
-    study_file: StudyFileArgument = None,
-    resume: Resume = None,
-    out: StudyOut = None,
-    workers: Workers = None,
-    backend: Backend = BackendChoice.local,
-    address: Address = None,
-    max_runs: MaxRuns = 20_000,
-    yes: Yes = False,
-    quiet: Quiet = False,
-    check: Check = False,
-) -> None:
-    """`study` for dynamic-programming studies (chapters 3-4); the last line is its directory."""
-    request = StudyRequest(
-        study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
-    )
-    run_study_command("dp", "dp", request)
+app.command(
+    "dp",
+    cls=Command,
+    help="`study` for dynamic-programming studies (chapters 3-4); the last line is its directory.",
+)(study_command)

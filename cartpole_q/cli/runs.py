@@ -85,7 +85,7 @@ def eval_command(
         from cartpole_q.cli.exact_text import exact_lines, exact_seeds_line
         from cartpole_q.cli.report import eval_line, eval_seeds_text
         from cartpole_q.config import parse_assignment
-        from cartpole_q.experiments.evaluate_runs import evaluate_run, evaluate_seeds
+        from cartpole_q.experiments.evaluate_runs import Recording, evaluate_run, evaluate_seeds
         from cartpole_q.store.runsets import check_tables, load_run_set
 
         changed = dict(parse_assignment(text, "--physics") for text in physics or [])
@@ -114,10 +114,10 @@ def eval_command(
             from cartpole_q.store.video import check_renderer
 
             check_renderer(run_set.runs[0].config.env.id, f"{run_dir}: --video")
+        recording = None if video is None else Recording(video, video_episodes, force)
         evaluation = evaluate_run(
             run_set.runs[0], episodes=episodes, seed=seed, physics=changed, max_steps=max_steps,
-            video=video, video_episodes=video_episodes, render=render, force=force,
-            engine=engine.value,
+            recording=recording, render=render, engine=engine.value,
         )  # fmt: skip
         if json_output:
             typer.echo(json.dumps(evaluation.to_json()))
@@ -228,7 +228,13 @@ def plot(
 ) -> None:
     """Draw reward curves (or, with --policy, a policy map) as PNG, SVG or PDF; print its path."""
     with exit_codes():
-        from cartpole_q.experiments.plots import plot_metric, plot_policy, plot_rewards
+        from cartpole_q.experiments.plots import (
+            CurveStyle,
+            MetricView,
+            plot_metric,
+            plot_policy,
+            plot_rewards,
+        )
         from cartpole_q.learning_curves import AGGREGATES, X_AXES, check_metric
         from cartpole_q.store.rundir import CURVE_FILE
 
@@ -258,8 +264,8 @@ def plot(
             default = run_dirs[0] / name if len(run_dirs) == 1 else name
             replace = force or (out is None and len(run_dirs) == 1)
             path = plot_metric(
-                run_dirs, out or default, metric, x_axis, aggregate, smooth, log_y, replace,
-                on_note=note, all_points=all_points,
+                run_dirs, out or default, MetricView(metric, x_axis, aggregate, smooth), replace,
+                on_note=note, style=CurveStyle(log_y=log_y, all_points=all_points),
             )  # fmt: skip
             typer.echo(str(path))
             return
@@ -337,16 +343,21 @@ def robustness_command(
     with exit_codes():
         import sys
 
-        from cartpole_q.experiments.robustness import parse_vary, preset_axes, robustness
+        from cartpole_q.experiments.robustness import (
+            Measurement,
+            parse_vary,
+            preset_axes,
+            robustness,
+        )
         from cartpole_q.progress import ROBUSTNESS_UNITS, make_sweep_progress
 
         if (preset is None) == (not vary):
             raise UserError("give --vary KEY=START:STOP:N (once or twice) or --preset NAME.")
         axes = preset_axes(preset, points) if preset else [parse_vary(text) for text in vary or []]
         figure, table = robustness(
-            run_dir, axes, episodes, seed, out or run_dir / "robustness.png", force, max_steps,
-            yes=yes, progress=make_sweep_progress(quiet, sys.stderr, ROBUSTNESS_UNITS),
-            on_note=note,
+            run_dir, Measurement(axes, episodes, seed, max_steps),
+            out or run_dir / "robustness.png", force=force, yes=yes,
+            progress=make_sweep_progress(quiet, sys.stderr, ROBUSTNESS_UNITS), on_note=note,
         )  # fmt: skip
         typer.echo(str(table))
         typer.echo(str(figure))

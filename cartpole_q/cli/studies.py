@@ -65,8 +65,25 @@ STOP_POINT = "the runs in flight, saving what has finished"
 """what a study does on a first signal"""
 
 
-@app.command("study", cls=Command)
+ALIAS_KINDS: dict[str, str | None] = {
+    "study": None,
+    "sweep": None,
+    "dp": "dp",
+    "updates": "updates",
+}
+"""each name :func:`study_command` answers to, and the kind it runs (``None``: any); the
+older names are aliases for one release (``bandit``, with its ``--engine``, is its own)"""
+
+
+@app.command(
+    "sweep",
+    cls=Command,
+    help="Train and evaluate every point of a sweep on every seed (`study` under its first "
+    "name); the last line is its directory.",
+)
+@app.command("study", cls=Command)  # registered first: listed first
 def study_command(
+    ctx: typer.Context,
     study_file: StudyFileArgument = None,
     resume: Resume = None,
     out: StudyOut = None,
@@ -79,33 +96,12 @@ def study_command(
     check: Check = False,
 ) -> None:
     """Run any study file (a sweep, bandits, dynamic programming, planning updates); the last line is its directory."""
+    # One function under several names: the name it was called by says which kind it runs.
+    command = ctx.info_name or "study"
     request = StudyRequest(
         study_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
     )
-    run_study_command("study", None, request)
-
-
-@app.command("sweep", cls=Command)
-def sweep_command(
-    sweep_file: Annotated[
-        Path | None,
-        typer.Argument(metavar="SWEEP.yaml", help=STUDY_FILE_HELP, show_default=False),
-    ] = None,
-    resume: Resume = None,
-    out: StudyOut = None,
-    workers: Workers = None,
-    backend: Backend = BackendChoice.local,
-    address: Address = None,
-    max_runs: MaxRuns = 20_000,
-    yes: Yes = False,
-    quiet: Quiet = False,
-    check: Check = False,
-) -> None:
-    """Train and evaluate every point of a sweep on every seed (`study` under its first name); the last line is its directory."""
-    request = StudyRequest(
-        sweep_file, resume, out, workers, backend, address, max_runs, yes, quiet, check
-    )
-    run_study_command("sweep", None, request)
+    run_study_command(command, ALIAS_KINDS[command], request)
 
 
 @dataclass(frozen=True)

@@ -243,8 +243,9 @@ def _train_into(run_dir: Path, prepared: Any, resume: bool, options: TrainOption
         try:
             if seeds is None:
                 outcome = runner.execute_run(
-                    run_dir, prepared, resume=resume, should_stop=stop.is_set, reporter=reporter,
-                    watch_every=watch, video_every=video_every,
+                    run_dir, prepared, resume=resume, should_stop=stop.is_set,
+                    reporting=runner.Reporting(reporter), watch_every=watch,
+                    video_every=video_every,
                 )  # fmt: skip
                 summary = outcome.summary
             else:

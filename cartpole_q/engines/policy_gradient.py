@@ -227,7 +227,7 @@ def warm_up() -> None:
     this compiles what every policy-gradient study plays (``cartpole-q compile --all``).
     """
     from cartpole_q.engines.linear import warm_up_world
-    from cartpole_q.rl.policy_gradient import ALGORITHMS, new_agent
+    from cartpole_q.rl.policy_gradient import ALGORITHMS, Layer, Settings, new_agent
 
     world, n_states, n_actions = warm_up_world("cartpole_q/ShortCorridor-v0", False, 20)
     policy_rows = (
@@ -238,7 +238,7 @@ def warm_up() -> None:
     for algorithm in ALGORITHMS:
         for engine in ENGINES:
             agent = new_agent(
-                algorithm, 0.01, 0.01, 1.0, 0.05, n_actions, policy_rows,
-                np.zeros(n_states * n_actions), value_rows, np.zeros(1), (0.5, 0.5),
+                algorithm, Settings(0.01, 0.01, 1.0, 0.05, (0.5, 0.5)), n_actions,
+                Layer(*policy_rows, np.zeros(n_states * n_actions)), Layer(*value_rows, np.zeros(1)),
             )  # fmt: skip
             run(agent, world, 0, 1, engine)

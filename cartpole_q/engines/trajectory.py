@@ -16,12 +16,11 @@ import numpy as np
 
 from cartpole_q.engines.compile import specialise
 from cartpole_q.rl.planning_updates import (
-    TRAJECTORY_CARRY,
     Curve,
     Task,
     task_draws,
+    trajectory_progress,
     trajectory_run,
-    trajectory_tables,
 )
 
 LOOP_NAME = "planning_trajectory_run"
@@ -78,15 +77,11 @@ def task_curves(
     run = _loop() if compiled else trajectory_run
     curves = []
     for on_policy in (False, True):
-        out = np.empty(curve.updates // curve.every + 1)
-        tables = trajectory_tables(task.states, task.actions)
-        carry = np.zeros(TRAJECTORY_CARRY, dtype=np.int64)
+        progress = trajectory_progress(task, curve)
         complete = False
         while not complete:
             if should_stop is not None and should_stop():
                 return None
-            complete = run(
-                next_states, rewards, task, curve, on_policy, rng, out, tables, carry, CHUNK_WORK
-            )
-        curves.append(out)
+            complete = run(next_states, rewards, task, curve, on_policy, rng, progress, CHUNK_WORK)
+        curves.append(progress.out)
     return curves[0], curves[1]

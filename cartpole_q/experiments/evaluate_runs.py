@@ -62,6 +62,18 @@ class RunEvaluation:
         return data
 
 
+@dataclass(frozen=True)
+class Recording:
+    """Where ``eval --video`` records, and how much: a GIF or MP4 of the first episodes."""
+
+    path: Path
+    """the ``.gif`` or ``.mp4`` file"""
+    episodes: int = 1
+    """how many of the played episodes it records"""
+    force: bool = False
+    """replace an existing file"""
+
+
 def evaluate_run(
     run: Run,
     *,
@@ -69,10 +81,8 @@ def evaluate_run(
     seed: int | None = None,
     physics: Mapping[str, Any] | None = None,
     max_steps: int | None = None,
-    video: Path | None = None,
-    video_episodes: int = 1,
+    recording: Recording | None = None,
     render: bool = False,
-    force: bool = False,
     engine: str = "gymnasium",
 ) -> RunEvaluation:
     """Play one run's greedy policy in ``gymnasium.make``, maybe recording or showing it.
@@ -83,22 +93,20 @@ def evaluate_run(
         seed: the first reset's seed (default: the run's ``eval.seed``).
         physics: play under these ``env.physics`` values instead.
         max_steps: play with this time limit instead.
-        video: record the first ``video_episodes`` episodes as this GIF or MP4.
-        video_episodes: how many episodes ``video`` records.
+        recording: record the first episodes as a GIF or MP4.
         render: show the episodes in Gymnasium's window.
-        force: let ``video`` replace an existing file.
         engine: ``gymnasium``, or ``numba`` to play on the compiled twin (no video, no window).
 
     Raises:
-        UserError: ``render`` and ``video`` together, ``render`` without a display, or a
-            ``video`` path that cannot be written (checked before any episode is played);
-            ``video`` or ``render`` with ``numba``.
+        UserError: ``render`` and ``recording`` together, ``render`` without a display, or
+            a ``recording`` path that cannot be written (checked before any episode is
+            played); ``recording`` or ``render`` with ``numba``.
         ConfigError: ``physics`` or ``max_steps`` do not fit the environment, or the
             environment has no twin under them (``numba``).
     """
     from cartpole_q.envs.gym import config_threshold, display_problem
 
-    if engine != "gymnasium" and (render or video is not None):
+    if engine != "gymnasium" and (render or recording is not None):
         raise UserError(
             f"--{'render' if render else 'video'} shows gymnasium.make's own drawing: it "
             f"cannot be combined with --engine {engine} (the compiled twin draws nothing)."
@@ -107,14 +115,14 @@ def evaluate_run(
     if physics or max_steps is not None:
         run = dataclasses.replace(run, config=under_conditions(run.config, physics, max_steps))
         threshold = config_threshold(run.config)
-    if render and video is not None:
+    if render and recording is not None:
         raise UserError("--render and --video cannot be combined: choose one.")
     if render and (problem := display_problem()) is not None:
         raise UserError(
             f"--render needs a display, but {problem}; "
             "record the episodes with --video FILE.gif instead."
         )
-    if video is None:
+    if recording is None:
         report = evaluate(
             run.q_table, run.config, episodes=episodes, seed=seed,
             render_mode="human" if render else None, engine=engine,
@@ -123,7 +131,9 @@ def evaluate_run(
         from cartpole_q.store.video import VideoRecorder, offscreen_rendering
 
         # The recorder checks the file (extension, directory, an existing file) before playing.
-        with VideoRecorder(video, episodes=video_episodes, force=force) as recorder:
+        with VideoRecorder(
+            recording.path, episodes=recording.episodes, force=recording.force
+        ) as recorder:
             with offscreen_rendering():
                 report = evaluate(
                     run.q_table, run.config, episodes=episodes, seed=seed,

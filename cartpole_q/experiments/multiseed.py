@@ -22,6 +22,7 @@ from cartpole_q.engines.plan import Plan, keep_plan, planned, planning
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
 from cartpole_q.experiments.run import (
+    Reporting,
     check_resumable,
     execute_run,
     outcome_line,
@@ -153,9 +154,10 @@ def _train_seeds(
         path = Path(child)
         config = load_config(path / rundir.CONFIG_FILE)
         plan = planned(config, str(path / rundir.CONFIG_FILE))
+        reporting = Reporting(reporter, f"worker {os.getpid()}", f"seed {seed}")
         outcome = execute_run(
-            path, plan, resume=resume, should_stop=handle.should_stop, reporter=reporter,
-            key=f"worker {os.getpid()}", label=f"seed {seed}", plot=plot,
+            path, plan, resume=resume, should_stop=handle.should_stop, reporting=reporting,
+            plot=plot,
         )  # fmt: skip
         yield seed, outcome.result.interrupted
 

@@ -23,6 +23,7 @@ from cartpole_q.figures import (
     DRAWN_POINTS,
     Curve,
     GridMap,
+    MapDimensions,
     MetricBand,
     SeedBand,
     action_names,
@@ -134,38 +135,47 @@ class CurveStyle:
     """the y axis's ends (``None``: matplotlib's choice), as the book's figure shows it"""
     log_x: bool = False
     """a logarithmic x axis (S&B Figures 5.3 and 5.4)"""
+    log_y: bool = False
+    """a logarithmic y axis (S&B Figure 10.2's steps per episode)"""
+    all_points: bool = False
+    """draw (and write) every point of a long curve, not
+    :data:`~cartpole_q.figures.DRAWN_POINTS` of them"""
+
+
+@dataclass(frozen=True)
+class MetricView:
+    """What :func:`plot_metric` draws: a metric against an x axis, over seeds, maybe smoothed."""
+
+    metric: str
+    """one of :data:`cartpole_q.learning_curves.METRICS`, or ``info:KEY`` (runs trained with
+    ``train.info_metric: KEY``)"""
+    x: str
+    """one of :data:`cartpole_q.learning_curves.X_AXES`"""
+    aggregate: str = "mean"
+    """``mean`` or ``iqm`` over seeds"""
+    window: int = 1
+    """a trailing moving average of per-episode values (``return``, ``length``)"""
 
 
 def plot_metric(
     run_dirs: Sequence[Path],
     out: Path,
-    metric: str,
-    x: str,
-    aggregate: str = "mean",
-    window: int = 1,
-    log_y: bool = False,
+    view: MetricView,
     force: bool = False,
     on_note: Callable[[str], None] | None = None,
     style: CurveStyle | None = None,
-    all_points: bool = False,
 ) -> Path:
     """Draw a metric's learning curves of runs, multi-seed runs and sweep points.
 
     Args:
         run_dirs: Run directories, multi-seed runs or sweep points, one curve each.
         out: A ``.png``, ``.svg`` or ``.pdf`` file; its data goes beside it as ``.csv``.
-        metric: One of :data:`cartpole_q.learning_curves.METRICS`, or ``info:KEY`` (runs
-            trained with ``train.info_metric: KEY``).
-        x: One of :data:`cartpole_q.learning_curves.X_AXES`.
-        aggregate: ``mean`` or ``iqm`` over seeds.
-        window: Trailing moving average of per-episode values (``return``, ``length``).
-        log_y: A logarithmic y axis (S&B Fig. 10.2's steps per episode).
+        view: The metric, the x axis, the aggregate over seeds and the smoothing window.
         force: Replace ``out`` (and its ``.csv``) if they exist.
         on_note: Told what is unfinished or left out.
-        style: Labels, a transform of the values and a reference line (a sweep file's
-            ``figure``); default: the directories' names, the values as they are.
-        all_points: Draw (and write) every point of a long curve, not
-            :data:`~cartpole_q.figures.DRAWN_POINTS` of them.
+        style: Labels, a transform of the values, a reference line, log axes and how many
+            points are drawn (a sweep file's ``figure``, ``plot --log-y``); default: the
+            directories' names, the values as they are.
 
     Raises:
         RunError: A directory is not a complete run, a sweep point kept no curves, or
@@ -174,6 +184,7 @@ def plot_metric(
             is drawn).
     """
     style = style or CurveStyle()
+    metric, x, aggregate, window = view.metric, view.x, view.aggregate, view.window
     column = record_column(metric)
     bands = []
     for number, path in enumerate(run_dirs):
@@ -213,11 +224,11 @@ def plot_metric(
         X_LABELS[x],
         y_label,
         title,
-        log_y,
+        style.log_y,
         style.reference,
         style.y_limits,
         log_x=style.log_x,
-        most=None if all_points else DRAWN_POINTS,
+        most=None if style.all_points else DRAWN_POINTS,
     )
     return write_figure(out, figure)
 
@@ -379,7 +390,7 @@ def plot_policy(
         names, dims = [names[dims[0]], names[dims[1]]], (0, 1)
         title += f" ({grid.tilings} tilings; other dimensions at their centre)"
     figure = policy_figure(
-        q_table, visits, dims, low, high, names, title,
+        q_table, visits, MapDimensions(dims, low, high, names), title,
         action_names=action_names(env_id, q_table.shape[-1]), value_name=value_name,
     )  # fmt: skip
     return write_figure(out, figure)
@@ -453,7 +464,7 @@ def _plot_discrete_policy(
         low = [-0.5] * len(shape)
         high = [size - 0.5 for size in shape]
         figure = policy_figure(
-            table, counts, (0, 1), low, high, names, title, action_names=actions,
+            table, counts, MapDimensions((0, 1), low, high, names), title, action_names=actions,
             rows_down=profile.rows_down,
         )  # fmt: skip
     return write_figure(out, figure)

@@ -310,9 +310,11 @@ def new_agent(study: Study, curve: CurveSpec) -> methods.Agent:
     d, d_w = _weights(curve, facts)
     theta0 = np.full(d, curve.theta0[0]) if len(curve.theta0) == 1 else np.asarray(curve.theta0)
     w0 = np.full(d_w, curve.w0[0]) if len(curve.w0) == 1 else np.asarray(curve.w0)
+    settings = methods.Settings(curve.alpha, curve.alpha_w, study.gamma, curve.floor, curve.lambdas)
     return methods.new_agent(
-        curve.algorithm, curve.alpha, curve.alpha_w, study.gamma, curve.floor, facts.n_actions,
-        policy_rows(curve, facts), theta0, value_rows(curve, facts), w0, curve.lambdas,
+        curve.algorithm, settings, facts.n_actions,
+        methods.Layer(*policy_rows(curve, facts), theta0),
+        methods.Layer(*value_rows(curve, facts), w0),
     )  # fmt: skip
 
 

@@ -47,6 +47,20 @@ class Axis:
     values: np.ndarray
 
 
+@dataclass(frozen=True)
+class Measurement:
+    """What ``robustness`` plays: a grid of physics, and at each point the greedy episodes."""
+
+    axes: list[Axis]
+    """one varied key (a curve) or two (a heatmap)"""
+    episodes: int
+    """greedy episodes per seed and grid point"""
+    seed: int
+    """the first episode's reset seed (the next ones count up)"""
+    max_steps: int | None = None
+    """play with this time limit (default: the run's)"""
+
+
 def parse_vary(text: str) -> Axis:
     """Parse ``--vary KEY=START:STOP:N`` (``N`` values from START to STOP, both included).
 
@@ -98,12 +112,7 @@ MAX_EVALUATIONS = 5_000_000
 
 
 def measure(
-    run_set: RunSet,
-    axes: list[Axis],
-    episodes: int,
-    seed: int,
-    max_steps: int | None = None,
-    progress: SweepProgress | None = None,
+    run_set: RunSet, measurement: Measurement, progress: SweepProgress | None = None
 ) -> tuple[np.ndarray, list[float], float | None]:
     """Each seed's greedy mean return at each grid point (its values checked: :func:`check_values`).
 
@@ -112,6 +121,8 @@ def measure(
         training value; the threshold at the horizon played (``max_steps``, else the run's).
     """
     progress = progress or NullSweepProgress()
+    axes, max_steps = measurement.axes, measurement.max_steps
+    episodes, seed = measurement.episodes, measurement.seed
     runs = run_set.runs
     config = run_set.config
     spec = varied_physics(run_set, axes)
@@ -187,13 +198,10 @@ def check_size(run_set: RunSet, axes: list[Axis], episodes: int, yes: bool) -> N
 
 def robustness(
     run_dir: Path,
-    axes: list[Axis],
-    episodes: int,
-    seed: int,
+    measurement: Measurement,
     out: Path,
-    force: bool = False,
-    max_steps: int | None = None,
     *,
+    force: bool = False,
     yes: bool = False,
     progress: SweepProgress | None = None,
     on_note: Callable[[str], None] | None = None,
@@ -212,6 +220,7 @@ def robustness(
             more greedy episodes than :data:`MAX_EVALUATIONS` without ``yes``.
         WriteError: the files cannot be written (checked before measuring).
     """
+    axes, episodes, max_steps = measurement.axes, measurement.episodes, measurement.max_steps
     if not 1 <= len(axes) <= 2 or len({axis.key for axis in axes}) != len(axes):
         raise UserError("--vary: give one key (a curve) or two different keys (a heatmap).")
     run_set = load_run_set(run_dir)
@@ -224,7 +233,7 @@ def robustness(
     for note in run_set.notes:
         if on_note is not None:
             on_note(note)
-    means, trained, threshold = measure(run_set, axes, episodes, seed, max_steps, progress)
+    means, trained, threshold = measure(run_set, measurement, progress)
     seeds = [run.config.seed for run in run_set.runs]
     atomic_write_text(table_path, _csv(axes, means, seeds))
     horizon = "" if max_steps is None else f" of {max_steps} steps"

@@ -55,6 +55,17 @@ class Outcome:
     summary: RunSummary
 
 
+@dataclass(frozen=True)
+class Reporting:
+    """Where a run's progress goes: a reporter, and the key and label it shows the run under."""
+
+    reporter: Reporter
+    key: Hashable = None
+    """the reporter's key for this run"""
+    label: str | None = None
+    """the reporter's label (default: the run directory's name)"""
+
+
 class StopRequest:
     """Turns SIGINT and SIGTERM into a polite request to stop at the next episode boundary.
 
@@ -187,9 +198,7 @@ def execute_run(
     *,
     resume: bool = False,
     should_stop: Callable[[], bool] | None = None,
-    reporter: Reporter | None = None,
-    key: Hashable = None,
-    label: str | None = None,
+    reporting: Reporting | None = None,
     watch_every: int = 0,
     video_every: int = 0,
     plot: bool = True,
@@ -202,9 +211,7 @@ def execute_run(
         resume: continue from ``run_dir``'s checkpoint (from episode 0 when the run was
             stopped before its first checkpoint) instead of a new run.
         should_stop: polled between chunks of episodes.
-        reporter: receives progress under ``key``.
-        key: the reporter's key for this run.
-        label: the reporter's label (default: the directory name).
+        reporting: where progress goes (default: nowhere).
         watch_every: every this many episodes, play one greedy episode in Gymnasium's
             window (``train --watch``; 0: never).
         video_every: every this many episodes, record one greedy episode as
@@ -215,7 +222,8 @@ def execute_run(
     Raises:
         RunError: ``resume`` and the checkpoint is missing or damaged.
     """
-    reporter = reporter or NullReporter()
+    reporting = reporting or Reporting(NullReporter())
+    reporter, key, label = reporting.reporter, reporting.key, reporting.label
     config = prepared.config
     checkpoint = None
     if resume:

@@ -31,7 +31,7 @@ from cartpole_q.config import (
 from cartpole_q.engines.plan import planned, planning
 from cartpole_q.errors import RunError
 from cartpole_q.experiments.compiling import compile_ahead
-from cartpole_q.experiments.plots import CurveStyle, check_record, plot_metric
+from cartpole_q.experiments.plots import CurveStyle, MetricView, check_record, plot_metric
 from cartpole_q.experiments.study import (
     Options,
     Outcome,
@@ -386,7 +386,7 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
         reference = (figure.reference, figure.reference_label)
     style = CurveStyle(
         labels, figure.title, figure.y_label, figure.offset, figure.scale, reference,
-        figure.x_max, (figure.y_min, figure.y_max), log_x=figure.log_x,
+        figure.x_max, (figure.y_min, figure.y_max), log_x=figure.log_x, log_y=figure.log_y,
     )  # fmt: skip
     paths = [directory / "points" / spec.point_id(point.index) for point in spec.points]
     if figure.against is not None:
@@ -395,10 +395,8 @@ def draw_sweep_figure(spec: SweepSpec, directory: Path) -> Path:
         return plot_values(spec, paths, labels, directory / figure.file)
     if figure.metric == POLICY_FIGURE:
         return plot_policy(spec, paths, labels, directory / figure.file)
-    return plot_metric(
-        paths, directory / figure.file, figure.metric, figure.x, figure.aggregate,
-        figure.smooth, figure.log_y, force=True, style=style,
-    )  # fmt: skip
+    view = MetricView(figure.metric, figure.x, figure.aggregate, figure.smooth)
+    return plot_metric(paths, directory / figure.file, view, force=True, style=style)
 
 
 def plot_against(spec: SweepSpec, paths: Sequence[Path], out: Path) -> Path:

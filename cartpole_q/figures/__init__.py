@@ -66,6 +66,7 @@ from cartpole_q.figures.dp import (
 from cartpole_q.figures.linear import ErrorCurve, WeightsPanel, error_curves_figure, weights_figure
 from cartpole_q.figures.maps import (
     GridMap,
+    MapDimensions,
     action_names,
     blackjack_optimal_figure,
     blackjack_policy_figure,
@@ -121,6 +122,7 @@ __all__ = [
     "FigureData",
     "GridMap",
     "GridPanel",
+    "MapDimensions",
     "MetricBand",
     "PanelData",
     "ParameterLine",

@@ -31,13 +31,24 @@ from cartpole_q.figures.curves import (
 )
 
 
+@dataclass(frozen=True)
+class MapDimensions:
+    """The two dimensions a policy map draws, and every dimension's range and name."""
+
+    dims: tuple[int, int]
+    """the dimension drawn down (rows) and the one drawn across (columns)"""
+    low: Sequence[float]
+    """each dimension's lowest value (a bin grid's ``low``)"""
+    high: Sequence[float]
+    """each dimension's highest value"""
+    names: Sequence[str]
+    """each dimension's name, on the axes"""
+
+
 def policy_figure(
     q_table: np.ndarray,
     visits: np.ndarray | None,
-    dims: tuple[int, int],
-    low: Sequence[float],
-    high: Sequence[float],
-    names: Sequence[str],
+    dimensions: MapDimensions,
     title: str,
     action_names: Sequence[str] | None = None,
     value_name: str = "state value max_a Q",
@@ -51,6 +62,7 @@ def policy_figure(
     action, labelled ``"0: push left"`` and so on when ``action_names`` are given.
     ``rows_down`` draws the first dimension downwards (a grid world's rows, as Taxi).
     """
+    dims, low, high, names = dimensions.dims, dimensions.low, dimensions.high, dimensions.names
     q_map, value_map, visit_map = project_policy(q_table, visits, dims)
     actions = np.argmax(q_map, axis=-1)
     action_map = actions.astype(float)

@@ -191,16 +191,6 @@ number of the next update (0: not started, the start state not valued yet), and 
 of the on-policy simulation"""
 
 
-def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
-    """A run's tables, kept across its chunks: ``Q`` (zeros), the values, their next sweep, the policy."""
-    return (
-        np.zeros((states, actions)),
-        np.zeros(states),
-        np.zeros(states),
-        np.zeros(states, np.int64),
-    )
-
-
 class Task(NamedTuple):
     """One of Figure 8.8's random tasks: its size and how episodes end."""
 
@@ -225,6 +215,36 @@ class Curve(NamedTuple):
     """policy evaluation of the greedy policy stops at this largest change"""
 
 
+class Progress(NamedTuple):
+    """A curve's run between chunks of :func:`trajectory_run`: what it drew and where it is."""
+
+    out: np.ndarray
+    """float64 ``[updates // every + 1]``: the start state's greedy values so far"""
+    tables: tuple[np.ndarray, ...]
+    """``Q``, the values, their next sweep, the policy (:func:`trajectory_tables`)"""
+    carry: np.ndarray
+    """int64 ``[TRAJECTORY_CARRY]``: the next update and the on-policy state"""
+
+
+def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
+    """A run's tables, kept across its chunks: ``Q`` (zeros), the values, their next sweep, the policy."""
+    return (
+        np.zeros((states, actions)),
+        np.zeros(states),
+        np.zeros(states),
+        np.zeros(states, np.int64),
+    )
+
+
+def trajectory_progress(task: Task, curve: Curve) -> Progress:
+    """A curve's run at its start: no value drawn, ``Q`` at 0, at the start state."""
+    return Progress(
+        np.empty(curve.updates // curve.every + 1),
+        trajectory_tables(task.states, task.actions),
+        np.zeros(TRAJECTORY_CARRY, dtype=np.int64),
+    )
+
+
 @compilable
 def trajectory_run(
     next_states: np.ndarray,
@@ -233,9 +253,7 @@ def trajectory_run(
     curve: Curve,
     on_policy: bool,
     rng: Rng,
-    out: np.ndarray,
-    tables: tuple[np.ndarray, ...],
-    carry: np.ndarray,
+    progress: Progress,
     budget: int,
 ) -> bool:
     """One task's curve: ``out[i]`` is the start state's greedy value after ``i * every`` updates.
@@ -247,12 +265,13 @@ def trajectory_run(
     termination`` ends the episode (the next starts at state 0), else ``s =
     next_states[s, a, rng.integers(0, b)]``.
 
-    A call goes on from ``carry`` (zeros: the start) with ``tables``
-    (:func:`trajectory_tables`) for about ``budget`` units of work (an update counts ``b``,
+    A call goes on from ``progress`` (:func:`trajectory_progress`: the start) for about
+    ``budget`` units of work (an update counts ``b``,
     a valuation ``S * b``, one sweep's worth; ``budget >= 1``) and returns whether the
     curve is complete: the run in chunks is the run in one call, draw for draw.
     """
-    q, values, fresh, policy = tables
+    out, carry = progress.out, progress.carry
+    q, values, fresh, policy = progress.tables
     states, actions, branching = next_states.shape
     termination, epsilon = task.termination, curve.epsilon
     every, tolerance = curve.every, curve.tolerance

@@ -69,18 +69,42 @@ class Agent(NamedTuple):
     """float64 ``(d_w,)``: ``z^w``"""
 
 
+class Settings(NamedTuple):
+    """A curve's step sizes, discount, floor and trace decays: what :func:`new_agent` copies."""
+
+    alpha: float
+    """the policy's step size (the book's alpha, or alpha^theta)"""
+    alpha_w: float
+    """the value layer's step size (0.0 without one)"""
+    gamma: float
+    floor: float = 0.0
+    """two actions: the least probability either may have (0.0: none)"""
+    lambdas: tuple[float, float] = (0.0, 0.0)
+    """``(λ^θ, λ^w)``: the traces' decays (actor-critic with traces)"""
+
+
+class Layer(NamedTuple):
+    """A linear layer at its start: its rows (pairs of a weight index and a value) and weights."""
+
+    indices: np.ndarray
+    """int64 ``(rows, K)``: each row's weight indices"""
+    values: np.ndarray
+    """float64 ``(rows, K)``: each row's feature values"""
+    weights: np.ndarray
+    """the start weights (copied by :func:`new_agent`)"""
+
+
 def new_agent(
-    algorithm: str, alpha: float, alpha_w: float, gamma: float, floor: float, n_actions: int,
-    policy_rows: tuple[np.ndarray, np.ndarray], theta0: np.ndarray,
-    value_rows: tuple[np.ndarray, np.ndarray], w0: np.ndarray,
-    lambdas: tuple[float, float] = (0.0, 0.0),
-) -> Agent:  # fmt: skip
-    """An agent at its start: ``θ = theta0``, ``w = w0`` (copied); ``lambdas``: ``(λ^θ, λ^w)``."""
+    algorithm: str, settings: Settings, n_actions: int, policy_layer: Layer, value_layer: Layer
+) -> Agent:
+    """An agent at its start: ``θ`` and ``w`` copied from the layers' start weights."""
+    theta0, w0 = policy_layer.weights, value_layer.weights
     return Agent(
-        CODES[algorithm], float(alpha), float(alpha_w), float(gamma), float(floor),
-        float(lambdas[0]), float(lambdas[1]), int(n_actions),
-        policy_rows[0], policy_rows[1], theta0.astype(np.float64, copy=True),
-        value_rows[0], value_rows[1], w0.astype(np.float64, copy=True),
+        CODES[algorithm], float(settings.alpha), float(settings.alpha_w), float(settings.gamma),
+        float(settings.floor), float(settings.lambdas[0]), float(settings.lambdas[1]),
+        int(n_actions),
+        policy_layer.indices, policy_layer.values, theta0.astype(np.float64, copy=True),
+        value_layer.indices, value_layer.values, w0.astype(np.float64, copy=True),
         np.zeros(n_actions), np.zeros(theta0.shape[0]), np.zeros(theta0.shape[0]),
         np.zeros(w0.shape[0]),
     )  # fmt: skip
