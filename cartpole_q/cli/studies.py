@@ -71,8 +71,9 @@ ALIAS_KINDS: dict[str, str | None] = {
     "dp": "dp",
     "updates": "updates",
 }
-"""each name :func:`study_command` answers to, and the kind it runs (``None``: any); the
-older names are aliases for one release (``bandit``, with its ``--engine``, is its own)"""
+"""each name :func:`study_command` answers to, and the kind it runs (``None``: any): ``sweep``
+is ``study``'s first name; ``dp`` and ``updates`` are aliases for one release (``bandit``,
+with its ``--engine``, is a command of its own)"""
 
 
 @app.command(

@@ -36,7 +36,7 @@ class MapDimensions:
     """The two dimensions a policy map draws, and every dimension's range and name."""
 
     dims: tuple[int, int]
-    """the dimension drawn down (rows) and the one drawn across (columns)"""
+    """the dimension on the y axis (rows; upwards unless ``rows_down``) and the one on the x axis"""
     low: Sequence[float]
     """each dimension's lowest value (a bin grid's ``low``)"""
     high: Sequence[float]

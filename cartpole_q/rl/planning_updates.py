@@ -215,7 +215,7 @@ class Curve(NamedTuple):
     """policy evaluation of the greedy policy stops at this largest change"""
 
 
-class Progress(NamedTuple):
+class TrajectoryProgress(NamedTuple):
     """A curve's run between chunks of :func:`trajectory_run`: what it drew and where it is."""
 
     out: np.ndarray
@@ -236,9 +236,9 @@ def trajectory_tables(states: int, actions: int) -> tuple[np.ndarray, ...]:
     )
 
 
-def trajectory_progress(task: Task, curve: Curve) -> Progress:
+def trajectory_progress(task: Task, curve: Curve) -> TrajectoryProgress:
     """A curve's run at its start: no value drawn, ``Q`` at 0, at the start state."""
-    return Progress(
+    return TrajectoryProgress(
         np.empty(curve.updates // curve.every + 1),
         trajectory_tables(task.states, task.actions),
         np.zeros(TRAJECTORY_CARRY, dtype=np.int64),
@@ -253,10 +253,10 @@ def trajectory_run(
     curve: Curve,
     on_policy: bool,
     rng: Rng,
-    progress: Progress,
+    progress: TrajectoryProgress,
     budget: int,
 ) -> bool:
-    """One task's curve: ``out[i]`` is the start state's greedy value after ``i * every`` updates.
+    """One task's curve: ``progress.out[i]``, the start state's greedy value after ``i * every`` updates.
 
     ``Q`` starts at 0. Update ``k = 1, 2, ...``: uniform: the pair ``(k - 1) mod (S * A)``
     in order ``(0, 0), (0, 1), ..., (1, 0), ...``; on-policy: the pair ``(s, a)`` with ``a``
@@ -266,9 +266,9 @@ def trajectory_run(
     next_states[s, a, rng.integers(0, b)]``.
 
     A call goes on from ``progress`` (:func:`trajectory_progress`: the start) for about
-    ``budget`` units of work (an update counts ``b``,
-    a valuation ``S * b``, one sweep's worth; ``budget >= 1``) and returns whether the
-    curve is complete: the run in chunks is the run in one call, draw for draw.
+    ``budget`` units of work (an update counts ``b``, a valuation ``S * b``, one sweep's
+    worth; ``budget >= 1``) and returns whether the curve is complete: the run in chunks is
+    the run in one call, draw for draw.
     """
     out, carry = progress.out, progress.carry
     q, values, fresh, policy = progress.tables
