@@ -266,6 +266,10 @@ def test_bandit_refuses_a_missing_file_a_bad_out_and_a_bad_engine(tmp_path: Path
     assert result.exit_code == 2 and "engine: must be one of numba, gymnasium" in result.stderr
     result = invoke("bandit", REPO / "examples" / "book" / "fig4_1_small_gridworld.yaml")
     assert result.exit_code == 2 and "is a dp study, not a bandit study" in result.stderr
+    result = invoke("updates", study, "--check")  # the alias answers by the name it was called
+    assert result.exit_code == 2
+    assert "is a bandit study, not an updates study" in result.stderr
+    assert "(`updates` runs updates studies)" in result.stderr
     assert not (tmp_path / "s").exists()
 
 

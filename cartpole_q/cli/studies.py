@@ -208,9 +208,18 @@ def _check_kind(kind: str, required: str | None, where: str, command: str) -> No
     """Refuse a study of another kind than the alias runs, naming the command that runs it."""
     if required is not None and kind != required:
         raise UserError(
-            f"{where}: is a {kind} study, not a {required} study; run it with `cartpole-q study "
-            f"{where}` (`{command}` runs {required} studies)."
+            f"{where}: is {_a(kind)} study, not {_a(required)} study; run it with `cartpole-q "
+            f"study {where}` (`{command}` runs {required} studies)."
         )
+
+
+def _a(kind: str) -> str:
+    """The kind with its article: ``a dp``, ``an updates``.
+
+    >>> _a("dp"), _a("updates"), _a("average_reward")
+    ('a dp', 'an updates', 'an average_reward')
+    """
+    return f"{'an' if kind[:1] in 'aeiou' else 'a'} {kind}"
 
 
 def _options(
