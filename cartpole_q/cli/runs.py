@@ -454,8 +454,7 @@ def optimum_command(
 ) -> None:
     """The best expected return from the start, by value iteration on the environment's model.
 
-    On an average-reward world (access control), the optimal reward per step instead, by
-    relative value iteration.
+    On an average-reward world (access control): the best reward per step, by relative value iteration.
     """
     with exit_codes():
         from cartpole_q.cli.exact_text import exact_lines, policy_grid, state_label
